@@ -1,0 +1,344 @@
+/*
+ * mfree — embeddable meshfree particle approximations.
+ *
+ * Public C ABI. C99-clean, usable from C++ and (through module mfree) Fortran 2008.
+ *
+ * Conventions (see ../shared/STYLE.md in the project tree):
+ *  - every function returns mfree_status_t: 0 success, negative misuse or resource
+ *    failure (nothing changed), positive data-dependent numerical failure (the call
+ *    completed what it could);
+ *  - the message of the last failure is kept on the context
+ *    (mfree_context_get_last_error); the library never prints, aborts or exits;
+ *  - reals are double, particle indices int32_t, offsets and counts of non-zeros int64_t;
+ *  - destroy(&h) accepts NULL and sets h = NULL; objects are reference counted, so the
+ *    order of destruction does not matter.
+ */
+#ifndef MFREE_H
+#define MFREE_H
+
+#include <stdint.h>
+
+#include "mfree_version.h"
+
+#if defined(_WIN32)
+#if defined(MFREE_BUILDING)
+#define MFREE_API __declspec(dllexport)
+#else
+#define MFREE_API
+#endif
+#elif defined(__GNUC__) && __GNUC__ >= 4
+#define MFREE_API __attribute__((visibility("default")))
+#else
+#define MFREE_API
+#endif
+
+/** True when the headers are at least version a.b.c. */
+#define MFREE_VERSION_GE(a, b, c)                                                        \
+  ((MFREE_VERSION_MAJOR > (a)) ||                                                        \
+   (MFREE_VERSION_MAJOR == (a) && MFREE_VERSION_MINOR > (b)) ||                          \
+   (MFREE_VERSION_MAJOR == (a) && MFREE_VERSION_MINOR == (b) &&                          \
+    MFREE_VERSION_PATCH >= (c)))
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------ */
+/* Status codes. Values are frozen: never renumbered, never reused.                      */
+/* ------------------------------------------------------------------------------------ */
+
+typedef enum mfree_status {
+  MFREE_SUCCESS = 0,
+
+  /* Negative: misuse or resource failure. Nothing was changed. */
+  MFREE_ERR_NULL = -1,        /**< a required handle or pointer is NULL */
+  MFREE_ERR_ARG = -2,         /**< an argument is out of range (dimension, count,
+                                   leading dimension, unknown enumerator) */
+  MFREE_ERR_STATE = -3,       /**< the object is not in a state that allows the call */
+  MFREE_ERR_ALLOC = -4,       /**< memory allocation failed */
+  MFREE_ERR_MISMATCH = -5,    /**< objects or sizes that must agree do not */
+  MFREE_ERR_UNSUPPORTED = -6, /**< a valid request this method/kernel does not provide */
+  MFREE_ERR_INPUT = -7,       /**< invalid values in an input array (NaN/Inf, zero or
+                                   negative volume or support, malformed CSR) */
+  MFREE_ERR_INTERNAL = -99,   /**< a bug in mfree; please report it */
+
+  /* Positive: data-dependent failure. The call completed what it could and reports
+   * the affected particles or sites. */
+  MFREE_FAIL_NONFINITE = 1,   /**< a non-finite value in borrowed data or a result */
+  MFREE_FAIL_INVALID_DATA = 2,/**< a borrowed value outside its range (e.g. a volume or
+                                   support that became <= 0 after it was set) */
+  MFREE_FAIL_SINGULAR = 3,    /**< singular or ill-conditioned local system */
+  MFREE_FAIL_NEIGHBORS = 4    /**< too few neighbours (isolated site, basis too large) */
+} mfree_status_t;
+
+/** How an input array is held. */
+typedef enum mfree_mem {
+  MFREE_COPY = 1,  /**< copied at the call; the host may free or reuse its array */
+  MFREE_BORROW = 2 /**< kept as a pointer and re-read at every setup/update/apply; the
+                        host keeps it alive and may change its values between calls */
+} mfree_mem_t;
+
+/** Layout of a multi-component array of n items with ncomp components. */
+typedef enum mfree_layout {
+  MFREE_LAYOUT_AOS = 1, /**< item i, component c at a[i*ld + c], ld >= ncomp
+                             (Fortran x(3,n); an array of host structs) */
+  MFREE_LAYOUT_SOA = 2  /**< item i, component c at a[c*ld + i], ld >= n
+                             (Fortran x(n,3)) */
+} mfree_layout_t;
+
+/** Neighbour criterion for particles i, j at distance r with supports h_i, h_j. */
+typedef enum mfree_search {
+  MFREE_SEARCH_GATHER = 1,         /**< r < kappa*h_i (row i uses its own support) */
+  MFREE_SEARCH_SYMMETRIC_MAX = 2,  /**< r < kappa*max(h_i, h_j) */
+  MFREE_SEARCH_SYMMETRIC_MEAN = 3  /**< r < kappa*(h_i + h_j)/2 */
+} mfree_search_t;
+
+/**
+ * Smoothing kernels W(r, h) = C_dim / h^dim * f(q), q = r/h, with support q < R.
+ * C_dim makes the integral of W over R^dim equal 1 in dimension dim = 1, 2, 3.
+ */
+typedef enum mfree_kernel {
+  MFREE_KERNEL_CUBIC_SPLINE = 1,        /**< 000 eq 26, 001 eq 6.6; R = 2 */
+  MFREE_KERNEL_QUARTIC = 2,             /**< 001 eq 6.7, 1 - 3/2q^2 + q^3 - 3/16q^4
+                                             (Lucy); R = 2 */
+  MFREE_KERNEL_QUINTIC_SPLINE = 3,      /**< Morris' quintic spline; R = 3 */
+  MFREE_KERNEL_GAUSSIAN = 4,            /**< exp(-q^2), truncated and renormalised at
+                                             R = 3 */
+  MFREE_KERNEL_SUPER_GAUSS = 5,         /**< 001 eq 6.9, (5/2 - q^2) exp(-q^2),
+                                             truncated and renormalised at R = 3;
+                                             negative for q^2 > 5/2 */
+  MFREE_KERNEL_REVISED_GAUSS = 6,       /**< 001 eq 6.8, exp(-q^2) - exp(-4); R = 2 */
+  MFREE_KERNEL_REVISED_SUPER_GAUSS = 7, /**< 001 eqs 6.10/6.17, (4 - q^2) exp(-a q^2);
+                                             R = 2; parameter a, default 1 */
+  MFREE_KERNEL_WENDLAND_C2 = 8,         /**< Wendland C2 (1D: psi_{2,1}; 2D/3D:
+                                             psi_{3,1}); R = 2 */
+  MFREE_KERNEL_WENDLAND_C4 = 9,         /**< Wendland C4 (1D: psi_{3,2}; 2D/3D:
+                                             psi_{4,2}); R = 2 */
+  MFREE_KERNEL_LINEAR = 10,             /**< 001 eq 6.4, (2 - q)/4; R = 2 */
+  MFREE_KERNEL_QUADRATIC = 11,          /**< 001 eq 6.5, (1 - q/2)^2; R = 2 */
+  MFREE_KERNEL_QUARTIC_SPLINE = 12      /**< Morris' quartic spline; R = 5/2 */
+} mfree_kernel_t;
+
+/* ------------------------------------------------------------------------------------ */
+/* Opaque handles                                                                         */
+/* ------------------------------------------------------------------------------------ */
+
+typedef struct mfree_context mfree_context_t;
+typedef struct mfree_particles mfree_particles_t;
+
+/** Called on every failure recorded on a context (from the failing call's thread). */
+typedef void (*mfree_error_handler_t)(void *user, mfree_status_t code, const char *message);
+
+/* ------------------------------------------------------------------------------------ */
+/* Version and status                                                                     */
+/* ------------------------------------------------------------------------------------ */
+
+/** Run-time version, "MAJOR.MINOR.PATCH"; a static string. */
+MFREE_API const char *mfree_version_string(void);
+
+/** Run-time version numbers (compare with the MFREE_VERSION_* macros).
+ * @param[out] major, minor, patch  each may be NULL */
+MFREE_API mfree_status_t mfree_version_get(int32_t *major, int32_t *minor, int32_t *patch);
+
+/** A static, human-readable name for a status code ("unknown status" if not one). */
+MFREE_API const char *mfree_status_string(mfree_status_t status);
+
+/* ------------------------------------------------------------------------------------ */
+/* Context                                                                                */
+/* ------------------------------------------------------------------------------------ */
+
+/** Create a context: error state, thread count, error handler. Use one per host thread.
+ * @param[out] ctx  the new context */
+MFREE_API mfree_status_t mfree_context_create(mfree_context_t **ctx);
+
+/** Release a context. Objects created on it keep it alive until they are destroyed.
+ * @param[in,out] ctx  may be NULL or point to NULL; set to NULL */
+MFREE_API mfree_status_t mfree_context_destroy(mfree_context_t **ctx);
+
+/** The last failure recorded on the context (successful calls leave it unchanged).
+ * @param[out] code     the status of the failing call (MFREE_SUCCESS if none); may be NULL
+ * @param[out] message  buffer for the NUL-terminated message; may be NULL
+ * @param[in]  len      size of message in bytes; the message is truncated to fit */
+MFREE_API mfree_status_t mfree_context_get_last_error(const mfree_context_t *ctx,
+                                                      mfree_status_t *code, char *message,
+                                                      int64_t len);
+
+/** Install an error handler (NULL removes it). The handler must not call back into
+ * mfree with the same context. */
+MFREE_API mfree_status_t mfree_context_set_error_handler(mfree_context_t *ctx,
+                                                         mfree_error_handler_t handler,
+                                                         void *user);
+
+/** Threads used by objects created on this context (default 1; 0 means all cores).
+ * mfree never calls omp_set_* itself. */
+MFREE_API mfree_status_t mfree_context_set_num_threads(mfree_context_t *ctx,
+                                                       int32_t nthreads);
+MFREE_API mfree_status_t mfree_context_get_num_threads(const mfree_context_t *ctx,
+                                                       int32_t *nthreads);
+
+/* ------------------------------------------------------------------------------------ */
+/* Kernels                                                                                */
+/* ------------------------------------------------------------------------------------ */
+
+/**
+ * Evaluate a kernel and its radial derivatives at n distances.
+ * @param[in]  kernel  an mfree_kernel_t
+ * @param[in]  dim     1, 2 or 3 (selects the normalisation and, for Wendland, the form)
+ * @param[in]  param   shape parameter: the decay a of MFREE_KERNEL_REVISED_SUPER_GAUSS
+ *                     (> 0); 0 selects the default (1); ignored by the other kernels
+ * @param[in]  h       smoothing length (> 0, finite)
+ * @param[in]  n       number of distances (>= 0)
+ * @param[in]  r       distances (>= 0, finite), length n
+ * @param[out] w       W(r), or NULL
+ * @param[out] dwdr    dW/dr, or NULL
+ * @param[out] d2wdr2  d2W/dr2, or NULL
+ */
+MFREE_API mfree_status_t mfree_kernel_eval(mfree_context_t *ctx, mfree_kernel_t kernel,
+                                           int32_t dim, double param, double h, int64_t n,
+                                           const double *r, double *w, double *dwdr,
+                                           double *d2wdr2);
+
+/** Support radius R in units of h: W(r, h) = 0 for r >= R h. */
+MFREE_API mfree_status_t mfree_kernel_get_support_radius(mfree_context_t *ctx,
+                                                         mfree_kernel_t kernel,
+                                                         double param, double *radius);
+
+/** The constant C_dim in W = C_dim / h^dim f(q). For the Gauss family of paper 001
+ * (W = G/(h sqrt(pi))^dim f) this is G / pi^(dim/2). */
+MFREE_API mfree_status_t mfree_kernel_get_normalization(mfree_context_t *ctx,
+                                                        mfree_kernel_t kernel, int32_t dim,
+                                                        double param, double *c);
+
+/* ------------------------------------------------------------------------------------ */
+/* Particle sets                                                                          */
+/* ------------------------------------------------------------------------------------ */
+
+/**
+ * Create a particle set of n particles in dimension dim. The last n_ghost particles
+ * (mfree_particles_set_num_ghost, default 0) are ghosts: they serve as neighbours but
+ * get no rows of their own.
+ * @param[in]  dim  1, 2 or 3
+ * @param[in]  n    number of particles, owned plus ghost (>= 0)
+ * @param[out] ps   the new particle set
+ */
+MFREE_API mfree_status_t mfree_particles_create(mfree_context_t *ctx, int32_t dim,
+                                                int32_t n, mfree_particles_t **ps);
+
+/** Release a particle set (objects built on it keep it alive).
+ * @param[in,out] ps  may be NULL or point to NULL; set to NULL */
+MFREE_API mfree_status_t mfree_particles_destroy(mfree_particles_t **ps);
+
+/** The last n_ghost particles are ghosts (0 <= n_ghost <= n). Default 0. */
+MFREE_API mfree_status_t mfree_particles_set_num_ghost(mfree_particles_t *ps,
+                                                       int32_t n_ghost);
+
+/**
+ * Positions, dim components per particle.
+ * @param[in] x       coordinates (finite); copied or borrowed according to mem
+ * @param[in] layout  MFREE_LAYOUT_AOS (x[i*ld + d], ld >= dim) or
+ *                    MFREE_LAYOUT_SOA (x[d*ld + i], ld >= n)
+ * @param[in] ld      leading dimension, in doubles
+ */
+MFREE_API mfree_status_t mfree_particles_set_positions(mfree_particles_t *ps,
+                                                       const double *x,
+                                                       mfree_layout_t layout, int64_t ld,
+                                                       mfree_mem_t mem);
+
+/**
+ * Per-particle scalars: element i is a[i*stride]; stride 0 gives every particle a[0].
+ * Values must be finite and > 0. Copied or borrowed according to mem.
+ *  - volumes: Delta V_i. When unset, volumes are masses/densities.
+ *  - masses, densities: used for volumes (V_i = m_i / rho_i) when volumes are unset.
+ *  - support: smoothing lengths h_i (the kernel support radius is R h_i).
+ */
+MFREE_API mfree_status_t mfree_particles_set_volumes(mfree_particles_t *ps,
+                                                     const double *v, int64_t stride,
+                                                     mfree_mem_t mem);
+MFREE_API mfree_status_t mfree_particles_set_masses(mfree_particles_t *ps,
+                                                    const double *m, int64_t stride,
+                                                    mfree_mem_t mem);
+MFREE_API mfree_status_t mfree_particles_set_densities(mfree_particles_t *ps,
+                                                       const double *rho, int64_t stride,
+                                                       mfree_mem_t mem);
+MFREE_API mfree_status_t mfree_particles_set_support(mfree_particles_t *ps,
+                                                     const double *h, int64_t stride,
+                                                     mfree_mem_t mem);
+
+/**
+ * Neighbour criterion and radius multiplier: j is a neighbour of i when their distance
+ * is below kappa times the convention's support. Default MFREE_SEARCH_GATHER, kappa 2
+ * (the support of the 001 kernels and the cubic spline).
+ */
+MFREE_API mfree_status_t mfree_particles_set_search(mfree_particles_t *ps,
+                                                    mfree_search_t convention,
+                                                    double kappa);
+
+/**
+ * A box [lo, hi) with periodic axes (copied). Distances use the nearest image along
+ * periodic axes; kappa * h must stay below half the box length there.
+ * @param[in] lo, hi     dim values each, hi > lo
+ * @param[in] periodic   dim flags, nonzero for a periodic axis
+ */
+MFREE_API mfree_status_t mfree_particles_set_periodic(mfree_particles_t *ps,
+                                                      const double *lo, const double *hi,
+                                                      const int32_t *periodic);
+
+/**
+ * Host-supplied neighbour lists, one row per owned particle (CSR). mfree then does no
+ * search of its own. Rows need not be sorted nor contain the particle itself.
+ * @param[in] rowptr      n_owned + 1 monotone offsets, rowptr[0] = base
+ * @param[in] cols        column indices in [base, base + n)
+ * @param[in] index_base  0 (C) or 1 (Fortran) for both arrays
+ * @param[in] mem         copied or borrowed (borrowed lists are re-validated at setup)
+ */
+MFREE_API mfree_status_t mfree_particles_set_neighbors(mfree_particles_t *ps,
+                                                       const int64_t *rowptr,
+                                                       const int32_t *cols,
+                                                       int32_t index_base,
+                                                       mfree_mem_t mem);
+
+/**
+ * Validate the particle data and build the neighbour lists (cell-list search, or the
+ * host's lists). A particle whose borrowed data are non-finite or out of range is
+ * isolated: its row is empty and no other row lists it; the call then returns
+ * MFREE_FAIL_NONFINITE or MFREE_FAIL_INVALID_DATA and mfree_particles_get_site_status
+ * names the particles.
+ */
+MFREE_API mfree_status_t mfree_particles_setup(mfree_particles_t *ps);
+
+/** Re-read and re-validate borrowed data after particles moved; the neighbour lists
+ * are kept (use setup to search again). */
+MFREE_API mfree_status_t mfree_particles_update(mfree_particles_t *ps);
+
+MFREE_API mfree_status_t mfree_particles_get_dimension(const mfree_particles_t *ps,
+                                                       int32_t *dim);
+/** @param[out] n  owned plus ghost particles; @param[out] n_ghost  ghosts; either NULL */
+MFREE_API mfree_status_t mfree_particles_get_size(const mfree_particles_t *ps, int32_t *n,
+                                                  int32_t *n_ghost);
+
+/** Number of stored neighbour pairs (after setup). */
+MFREE_API mfree_status_t mfree_particles_get_neighbor_nnz(const mfree_particles_t *ps,
+                                                          int64_t *nnz);
+
+/**
+ * Copy the neighbour lists (0-based CSR, one row per owned particle, each row sorted
+ * ascending; searched rows include the particle itself).
+ * @param[out] rowptr  n_owned + 1 offsets
+ * @param[out] cols    nnz column indices (size from mfree_particles_get_neighbor_nnz)
+ */
+MFREE_API mfree_status_t mfree_particles_get_neighbors(const mfree_particles_t *ps,
+                                                       int64_t *rowptr, int32_t *cols);
+
+/**
+ * Per-particle status of the last setup/update: 0, or the positive status that
+ * isolated the particle. @param[out] status  n values
+ * @param[out] nfailed  number of nonzero entries (may be NULL)
+ */
+MFREE_API mfree_status_t mfree_particles_get_site_status(const mfree_particles_t *ps,
+                                                         int32_t *status, int32_t *nfailed);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MFREE_H */

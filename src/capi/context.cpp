@@ -1,0 +1,81 @@
+#include <cstring>
+
+#include "handles.hpp"
+
+namespace mfree {
+
+void retain(mfree_context_t *c) { c->refs.fetch_add(1, std::memory_order_relaxed); }
+void release(mfree_context_t *c) {
+  if (c && c->refs.fetch_sub(1, std::memory_order_acq_rel) == 1) delete c;
+}
+
+mfree_status_t record(mfree_context_t *ctx, mfree_status_t status, const char *fn,
+                      const std::string &msg) {
+  if (!ctx) return status;
+  try {
+    ctx->last_code = status;
+    ctx->last_message = std::string(fn) + ": " + msg;
+  } catch (...) {
+    ctx->last_code = status;
+  }
+  if (ctx->handler) ctx->handler(ctx->handler_user, status, ctx->last_message.c_str());
+  return status;
+}
+
+}  // namespace mfree
+
+extern "C" {
+
+mfree_status_t mfree_context_create(mfree_context_t **ctx) {
+  if (!ctx) return MFREE_ERR_NULL;
+  *ctx = nullptr;
+  mfree_context_t *c = new (std::nothrow) mfree_context_t();
+  if (!c) return MFREE_ERR_ALLOC;
+  *ctx = c;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_context_destroy(mfree_context_t **ctx) {
+  if (!ctx || !*ctx) return MFREE_SUCCESS;
+  mfree::release(*ctx);
+  *ctx = nullptr;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_context_get_last_error(const mfree_context_t *ctx, mfree_status_t *code,
+                                            char *message, int64_t len) {
+  if (!ctx) return MFREE_ERR_NULL;
+  if (message && len < 1) return MFREE_ERR_ARG;
+  if (code) *code = ctx->last_code;
+  if (message) {
+    const size_t n = std::min<size_t>(ctx->last_message.size(), static_cast<size_t>(len - 1));
+    std::memcpy(message, ctx->last_message.data(), n);
+    message[n] = '\0';
+  }
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_context_set_error_handler(mfree_context_t *ctx,
+                                               mfree_error_handler_t handler, void *user) {
+  if (!ctx) return MFREE_ERR_NULL;
+  ctx->handler = handler;
+  ctx->handler_user = user;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_context_set_num_threads(mfree_context_t *ctx, int32_t nthreads) {
+  if (!ctx) return MFREE_ERR_NULL;
+  if (nthreads < 0)
+    return mfree::record(ctx, MFREE_ERR_ARG, "mfree_context_set_num_threads",
+                         "thread count " + std::to_string(nthreads) + " is negative");
+  ctx->nthreads = nthreads;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_context_get_num_threads(const mfree_context_t *ctx, int32_t *nthreads) {
+  if (!ctx || !nthreads) return MFREE_ERR_NULL;
+  *nthreads = ctx->nthreads;
+  return MFREE_SUCCESS;
+}
+
+}  // extern "C"

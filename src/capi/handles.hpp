@@ -1,0 +1,67 @@
+// Handle structs behind the opaque C types, reference counting and the exception guard
+// that every extern "C" body runs inside.
+#pragma once
+
+#include <atomic>
+#include <new>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/particles.hpp"
+#include "mfree.h"
+
+struct mfree_context {
+  std::atomic<int> refs{1};
+  mfree_status_t last_code = MFREE_SUCCESS;
+  std::string last_message;
+  mfree_error_handler_t handler = nullptr;
+  void *handler_user = nullptr;
+  int32_t nthreads = 1;
+};
+
+struct mfree_particles {
+  std::atomic<int> refs{1};
+  mfree_context_t *ctx = nullptr;
+  mfree::ParticleSet set;
+  mfree_particles(mfree_context_t *c, int dim, int32_t n) : ctx(c), set(dim, n) {}
+};
+
+namespace mfree {
+
+void retain(mfree_context_t *c);
+void release(mfree_context_t *c);
+void retain(mfree_particles_t *p);
+void release(mfree_particles_t *p);
+
+// Record a failure (or a positive report) on the context; returns status unchanged.
+mfree_status_t record(mfree_context_t *ctx, mfree_status_t status, const char *fn,
+                      const std::string &msg);
+
+// Run body() and turn every exception into a status and a message on ctx.
+template <class Body>
+mfree_status_t guard(mfree_context_t *ctx, const char *fn, Body &&body) noexcept {
+  try {
+    return body();
+  } catch (const Error &e) {
+    return record(ctx, e.status(), fn, e.what());
+  } catch (const std::bad_alloc &) {
+    return record(ctx, MFREE_ERR_ALLOC, fn, "out of memory");
+  } catch (const std::exception &e) {
+    return record(ctx, MFREE_ERR_INTERNAL, fn, std::string("internal error: ") + e.what());
+  } catch (...) {
+    return record(ctx, MFREE_ERR_INTERNAL, fn, "internal error: unknown exception");
+  }
+}
+
+// Report a data-dependent outcome: record its message if it failed, return its status.
+inline mfree_status_t finish(mfree_context_t *ctx, const char *fn, const Report &r) {
+  if (r.status != MFREE_SUCCESS) return record(ctx, r.status, fn, r.message);
+  return MFREE_SUCCESS;
+}
+
+}  // namespace mfree
+
+#define MFREE_REQUIRE(cond, status, msg)          \
+  do {                                            \
+    if (!(cond)) throw ::mfree::Error(status, msg); \
+  } while (0)

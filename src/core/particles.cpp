@@ -1,0 +1,279 @@
+#include "particles.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace mfree {
+
+namespace {
+
+std::string fmt_index(const char *what, int64_t i, double v) {
+  std::ostringstream s;
+  s << what << "[" << i << "] = " << v;
+  return s.str();
+}
+
+void check_mem(int mem) {
+  if (mem != MFREE_COPY && mem != MFREE_BORROW)
+    throw Error(MFREE_ERR_ARG, "mem must be MFREE_COPY or MFREE_BORROW, got " + std::to_string(mem));
+}
+
+}  // namespace
+
+ParticleSet::ParticleSet(int dim, int32_t n) : dim_(dim), n_(n) {
+  if (dim < 1 || dim > 3)
+    throw Error(MFREE_ERR_ARG, "dimension " + std::to_string(dim) + " is not 1, 2 or 3");
+  if (n < 0) throw Error(MFREE_ERR_ARG, "particle count " + std::to_string(n) + " is negative");
+  nbr_.rowptr.assign(1, 0);
+}
+
+void ParticleSet::set_num_ghost(int32_t g) {
+  if (g < 0 || g > n_)
+    throw Error(MFREE_ERR_ARG, "ghost count " + std::to_string(g) + " is outside [0, n = " +
+                                   std::to_string(n_) + "]");
+  n_ghost_ = g;
+  setup_done_ = false;
+}
+
+void ParticleSet::set_positions(const double *x, int layout, int64_t ld, int mem) {
+  check_mem(mem);
+  if (layout != MFREE_LAYOUT_AOS && layout != MFREE_LAYOUT_SOA)
+    throw Error(MFREE_ERR_ARG, "unknown layout " + std::to_string(layout));
+  const int64_t need = layout == MFREE_LAYOUT_AOS ? dim_ : n_;
+  if (ld < need)
+    throw Error(MFREE_ERR_ARG, "leading dimension " + std::to_string(ld) + " is below " +
+                                   std::to_string(need) +
+                                   (layout == MFREE_LAYOUT_AOS ? " (dim)" : " (n)"));
+  if (x == nullptr && n_ > 0) throw Error(MFREE_ERR_NULL, "positions pointer is NULL");
+  VectorArray v;
+  v.ptr = x;
+  v.ld = ld;
+  v.layout = layout;
+  for (int32_t i = 0; i < n_; ++i)
+    for (int c = 0; c < dim_; ++c)
+      if (!std::isfinite(v(i, c))) {
+        std::ostringstream s;
+        s << "position of particle " << i << ", component " << c << " is " << v(i, c);
+        throw Error(MFREE_ERR_INPUT, s.str());
+      }
+  if (mem == MFREE_COPY) {
+    std::vector<double> own(static_cast<size_t>(n_) * dim_);
+    for (int32_t i = 0; i < n_; ++i)
+      for (int c = 0; c < dim_; ++c) own[static_cast<size_t>(i) * dim_ + c] = v(i, c);
+    pos_.own.swap(own);
+    pos_.ptr = pos_.own.data();
+    pos_.ld = dim_;
+    pos_.layout = MFREE_LAYOUT_AOS;
+  } else {
+    pos_.own.clear();
+    pos_.ptr = x;
+    pos_.ld = ld;
+    pos_.layout = layout;
+  }
+  // A zero-particle set still needs a non-NULL marker that positions were given.
+  if (pos_.ptr == nullptr) {
+    pos_.own.assign(1, 0.0);
+    pos_.ptr = pos_.own.data();
+  }
+  setup_done_ = false;
+}
+
+void ParticleSet::set_scalar(ScalarArray &a, const double *v, int64_t stride, int mem,
+                             const char *what) {
+  check_mem(mem);
+  if (stride < 0)
+    throw Error(MFREE_ERR_ARG, std::string(what) + " stride " + std::to_string(stride) + " is negative");
+  if (v == nullptr && (n_ > 0 || stride == 0))
+    throw Error(MFREE_ERR_NULL, std::string(what) + " pointer is NULL");
+  const int32_t count = stride == 0 ? 1 : n_;
+  for (int32_t i = 0; i < count; ++i) {
+    const double val = v[i * stride];
+    if (!std::isfinite(val) || val <= 0.0)
+      throw Error(MFREE_ERR_INPUT, fmt_index(what, i, val) + " must be finite and > 0");
+  }
+  if (mem == MFREE_COPY) {
+    std::vector<double> own(count > 0 ? count : 1, 1.0);
+    for (int32_t i = 0; i < count; ++i) own[i] = v[i * stride];
+    a.own.swap(own);
+    a.ptr = a.own.data();
+    a.stride = stride == 0 ? 0 : 1;
+  } else {
+    a.own.clear();
+    a.ptr = v;
+    a.stride = stride;
+    if (a.ptr == nullptr) {  // n = 0 with a NULL array: still counts as set
+      a.own.assign(1, 1.0);
+      a.ptr = a.own.data();
+    }
+  }
+  setup_done_ = false;
+}
+
+void ParticleSet::set_volumes(const double *v, int64_t stride, int mem) {
+  set_scalar(vol_, v, stride, mem, "volume");
+}
+void ParticleSet::set_masses(const double *m, int64_t stride, int mem) {
+  set_scalar(mass_, m, stride, mem, "mass");
+}
+void ParticleSet::set_densities(const double *rho, int64_t stride, int mem) {
+  set_scalar(rho_, rho, stride, mem, "density");
+}
+void ParticleSet::set_support(const double *h, int64_t stride, int mem) {
+  set_scalar(h_, h, stride, mem, "support");
+}
+
+void ParticleSet::set_search(int convention, double kappa) {
+  if (convention < MFREE_SEARCH_GATHER || convention > MFREE_SEARCH_SYMMETRIC_MEAN)
+    throw Error(MFREE_ERR_ARG, "unknown search convention " + std::to_string(convention));
+  if (!std::isfinite(kappa) || kappa <= 0.0)
+    throw Error(MFREE_ERR_ARG, "kappa must be finite and > 0");
+  convention_ = convention;
+  kappa_ = kappa;
+  setup_done_ = false;
+}
+
+void ParticleSet::set_periodic(const double *lo, const double *hi, const int32_t *periodic) {
+  if (!lo || !hi || !periodic) throw Error(MFREE_ERR_NULL, "lo, hi and periodic must not be NULL");
+  for (int c = 0; c < dim_; ++c) {
+    if (!std::isfinite(lo[c]) || !std::isfinite(hi[c]))
+      throw Error(MFREE_ERR_INPUT, "box bounds must be finite");
+    if (periodic[c] && !(hi[c] > lo[c]))
+      throw Error(MFREE_ERR_ARG, "box axis " + std::to_string(c) + " has hi <= lo");
+  }
+  for (int c = 0; c < dim_; ++c) {
+    lo_[c] = lo[c];
+    hi_[c] = hi[c];
+    periodic_[c] = periodic[c] != 0;
+  }
+  setup_done_ = false;
+}
+
+void ParticleSet::check_host_csr(const int64_t *rowptr, const int32_t *cols, int32_t base) const {
+  const int32_t rows = num_owned();
+  if (rowptr[0] != base)
+    throw Error(MFREE_ERR_INPUT, "neighbour rowptr[0] = " + std::to_string(rowptr[0]) +
+                                     ", expected the index base " + std::to_string(base));
+  for (int32_t i = 0; i < rows; ++i)
+    if (rowptr[i + 1] < rowptr[i])
+      throw Error(MFREE_ERR_INPUT, "neighbour rowptr is not monotone at row " + std::to_string(i));
+  const int64_t nnz = rowptr[rows] - base;
+  if (nnz > 0 && cols == nullptr) throw Error(MFREE_ERR_NULL, "neighbour column array is NULL");
+  for (int64_t k = 0; k < nnz; ++k)
+    if (cols[k] < base || cols[k] - base >= n_)
+      throw Error(MFREE_ERR_INPUT, "neighbour column " + std::to_string(cols[k]) + " at position " +
+                                       std::to_string(k) + " is outside [" + std::to_string(base) +
+                                       ", " + std::to_string(base + n_) + ")");
+}
+
+void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int32_t base, int mem) {
+  check_mem(mem);
+  if (base != 0 && base != 1) throw Error(MFREE_ERR_ARG, "index base must be 0 or 1");
+  if (!rowptr) throw Error(MFREE_ERR_NULL, "neighbour rowptr is NULL");
+  check_host_csr(rowptr, cols, base);
+  const int32_t rows = num_owned();
+  if (mem == MFREE_COPY) {
+    host_rowptr_own_.assign(rowptr, rowptr + rows + 1);
+    const int64_t nnz = rowptr[rows] - base;
+    host_cols_own_.assign(cols, cols + nnz);
+    if (host_cols_own_.empty()) host_cols_own_.push_back(base);  // keep data() non-NULL
+    host_rowptr_ = host_rowptr_own_.data();
+    host_cols_ = host_cols_own_.data();
+  } else {
+    host_rowptr_own_.clear();
+    host_cols_own_.clear();
+    host_rowptr_ = rowptr;
+    host_cols_ = cols;
+  }
+  host_base_ = base;
+  setup_done_ = false;
+}
+
+Report ParticleSet::validate() {
+  Report rep;
+  site_status_.assign(n_, 0);
+  int64_t bad = 0;
+  for (int32_t i = 0; i < n_; ++i) {
+    int32_t st = 0;
+    std::string why;
+    for (int c = 0; c < dim_ && !st; ++c)
+      if (!std::isfinite(pos_(i, c))) {
+        st = MFREE_FAIL_NONFINITE;
+        why = "position component " + std::to_string(c) + " is " + std::to_string(pos_(i, c));
+      }
+    auto check = [&](const ScalarArray &a, const char *what) {
+      if (st || !a.set()) return;
+      const double v = a(i);
+      if (!std::isfinite(v)) {
+        st = MFREE_FAIL_NONFINITE;
+        why = std::string(what) + " is " + std::to_string(v);
+      } else if (v <= 0.0) {
+        st = MFREE_FAIL_INVALID_DATA;
+        why = std::string(what) + " is " + std::to_string(v) + " (must be > 0)";
+      }
+    };
+    check(h_, "support");
+    check(vol_, "volume");
+    check(mass_, "mass");
+    check(rho_, "density");
+    if (st) {
+      site_status_[i] = st;
+      if (bad == 0)
+        rep.fail(static_cast<mfree_status_t>(st), "particle " + std::to_string(i) + ": " + why);
+      ++bad;
+    }
+  }
+  if (bad > 1) rep.message += " (" + std::to_string(bad) + " particles isolated)";
+  else if (bad == 1) rep.message += " (particle isolated)";
+  return rep;
+}
+
+Report ParticleSet::setup() {
+  if (!pos_.set()) throw Error(MFREE_ERR_STATE, "positions are not set");
+  if (!host_neighbors() && !h_.set())
+    throw Error(MFREE_ERR_STATE, "support sizes are not set (needed by the neighbour search)");
+  if (host_neighbors()) check_host_csr(host_rowptr_, host_cols_, host_base_);
+  Report rep = validate();
+  Csr out;
+  if (host_neighbors()) {
+    const int32_t rows = num_owned();
+    out.rowptr.assign(static_cast<size_t>(rows) + 1, 0);
+    out.cols.reserve(static_cast<size_t>(host_rowptr_[rows] - host_base_));
+    for (int32_t i = 0; i < rows; ++i) {
+      if (site_status_[i] == 0)
+        for (int64_t k = host_rowptr_[i] - host_base_; k < host_rowptr_[i + 1] - host_base_; ++k) {
+          const int32_t j = host_cols_[k] - host_base_;
+          if (site_status_[j] == 0) out.cols.push_back(j);
+        }
+      out.rowptr[i + 1] = static_cast<int64_t>(out.cols.size());
+    }
+  } else {
+    find_neighbors(*this, site_status_, out);
+  }
+  nbr_ = std::move(out);
+  setup_done_ = true;
+  return rep;
+}
+
+Report ParticleSet::update() {
+  if (!setup_done_) throw Error(MFREE_ERR_STATE, "update called before setup");
+  const std::vector<int32_t> before = site_status_;
+  Report rep = validate();
+  // A particle that turned invalid since setup must not stay in anybody's row.
+  bool changed = false;
+  for (int32_t i = 0; i < n_; ++i)
+    if (site_status_[i] != 0 && before[i] == 0) changed = true;
+  if (changed) {
+    Csr out;
+    out.rowptr.assign(static_cast<size_t>(num_owned()) + 1, 0);
+    for (int32_t i = 0; i < num_owned(); ++i) {
+      if (site_status_[i] == 0)
+        for (int64_t k = nbr_.rowptr[i]; k < nbr_.rowptr[i + 1]; ++k)
+          if (site_status_[nbr_.cols[k]] == 0) out.cols.push_back(nbr_.cols[k]);
+      out.rowptr[i + 1] = static_cast<int64_t>(out.cols.size());
+    }
+    nbr_ = std::move(out);
+  }
+  return rep;
+}
+
+}  // namespace mfree

@@ -1,0 +1,125 @@
+// Particle set: borrowed or copied host arrays, validation, neighbour lists.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "error.hpp"
+#include "mfree.h"
+
+namespace mfree {
+
+// A strided view of n scalars, or of n items with ncomp components (AoS/SoA), that
+// either points into host memory or into its own copy.
+struct ScalarArray {
+  const double *ptr = nullptr;
+  int64_t stride = 1;  // 0: one value for all
+  std::vector<double> own;
+  bool set() const { return ptr != nullptr; }
+  double operator()(int64_t i) const { return ptr[i * stride]; }
+};
+
+struct VectorArray {
+  const double *ptr = nullptr;
+  int64_t ld = 0;
+  int layout = MFREE_LAYOUT_AOS;
+  std::vector<double> own;
+  bool set() const { return ptr != nullptr; }
+  double operator()(int64_t i, int c) const {
+    return layout == MFREE_LAYOUT_AOS ? ptr[i * ld + c] : ptr[c * ld + i];
+  }
+};
+
+// CSR adjacency, 0-based, one row per owned particle.
+struct Csr {
+  std::vector<int64_t> rowptr{0};
+  std::vector<int32_t> cols;
+  int64_t nnz() const { return rowptr.empty() ? 0 : rowptr.back(); }
+};
+
+class ParticleSet {
+ public:
+  ParticleSet(int dim, int32_t n);
+
+  int dim() const { return dim_; }
+  int32_t size() const { return n_; }
+  int32_t num_ghost() const { return n_ghost_; }
+  int32_t num_owned() const { return n_ - n_ghost_; }
+
+  void set_num_ghost(int32_t g);
+  void set_positions(const double *x, int layout, int64_t ld, int mem);
+  void set_volumes(const double *v, int64_t stride, int mem);
+  void set_masses(const double *m, int64_t stride, int mem);
+  void set_densities(const double *rho, int64_t stride, int mem);
+  void set_support(const double *h, int64_t stride, int mem);
+  void set_search(int convention, double kappa);
+  void set_periodic(const double *lo, const double *hi, const int32_t *periodic);
+  void set_neighbors(const int64_t *rowptr, const int32_t *cols, int32_t base, int mem);
+
+  // Validate (and for a search, rebuild the lists). Negative failures throw.
+  Report setup();
+  Report update();
+
+  bool is_setup() const { return setup_done_; }
+  const Csr &neighbors() const { return nbr_; }
+  const std::vector<int32_t> &site_status() const { return site_status_; }
+
+  double x(int32_t i, int c) const { return pos_(i, c); }
+  double h(int32_t i) const { return h_(i); }
+  bool has_support() const { return h_.set(); }
+  bool has_volumes() const { return vol_.set() || (mass_.set() && rho_.set()); }
+  double volume(int32_t i) const { return vol_.set() ? vol_(i) : mass_(i) / rho_(i); }
+
+  int search_convention() const { return convention_; }
+  double kappa() const { return kappa_; }
+  bool periodic(int c) const { return periodic_[c]; }
+  double box_lo(int c) const { return lo_[c]; }
+  double box_hi(int c) const { return hi_[c]; }
+  bool host_neighbors() const { return host_rowptr_ != nullptr; }
+
+  // Displacement x_i - x_j with the nearest image along periodic axes.
+  void displacement(int32_t i, int32_t j, double *d) const {
+    for (int c = 0; c < dim_; ++c) {
+      double v = pos_(i, c) - pos_(j, c);
+      if (periodic_[c]) {
+        const double L = hi_[c] - lo_[c];
+        v -= L * std::nearbyint(v / L);
+      }
+      d[c] = v;
+    }
+  }
+
+ private:
+  void set_scalar(ScalarArray &a, const double *v, int64_t stride, int mem, const char *what);
+  // Mark particles whose borrowed data are invalid; returns the report.
+  Report validate();
+  void check_host_csr(const int64_t *rowptr, const int32_t *cols, int32_t base) const;
+
+  int dim_;
+  int32_t n_;
+  int32_t n_ghost_ = 0;
+  VectorArray pos_;
+  ScalarArray vol_, mass_, rho_, h_;
+  int convention_ = MFREE_SEARCH_GATHER;
+  double kappa_ = 2.0;
+  bool periodic_[3] = {false, false, false};
+  double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
+
+  const int64_t *host_rowptr_ = nullptr;
+  const int32_t *host_cols_ = nullptr;
+  int32_t host_base_ = 0;
+  std::vector<int64_t> host_rowptr_own_;
+  std::vector<int32_t> host_cols_own_;
+
+  bool setup_done_ = false;
+  Csr nbr_;
+  std::vector<int32_t> site_status_;
+};
+
+// Cell-list search over the valid particles of ps (valid[i] != 0); fills rows for the
+// owned particles. Throws Error on a periodic box too small for the supports.
+void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &site_status, Csr &out);
+
+}  // namespace mfree

@@ -1,0 +1,40 @@
+/* Shared helpers for the cmocka tests. */
+#ifndef MFREE_TESTUTIL_H
+#define MFREE_TESTUTIL_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+/* cmocka needs the three headers above first */
+#include <cmocka.h>
+
+#include <mfree.h>
+
+/* Assert a call returns `expected`; on mismatch print the context's message. */
+#define assert_status(ctx, call, expected)                                               \
+  do {                                                                                   \
+    mfree_status_t st_ = (call);                                                         \
+    if (st_ != (expected)) {                                                             \
+      char msg_[1024] = "";                                                              \
+      if (ctx) mfree_context_get_last_error((ctx), NULL, msg_, sizeof msg_);             \
+      fail_msg("%s returned %d (%s), expected %d; last error: %s", #call, (int)st_,      \
+               mfree_status_string(st_), (int)(expected), msg_);                         \
+    }                                                                                    \
+  } while (0)
+
+#define assert_ok(ctx, call) assert_status(ctx, call, MFREE_SUCCESS)
+
+/* Assert a call fails with `expected` and leaves a non-empty message mentioning
+ * `needle` (may be NULL) on the context. */
+void mfree_test_expect_error(mfree_context_t *ctx, mfree_status_t got, mfree_status_t expected,
+                             const char *needle, const char *what);
+#define assert_error(ctx, call, expected, needle) \
+  mfree_test_expect_error((ctx), (call), (expected), (needle), #call)
+
+/* Deterministic uniform random numbers in [0, 1) (xorshift64*). */
+typedef struct { uint64_t s; } mfree_rng_t;
+void mfree_rng_seed(mfree_rng_t *r, uint64_t seed);
+double mfree_rng_uniform(mfree_rng_t *r);
+
+#endif
