@@ -330,6 +330,12 @@ MFREE_API mfree_status_t mfree_particles_get_neighbors(const mfree_particles_t *
                                                        int64_t *rowptr, int32_t *cols);
 
 /**
+ * Copy the particle volumes: the set volumes, or masses / densities when volumes are
+ * unset (borrowed arrays are read now). @param[out] v  n values
+ */
+MFREE_API mfree_status_t mfree_particles_get_volumes(const mfree_particles_t *ps, double *v);
+
+/**
  * Per-particle status of the last setup/update: 0, or the positive status that
  * isolated the particle. @param[out] status  n values
  * @param[out] nfailed  number of nonzero entries (may be NULL)

@@ -175,6 +175,16 @@ mfree_status_t mfree_particles_get_neighbors(const mfree_particles_t *ps, int64_
   });
 }
 
+mfree_status_t mfree_particles_get_volumes(const mfree_particles_t *ps, double *v) {
+  return with_set(ps, "mfree_particles_get_volumes", [&](const mfree::ParticleSet &s) {
+    MFREE_REQUIRE(v || s.size() == 0, MFREE_ERR_NULL, "output pointer is NULL");
+    MFREE_REQUIRE(s.has_volumes(), MFREE_ERR_STATE,
+                  "neither volumes nor both masses and densities are set");
+    for (int32_t i = 0; i < s.size(); ++i) v[i] = s.volume(i);
+    return MFREE_SUCCESS;
+  });
+}
+
 mfree_status_t mfree_particles_get_site_status(const mfree_particles_t *ps, int32_t *status,
                                                int32_t *nfailed) {
   return with_set(ps, "mfree_particles_get_site_status", [&](const mfree::ParticleSet &s) {
