@@ -39,6 +39,14 @@
    (MFREE_VERSION_MAJOR == (a) && MFREE_VERSION_MINOR == (b) &&                          \
     MFREE_VERSION_PATCH >= (c)))
 
+/* Enumerations have int as their underlying type in C and C++ alike, so that a host
+ * passing any int (e.g. from Fortran) is well defined and gets MFREE_ERR_ARG back. */
+#ifdef __cplusplus
+#define MFREE_ENUM(name) enum name : int
+#else
+#define MFREE_ENUM(name) enum name
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -47,7 +55,7 @@ extern "C" {
 /* Status codes. Values are frozen: never renumbered, never reused.                      */
 /* ------------------------------------------------------------------------------------ */
 
-typedef enum mfree_status {
+typedef MFREE_ENUM(mfree_status) {
   MFREE_SUCCESS = 0,
 
   /* Negative: misuse or resource failure. Nothing was changed. */
@@ -72,14 +80,14 @@ typedef enum mfree_status {
 } mfree_status_t;
 
 /** How an input array is held. */
-typedef enum mfree_mem {
+typedef MFREE_ENUM(mfree_mem) {
   MFREE_COPY = 1,  /**< copied at the call; the host may free or reuse its array */
   MFREE_BORROW = 2 /**< kept as a pointer and re-read at every setup/update/apply; the
                         host keeps it alive and may change its values between calls */
 } mfree_mem_t;
 
 /** Layout of a multi-component array of n items with ncomp components. */
-typedef enum mfree_layout {
+typedef MFREE_ENUM(mfree_layout) {
   MFREE_LAYOUT_AOS = 1, /**< item i, component c at a[i*ld + c], ld >= ncomp
                              (Fortran x(3,n); an array of host structs) */
   MFREE_LAYOUT_SOA = 2  /**< item i, component c at a[c*ld + i], ld >= n
@@ -87,7 +95,7 @@ typedef enum mfree_layout {
 } mfree_layout_t;
 
 /** Neighbour criterion for particles i, j at distance r with supports h_i, h_j. */
-typedef enum mfree_search {
+typedef MFREE_ENUM(mfree_search) {
   MFREE_SEARCH_GATHER = 1,         /**< r < kappa*h_i (row i uses its own support) */
   MFREE_SEARCH_SYMMETRIC_MAX = 2,  /**< r < kappa*max(h_i, h_j) */
   MFREE_SEARCH_SYMMETRIC_MEAN = 3  /**< r < kappa*(h_i + h_j)/2 */
@@ -97,7 +105,7 @@ typedef enum mfree_search {
  * Smoothing kernels W(r, h) = C_dim / h^dim * f(q), q = r/h, with support q < R.
  * C_dim makes the integral of W over R^dim equal 1 in dimension dim = 1, 2, 3.
  */
-typedef enum mfree_kernel {
+typedef MFREE_ENUM(mfree_kernel) {
   MFREE_KERNEL_CUBIC_SPLINE = 1,        /**< 000 eq 26, 001 eq 6.6; R = 2 */
   MFREE_KERNEL_QUARTIC = 2,             /**< 001 eq 6.7, 1 - 3/2q^2 + q^3 - 3/16q^4
                                              (Lucy); R = 2 */
@@ -119,12 +127,58 @@ typedef enum mfree_kernel {
   MFREE_KERNEL_QUARTIC_SPLINE = 12      /**< Morris' quartic spline; R = 5/2 */
 } mfree_kernel_t;
 
+/** Approximation methods (papers 000 and 001). Values are frozen. */
+typedef MFREE_ENUM(mfree_method) {
+  MFREE_METHOD_SPH = 1,               /**< kernel sum and kernel gradient, 000 eqs 21, 29 */
+  MFREE_METHOD_SPH_SYMMETRIC = 2,     /**< symmetrised (difference) gradient, 000 eq 47;
+                                           particles only */
+  MFREE_METHOD_SHEPARD = 3,           /**< Shepard functions, 000 eqs 38-39 */
+  MFREE_METHOD_MLS = 4,               /**< moving least squares, order 0..3, shifted and
+                                           scaled basis, 000 eqs 43-46 */
+  MFREE_METHOD_RKPM = 5,              /**< reproducing kernel particle method, order 0..3,
+                                           001 Sect. 4 (weights W V; true derivatives) */
+  MFREE_METHOD_JOHNSON_BEISSEL = 6,   /**< 000 eqs 49, 52; particles only */
+  MFREE_METHOD_RANDLES_LIBERSKY = 7,  /**< renormalised gradient, 000 eqs 68-69;
+                                           particles only */
+  MFREE_METHOD_KB_METHOD1 = 8,        /**< Krongauz-Belytschko corrected derivatives,
+                                           000 eqs 55-61 (alpha = A^-T) */
+  MFREE_METHOD_KB_METHOD2 = 9,        /**< corrected derivatives Method 2 (diffuse MLS
+                                           derivatives), 000 eqs 63-64 */
+  MFREE_METHOD_KB_METHOD3 = 10,       /**< corrected derivatives Method 3, 000 eqs 65-66 */
+  MFREE_METHOD_MSPH = 11,             /**< modified SPH, order 1..2, 001 Sect. 2 */
+  MFREE_METHOD_SSPH = 12              /**< symmetric SPH, order 1..3, 001 Sect. 3 */
+} mfree_method_t;
+
+/** Shape-function tables an approximant builds (bit flags, may be or-ed). */
+typedef MFREE_ENUM(mfree_deriv) {
+  MFREE_DERIV_VALUE = 1,    /**< values Phi_j(x) */
+  MFREE_DERIV_GRADIENT = 2, /**< first derivatives (corrected where the method corrects) */
+  MFREE_DERIV_HESSIAN = 4   /**< second derivatives, packed xx | xx,xy,yy | xx,xy,xz,yy,yz,zz */
+} mfree_deriv_t;
+
+/** Operators applied to host fields. */
+typedef MFREE_ENUM(mfree_op) {
+  MFREE_OP_VALUE = 1,      /**< ncomp in, ncomp out */
+  MFREE_OP_GRADIENT = 2,   /**< ncomp in, ncomp*dim out: component c, direction d at c*dim+d */
+  MFREE_OP_DIVERGENCE = 3, /**< dim in, 1 out */
+  MFREE_OP_LAPLACIAN = 4,  /**< ncomp in, ncomp out (trace of the Hessian table) */
+  MFREE_OP_HESSIAN = 5     /**< ncomp in, ncomp*nh out, nh = 1, 3, 6 packed as above */
+} mfree_op_t;
+
+/** What setup does at a site whose local system is singular or under-determined. */
+typedef MFREE_ENUM(mfree_fallback) {
+  MFREE_FALLBACK_NONE = 1,        /**< the site fails: zero rows, positive status */
+  MFREE_FALLBACK_LOWER_ORDER = 2  /**< retry with lower orders down to Shepard (as paper
+                                       003 does); sites that still fail are reported */
+} mfree_fallback_t;
+
 /* ------------------------------------------------------------------------------------ */
 /* Opaque handles                                                                         */
 /* ------------------------------------------------------------------------------------ */
 
 typedef struct mfree_context mfree_context_t;
 typedef struct mfree_particles mfree_particles_t;
+typedef struct mfree_approximant mfree_approximant_t;
 
 /** Called on every failure recorded on a context (from the failing call's thread). */
 typedef void (*mfree_error_handler_t)(void *user, mfree_status_t code, const char *message);
@@ -342,6 +396,120 @@ MFREE_API mfree_status_t mfree_particles_get_volumes(const mfree_particles_t *ps
  */
 MFREE_API mfree_status_t mfree_particles_get_site_status(const mfree_particles_t *ps,
                                                          int32_t *status, int32_t *nfailed);
+
+/* ------------------------------------------------------------------------------------ */
+/* Approximants                                                                           */
+/* ------------------------------------------------------------------------------------ */
+
+/**
+ * Create an approximant of the given method on a particle set (which it keeps alive).
+ * Defaults: cubic spline kernel, derivatives VALUE|GRADIENT, order 1 for MLS and KB
+ * Method 2, 2 for RKPM, MSPH and SSPH; sites = the owned particles; no fallback.
+ * The kernel's support radius R must not exceed the set's search multiplier kappa.
+ */
+MFREE_API mfree_status_t mfree_approximant_create(mfree_context_t *ctx,
+                                                  mfree_particles_t *ps,
+                                                  mfree_method_t method,
+                                                  mfree_approximant_t **a);
+MFREE_API mfree_status_t mfree_approximant_destroy(mfree_approximant_t **a);
+
+/** Kernel (weight function) and its shape parameter (0 = default). */
+MFREE_API mfree_status_t mfree_approximant_set_kernel(mfree_approximant_t *a,
+                                                      mfree_kernel_t kernel, double param);
+/** Polynomial order of MLS/RKPM (0..3), SSPH (1..3), MSPH (1..2), KB Method 2 (1..2);
+ * other methods accept only their own order (MFREE_ERR_UNSUPPORTED otherwise). */
+MFREE_API mfree_status_t mfree_approximant_set_order(mfree_approximant_t *a, int32_t order);
+/** Tables to build: an or of mfree_deriv_t flags. */
+MFREE_API mfree_status_t mfree_approximant_set_derivatives(mfree_approximant_t *a,
+                                                           int32_t flags);
+MFREE_API mfree_status_t mfree_approximant_set_fallback(mfree_approximant_t *a,
+                                                        mfree_fallback_t policy);
+
+/**
+ * Evaluate at host points instead of the particles (e.g. quadrature points). Each point
+ * has a support size used as the site's h; neighbours are searched with the particle
+ * set's convention and kappa. Not available for particles-only methods.
+ * @param[in] npts    number of points (>= 0)
+ * @param[in] x       coordinates, layout/ld as for particle positions; copied or borrowed
+ * @param[in] h       point supports, element i at h[i*h_stride] (stride 0: one value)
+ */
+MFREE_API mfree_status_t mfree_approximant_set_points(mfree_approximant_t *a, int32_t npts,
+                                                      const double *x, mfree_layout_t layout,
+                                                      int64_t ld, const double *h,
+                                                      int64_t h_stride, mfree_mem_t mem);
+
+/**
+ * Build the shape-function tables (sets up the particle set first if it never was).
+ * Sites whose local system fails are reported by a positive status
+ * (MFREE_FAIL_SINGULAR, MFREE_FAIL_NEIGHBORS), get all-zero rows and are listed by
+ * mfree_approximant_get_site_status; with MFREE_FALLBACK_LOWER_ORDER such sites first
+ * retry lower orders (mfree_approximant_get_site_order tells the order used).
+ */
+MFREE_API mfree_status_t mfree_approximant_setup(mfree_approximant_t *a);
+
+/** Recompute the tables after particles (borrowed positions) moved, keeping the
+ * neighbour pattern. */
+MFREE_API mfree_status_t mfree_approximant_update(mfree_approximant_t *a);
+
+/**
+ * out = op(u) at every site (apply) or out += op(u) (apply_add). No allocation.
+ * @param[in]  ncomp  components of u (op DIVERGENCE needs ncomp = dim)
+ * @param[in]  u      field at the n particles (owned and ghost), borrowed for the call
+ * @param[in]  ulayout, uld  layout of u: AOS ld >= ncomp, SOA ld >= n
+ * @param[out] out    one row per site, ocomp = the op's output components
+ * @param[in]  olayout, old  layout of out: AOS ld >= ocomp, SOA ld >= number of sites
+ */
+MFREE_API mfree_status_t mfree_approximant_apply(const mfree_approximant_t *a, mfree_op_t op,
+                                                 int32_t ncomp, const double *u,
+                                                 mfree_layout_t ulayout, int64_t uld,
+                                                 double *out, mfree_layout_t olayout,
+                                                 int64_t old);
+MFREE_API mfree_status_t mfree_approximant_apply_add(const mfree_approximant_t *a,
+                                                     mfree_op_t op, int32_t ncomp,
+                                                     const double *u, mfree_layout_t ulayout,
+                                                     int64_t uld, double *out,
+                                                     mfree_layout_t olayout, int64_t old);
+
+/** Number of sites (owned particles or host points) after setup. */
+MFREE_API mfree_status_t mfree_approximant_get_num_sites(const mfree_approximant_t *a,
+                                                         int32_t *nsites);
+/** Non-zeros of each table (one per site-neighbour pair). */
+MFREE_API mfree_status_t mfree_approximant_get_nnz(const mfree_approximant_t *a,
+                                                   int64_t *nnz);
+/**
+ * Copy one table as CSR (rows = sites, columns = particles).
+ * @param[in] deriv      MFREE_DERIV_VALUE, MFREE_DERIV_GRADIENT or MFREE_DERIV_HESSIAN
+ * @param[in] component  direction (gradient) or packed index (Hessian); 0 for values
+ * @param[out] rowptr    nsites + 1; @param[out] cols, vals  nnz each
+ */
+MFREE_API mfree_status_t mfree_approximant_assemble_csr(const mfree_approximant_t *a,
+                                                        mfree_deriv_t deriv,
+                                                        int32_t component, int64_t *rowptr,
+                                                        int32_t *cols, double *vals);
+
+/**
+ * Maximum violation over all valid sites of the reproducing conditions (000 eqs 5-9)
+ * for every monomial of degree <= order in local coordinates (x_j - x)/h: fn_err for
+ * the values, deriv_err for the gradient (scaled by h) and Hessian (scaled by h^2).
+ * A table that was not built contributes 0.
+ */
+MFREE_API mfree_status_t mfree_approximant_check_reproduction(const mfree_approximant_t *a,
+                                                              int32_t order, double *fn_err,
+                                                              double *deriv_err);
+
+/** Per-site diagnostics, nsites entries each: status (0 or a positive status), number
+ * of neighbours with non-zero weight, condition estimate of the local system (1 where
+ * the method solves none), order used (differs from the set order after a fallback;
+ * -1 for a failed site). */
+MFREE_API mfree_status_t mfree_approximant_get_site_status(const mfree_approximant_t *a,
+                                                           int32_t *status,
+                                                           int32_t *nfailed);
+MFREE_API mfree_status_t mfree_approximant_get_neighbor_counts(const mfree_approximant_t *a,
+                                                               int32_t *counts);
+MFREE_API mfree_status_t mfree_approximant_get_condition(const mfree_approximant_t *a,
+                                                         double *cond);
+MFREE_API mfree_status_t mfree_approximant_get_site_order(const mfree_approximant_t *a,
+                                                          int32_t *order);
 
 #ifdef __cplusplus
 }

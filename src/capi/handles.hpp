@@ -6,6 +6,7 @@
 #include <new>
 #include <string>
 
+#include "core/approximant.hpp"
 #include "core/error.hpp"
 #include "core/particles.hpp"
 #include "mfree.h"
@@ -24,6 +25,15 @@ struct mfree_particles {
   mfree_context_t *ctx = nullptr;
   mfree::ParticleSet set;
   mfree_particles(mfree_context_t *c, int dim, int32_t n) : ctx(c), set(dim, n) {}
+};
+
+struct mfree_approximant {
+  std::atomic<int> refs{1};
+  mfree_context_t *ctx = nullptr;
+  mfree_particles_t *ps = nullptr;  // retained
+  mfree::Approximant a;
+  mfree_approximant(mfree_context_t *c, mfree_particles_t *p, int method)
+      : ctx(c), ps(p), a(&p->set, method) {}
 };
 
 namespace mfree {

@@ -1,0 +1,518 @@
+#include "approximant.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "basis.hpp"
+
+namespace mfree {
+
+namespace {
+
+bool needs_volumes(int m) {
+  return m == MFREE_METHOD_SPH || m == MFREE_METHOD_SPH_SYMMETRIC || m == MFREE_METHOD_RKPM ||
+         m == MFREE_METHOD_SSPH || m == MFREE_METHOD_MSPH || m == MFREE_METHOD_JOHNSON_BEISSEL ||
+         m == MFREE_METHOD_RANDLES_LIBERSKY;
+}
+// Methods that differentiate the kernel for their gradient table (all but SSPH and KB
+// Method 2, which fit derivatives without W').
+bool gradient_needs_dw(int m) { return m != MFREE_METHOD_SSPH && m != MFREE_METHOD_KB_METHOD2; }
+bool hessian_needs_d2w(int m) {
+  return m == MFREE_METHOD_SPH || m == MFREE_METHOD_SHEPARD || m == MFREE_METHOD_MLS ||
+         m == MFREE_METHOD_RKPM || m == MFREE_METHOD_MSPH;
+}
+const char *method_name(int m) {
+  static const char *names[] = {"?", "SPH", "SPH symmetric", "Shepard", "MLS", "RKPM",
+                                "Johnson-Beissel", "Randles-Libersky", "KB Method 1",
+                                "KB Method 2", "KB Method 3", "MSPH", "SSPH"};
+  return (m >= 1 && m <= 12) ? names[m] : names[0];
+}
+int default_order(int m) {
+  switch (m) {
+    case MFREE_METHOD_RKPM:
+    case MFREE_METHOD_SSPH:
+    case MFREE_METHOD_MSPH:
+      return 2;
+    case MFREE_METHOD_MLS:
+    case MFREE_METHOD_KB_METHOD2:
+      return 1;
+    default:
+      return fixed_order(m);
+  }
+}
+
+}  // namespace
+
+Approximant::Approximant(const ParticleSet *ps, int method) : ps_(ps), method_(method) {
+  if (method < MFREE_METHOD_SPH || method > MFREE_METHOD_SSPH)
+    throw Error(MFREE_ERR_ARG, "unknown method " + std::to_string(method));
+  order_ = default_order(method);
+  kernel_ = std::make_unique<Kernel>(kernel_id_, ps->dim(), kernel_param_);
+}
+
+void Approximant::set_kernel(int kernel, double param) {
+  auto k = std::make_unique<Kernel>(kernel, ps_->dim(), param);  // validates
+  kernel_ = std::move(k);
+  kernel_id_ = kernel;
+  kernel_param_ = param;
+  setup_done_ = false;
+}
+
+void Approximant::set_order(int order) {
+  if (!has_order(method_)) {
+    if (order != fixed_order(method_))
+      throw Error(MFREE_ERR_UNSUPPORTED, std::string(method_name(method_)) + " has fixed order " +
+                                             std::to_string(fixed_order(method_)));
+    return;
+  }
+  if (order < min_order(method_) || order > max_order(method_))
+    throw Error(MFREE_ERR_UNSUPPORTED, std::string(method_name(method_)) + " supports orders " +
+                                           std::to_string(min_order(method_)) + ".." +
+                                           std::to_string(max_order(method_)) + ", not " +
+                                           std::to_string(order));
+  order_ = order;
+  setup_done_ = false;
+}
+
+void Approximant::set_derivatives(int flags) {
+  if (flags <= 0 || flags > 7)
+    throw Error(MFREE_ERR_ARG, "derivative flags " + std::to_string(flags) +
+                                   " are not an or of MFREE_DERIV_VALUE/GRADIENT/HESSIAN");
+  if ((flags & MFREE_DERIV_HESSIAN) && !provides_hessian(method_, max_order(method_)))
+    throw Error(MFREE_ERR_UNSUPPORTED,
+                std::string(method_name(method_)) + " provides no second derivatives");
+  flags_ = flags;
+  setup_done_ = false;
+}
+
+void Approximant::set_fallback(int policy) {
+  if (policy != MFREE_FALLBACK_NONE && policy != MFREE_FALLBACK_LOWER_ORDER)
+    throw Error(MFREE_ERR_ARG, "unknown fallback policy " + std::to_string(policy));
+  fallback_ = policy;
+}
+
+void Approximant::set_points(int32_t npts, const double *x, int layout, int64_t ld,
+                             const double *h, int64_t h_stride, int mem) {
+  if (particles_only(method_))
+    throw Error(MFREE_ERR_UNSUPPORTED, std::string(method_name(method_)) +
+                                           " is defined at the particles only");
+  // Reuse the particle-set validation on a scratch set of the points.
+  ParticleSet tmp(ps_->dim(), npts);
+  tmp.set_positions(x, layout, ld, mem);
+  tmp.set_support(h, h_stride, mem);
+  (void)tmp;
+  npts_ = npts;
+  points_ = true;
+  if (mem == MFREE_COPY) {
+    px_.own.assign(static_cast<size_t>(npts) * dim() + 1, 0.0);
+    VectorArray src;
+    src.ptr = x;
+    src.ld = ld;
+    src.layout = layout;
+    for (int32_t i = 0; i < npts; ++i)
+      for (int c = 0; c < dim(); ++c) px_.own[static_cast<size_t>(i) * dim() + c] = src(i, c);
+    px_.ptr = px_.own.data();
+    px_.ld = dim();
+    px_.layout = MFREE_LAYOUT_AOS;
+    const int32_t nh = h_stride == 0 ? 1 : npts;
+    ph_.own.assign(static_cast<size_t>(std::max(nh, 1)), 1.0);
+    for (int32_t i = 0; i < nh; ++i) ph_.own[i] = h[i * h_stride];
+    ph_.ptr = ph_.own.data();
+    ph_.stride = h_stride == 0 ? 0 : 1;
+  } else {
+    px_.own.clear();
+    px_.ptr = x;
+    px_.ld = ld;
+    px_.layout = layout;
+    ph_.own.clear();
+    ph_.ptr = h;
+    ph_.stride = h_stride;
+    if (!px_.ptr) {
+      px_.own.assign(1, 0.0);
+      px_.ptr = px_.own.data();
+    }
+    if (!ph_.ptr) {
+      ph_.own.assign(1, 1.0);
+      ph_.ptr = ph_.own.data();
+    }
+  }
+  setup_done_ = false;
+}
+
+void Approximant::validate_config() const {
+  const int k = kernel_id_, m = method_;
+  const std::string mn = method_name(m);
+  if (!ps_->has_support())
+    throw Error(MFREE_ERR_STATE, "the particle set has no support sizes (the kernel needs h)");
+  if (needs_volumes(m) && !ps_->has_volumes())
+    throw Error(MFREE_ERR_STATE, mn + " needs particle volumes (or masses and densities)");
+  if (!ps_->host_neighbors() && kernel_->radius() > ps_->kappa() * (1.0 + 1e-12)) {
+    std::ostringstream s;
+    s << "kernel support radius " << kernel_->radius() << " h exceeds the search radius kappa = "
+      << ps_->kappa() << " h of the particle set (mfree_particles_set_search)";
+    throw Error(MFREE_ERR_MISMATCH, s.str());
+  }
+  if (points_ && particles_only(m))
+    throw Error(MFREE_ERR_UNSUPPORTED, mn + " is defined at the particles only");
+  const bool grad = flags_ & MFREE_DERIV_GRADIENT, hess = flags_ & MFREE_DERIV_HESSIAN;
+  const bool uses_dw = (grad && gradient_needs_dw(m)) || m == MFREE_METHOD_MSPH ||
+                       m == MFREE_METHOD_JOHNSON_BEISSEL || m == MFREE_METHOD_RANDLES_LIBERSKY ||
+                       m == MFREE_METHOD_KB_METHOD1 || m == MFREE_METHOD_KB_METHOD3;
+  if (k == MFREE_KERNEL_LINEAR && uses_dw)
+    throw Error(MFREE_ERR_UNSUPPORTED,
+                mn + " differentiates the kernel; the linear kernel's derivative is constant "
+                     "(paper 001 Sect. 6.2): use SSPH or another kernel");
+  const bool uses_d2w = (hess && hessian_needs_d2w(m)) || (m == MFREE_METHOD_MSPH && order_ >= 2);
+  if ((k == MFREE_KERNEL_LINEAR || k == MFREE_KERNEL_QUADRATIC) && uses_d2w)
+    throw Error(MFREE_ERR_UNSUPPORTED,
+                mn + " needs the kernel's second derivative, constant for the linear and "
+                     "quadratic kernels (paper 001 Sect. 6.2)");
+  if (hess && !provides_hessian(m, order_))
+    throw Error(MFREE_ERR_UNSUPPORTED, mn + " of order " + std::to_string(order_) +
+                                           " provides no second derivatives");
+}
+
+double Approximant::site_x(int32_t s, int c) const { return points_ ? px_(s, c) : ps_->x(s, c); }
+double Approximant::site_h(int32_t s) const { return points_ ? ph_(s) : ps_->h(s); }
+
+void Approximant::site_displacement(int32_t s, int32_t j, double *d) const {
+  if (!points_) {
+    ps_->displacement(j, s, d);
+    return;
+  }
+  for (int c = 0; c < dim(); ++c) {
+    double v = ps_->x(j, c) - px_(s, c);
+    if (ps_->periodic(c)) {
+      const double L = ps_->box_hi(c) - ps_->box_lo(c);
+      v -= L * std::nearbyint(v / L);
+    }
+    d[c] = v;
+  }
+}
+
+double Approximant::pair_h(int32_t s, int32_t j) const {
+  const double hs = site_h(s);
+  switch (ps_->search_convention()) {
+    case MFREE_SEARCH_SYMMETRIC_MAX:
+      return std::max(hs, ps_->h(j));
+    case MFREE_SEARCH_SYMMETRIC_MEAN:
+      return 0.5 * (hs + ps_->h(j));
+    default:
+      return hs;
+  }
+}
+
+void Approximant::build_pattern() {
+  const int dim = ps_->dim();
+  const double R = kernel_->radius();
+  const Csr *src = &ps_->neighbors();
+  std::vector<int32_t> pstatus;
+  if (points_) {
+    // validate the points' borrowed data like particle data
+    for (int32_t s = 0; s < npts_; ++s) {
+      for (int c = 0; c < dim; ++c)
+        if (!std::isfinite(px_(s, c)))
+          throw Error(MFREE_ERR_INPUT, "point " + std::to_string(s) + " has a non-finite coordinate");
+      if (!(std::isfinite(ph_(s)) && ph_(s) > 0.0))
+        throw Error(MFREE_ERR_INPUT, "point " + std::to_string(s) + " has support <= 0 or non-finite");
+    }
+    find_point_neighbors(*ps_, ps_->site_status(), npts_, px_, ph_, point_nbr_);
+    src = &point_nbr_;
+    nsites_ = npts_;
+  } else {
+    nsites_ = ps_->num_owned();
+  }
+  rowptr_.assign(static_cast<size_t>(nsites_) + 1, 0);
+  cols_.clear();
+  self_.assign(nsites_, -1);
+  status_.assign(nsites_, 0);
+  const auto &pst = ps_->site_status();
+  for (int32_t s = 0; s < nsites_; ++s) {
+    const int32_t me = site_particle(s);
+    if (me >= 0 && pst[me] != 0) {
+      status_[s] = pst[me];
+      rowptr_[s + 1] = static_cast<int64_t>(cols_.size());
+      continue;
+    }
+    for (int64_t k = src->rowptr[s]; k < src->rowptr[s + 1]; ++k) {
+      const int32_t j = src->cols[k];
+      if (j == me) {
+        self_[s] = static_cast<int32_t>(cols_.size() - rowptr_[s]);
+        cols_.push_back(j);
+        continue;
+      }
+      double d[3] = {0, 0, 0}, r2 = 0.0;
+      site_displacement(s, j, d);
+      for (int c = 0; c < dim; ++c) r2 += d[c] * d[c];
+      const double rad = R * pair_h(s, j);
+      if (r2 < rad * rad) cols_.push_back(j);
+    }
+    if (me >= 0 && self_[s] < 0) {  // host lists may omit the particle itself
+      self_[s] = static_cast<int32_t>(cols_.size() - rowptr_[s]);
+      cols_.push_back(me);
+    }
+    rowptr_[s + 1] = static_cast<int64_t>(cols_.size());
+  }
+}
+
+Report Approximant::compute(const char *what) {
+  (void)what;
+  const int dim = ps_->dim(), nh = hessian_size(dim);
+  const size_t nnz = cols_.size();
+  const bool fv = flags_ & MFREE_DERIV_VALUE, fg = flags_ & MFREE_DERIV_GRADIENT,
+             fh = flags_ & MFREE_DERIV_HESSIAN;
+  val_.assign(fv ? nnz : 0, 0.0);
+  grad_.assign(fg ? nnz * dim : 0, 0.0);
+  hess_.assign(fh ? nnz * nh : 0, 0.0);
+  support_.assign(nsites_, 0);
+  cond_.assign(nsites_, 1.0);
+  order_used_.assign(nsites_, -1);
+  const bool have_vol = ps_->has_volumes();
+
+  LocalConfig cfg;
+  cfg.method = method_;
+  cfg.dim = dim;
+  cfg.order = order_;
+  cfg.want_value = fv;
+  cfg.want_grad = fg;
+  cfg.want_hess = fh;
+  cfg.kernel = kernel_.get();
+
+  Report rep;
+  int64_t nfailed = 0;
+  int32_t first_bad = -1;
+  for (int32_t s = 0; s < nsites_; ++s) {
+    const int32_t me = site_particle(s);
+    if (me >= 0 && ps_->site_status()[me] != 0) {
+      status_[s] = ps_->site_status()[me];
+      ++nfailed;
+      if (first_bad < 0) first_bad = s;
+      continue;
+    }
+    const int64_t k0 = rowptr_[s];
+    const int n = static_cast<int>(rowptr_[s + 1] - k0);
+    if (dbuf_.size() < 3 * static_cast<size_t>(n)) {
+      dbuf_.resize(3 * static_cast<size_t>(n));
+      vbuf_.resize(n);
+      hbuf_.resize(n);
+    }
+    for (int q = 0; q < n; ++q) {
+      const int32_t j = cols_[k0 + q];
+      double *d = &dbuf_[3 * static_cast<size_t>(q)];
+      d[0] = d[1] = d[2] = 0.0;
+      site_displacement(s, j, d);
+      vbuf_[q] = have_vol ? ps_->volume(j) : 1.0;
+      hbuf_[q] = pair_h(s, j);
+    }
+    LocalInput in;
+    in.n = n;
+    in.self = self_[s];
+    in.hs = site_h(s);
+    in.d = dbuf_.data();
+    in.vol = vbuf_.data();
+    in.h = hbuf_.data();
+    LocalOutput out;
+    out.phi = fv ? &val_[k0] : nullptr;
+    out.grad = fg ? &grad_[k0 * dim] : nullptr;
+    out.hess = fh ? &hess_[k0 * nh] : nullptr;
+    cfg.method = method_;
+    cfg.order = order_;
+    compute_site(cfg, in, work_, out);
+    if (out.status && fallback_ == MFREE_FALLBACK_LOWER_ORDER) {
+      const int first_status = out.status;
+      const double first_cond = out.cond;
+      if (has_order(method_))
+        for (int o = order_ - 1; o >= min_order(method_) && out.status; --o) {
+          cfg.order = o;
+          if (fh && !provides_hessian(method_, o)) break;
+          compute_site(cfg, in, work_, out);
+        }
+      if (out.status) {  // last resort: Shepard functions (constant complete)
+        cfg.method = MFREE_METHOD_SHEPARD;
+        cfg.order = 0;
+        compute_site(cfg, in, work_, out);
+      }
+      if (out.status) {
+        out.status = first_status;
+        out.cond = first_cond;
+      }
+    }
+    status_[s] = out.status;
+    support_[s] = out.support;
+    cond_[s] = out.cond;
+    order_used_[s] = out.order_used;
+    if (out.status) {
+      ++nfailed;
+      if (first_bad < 0) first_bad = s;
+    }
+  }
+  if (nfailed) {
+    const int32_t s = first_bad;
+    std::ostringstream msg;
+    msg << method_name(method_) << ": site " << s;
+    if (status_[s] == MFREE_FAIL_NEIGHBORS)
+      msg << " has " << support_[s] << " neighbours with non-zero weight, too few for the basis";
+    else if (status_[s] == MFREE_FAIL_SINGULAR)
+      msg << " has a singular local system (condition estimate " << cond_[s]
+          << "; collinear, coincident or too few neighbours)";
+    else
+      msg << " has invalid particle data";
+    msg << " (" << nfailed << (nfailed == 1 ? " site" : " sites") << " failed; their rows are zero)";
+    rep.fail(static_cast<mfree_status_t>(status_[s]), msg.str());
+  }
+  return rep;
+}
+
+Report Approximant::setup() {
+  validate_config();
+  build_pattern();
+  Report rep = compute("setup");
+  setup_done_ = true;
+  return rep;
+}
+
+Report Approximant::update() {
+  if (!setup_done_) throw Error(MFREE_ERR_STATE, "update called before setup");
+  validate_config();
+  return compute("update");
+}
+
+int Approximant::op_components(int op, int ncomp) const {
+  const int dim = ps_->dim();
+  switch (op) {
+    case MFREE_OP_VALUE:
+    case MFREE_OP_LAPLACIAN:
+      return ncomp;
+    case MFREE_OP_GRADIENT:
+      return ncomp * dim;
+    case MFREE_OP_DIVERGENCE:
+      if (ncomp != dim)
+        throw Error(MFREE_ERR_MISMATCH, "divergence needs ncomp = dim = " + std::to_string(dim) +
+                                            ", got " + std::to_string(ncomp));
+      return 1;
+    case MFREE_OP_HESSIAN:
+      return ncomp * hessian_size(dim);
+    default:
+      throw Error(MFREE_ERR_ARG, "unknown operator " + std::to_string(op));
+  }
+}
+
+void Approximant::apply(int op, int ncomp, const double *u, int ulayout, int64_t uld, double *out,
+                        int olayout, int64_t old, bool add) const {
+  const int dim = ps_->dim(), nh = hessian_size(dim);
+  const int ocomp = op_components(op, ncomp);
+  auto U = [&](int32_t j, int c) { return ulayout == MFREE_LAYOUT_AOS ? u[j * uld + c] : u[c * uld + j]; };
+  auto O = [&](int32_t s, int c) -> double & {
+    return olayout == MFREE_LAYOUT_AOS ? out[s * old + c] : out[c * old + s];
+  };
+  for (int32_t s = 0; s < nsites_; ++s) {
+    const int64_t k0 = rowptr_[s], k1 = rowptr_[s + 1];
+    for (int oc = 0; oc < ocomp; ++oc) {
+      double acc = 0.0;
+      switch (op) {
+        case MFREE_OP_VALUE:
+          for (int64_t k = k0; k < k1; ++k) acc += val_[k] * U(cols_[k], oc);
+          break;
+        case MFREE_OP_GRADIENT: {
+          const int c = oc / dim, d = oc % dim;
+          for (int64_t k = k0; k < k1; ++k) acc += grad_[k * dim + d] * U(cols_[k], c);
+          break;
+        }
+        case MFREE_OP_DIVERGENCE:
+          for (int64_t k = k0; k < k1; ++k)
+            for (int d = 0; d < dim; ++d) acc += grad_[k * dim + d] * U(cols_[k], d);
+          break;
+        case MFREE_OP_LAPLACIAN:
+          for (int64_t k = k0; k < k1; ++k) {
+            double tr = 0.0;
+            for (int d = 0; d < dim; ++d) tr += hess_[k * nh + hessian_index(dim, d, d)];
+            acc += tr * U(cols_[k], oc);
+          }
+          break;
+        case MFREE_OP_HESSIAN: {
+          const int c = oc / nh, e = oc % nh;
+          for (int64_t k = k0; k < k1; ++k) acc += hess_[k * nh + e] * U(cols_[k], c);
+          break;
+        }
+      }
+      if (add) O(s, oc) += acc;
+      else O(s, oc) = acc;
+    }
+  }
+}
+
+void Approximant::export_csr(int deriv, int component, int64_t *rowptr, int32_t *cols,
+                             double *vals) const {
+  const int dim = ps_->dim(), nh = hessian_size(dim);
+  const std::vector<double> *tab = nullptr;
+  int stride = 1;
+  if (deriv == MFREE_DERIV_VALUE) {
+    tab = &val_;
+    if (component != 0) throw Error(MFREE_ERR_ARG, "the value table has one component (0)");
+  } else if (deriv == MFREE_DERIV_GRADIENT) {
+    tab = &grad_;
+    stride = dim;
+  } else if (deriv == MFREE_DERIV_HESSIAN) {
+    tab = &hess_;
+    stride = nh;
+  } else {
+    throw Error(MFREE_ERR_ARG, "deriv must be one of MFREE_DERIV_VALUE, _GRADIENT, _HESSIAN");
+  }
+  if (component < 0 || component >= stride)
+    throw Error(MFREE_ERR_ARG, "component " + std::to_string(component) + " is outside [0, " +
+                                   std::to_string(stride) + ")");
+  if (!(flags_ & deriv)) throw Error(MFREE_ERR_STATE, "that table was not built (set_derivatives)");
+  if (rowptr) std::copy(rowptr_.begin(), rowptr_.end(), rowptr);
+  if (cols) std::copy(cols_.begin(), cols_.end(), cols);
+  if (vals)
+    for (size_t k = 0; k < cols_.size(); ++k) vals[k] = (*tab)[k * stride + component];
+}
+
+void Approximant::check_reproduction(int order, double &fn_err, double &deriv_err) const {
+  if (order < 0 || order > 3) throw Error(MFREE_ERR_ARG, "order must be 0..3");
+  const int dim = ps_->dim(), nh = hessian_size(dim);
+  const Basis B(dim, order);
+  const int L = B.size();
+  fn_err = deriv_err = 0.0;
+  double p[kMaxBasis];
+  for (int32_t s = 0; s < nsites_; ++s) {
+    if (status_[s]) continue;
+    const double hs = site_h(s), ih = 1.0 / hs;
+    double sv[kMaxBasis] = {0}, sg[kMaxBasis][3] = {{0}}, sh[kMaxBasis][6] = {{0}};
+    for (int64_t k = rowptr_[s]; k < rowptr_[s + 1]; ++k) {
+      double d[3] = {0, 0, 0};
+      site_displacement(s, cols_[k], d);
+      for (int c = 0; c < dim; ++c) d[c] *= ih;
+      B.eval(d, p);
+      for (int m = 0; m < L; ++m) {
+        if (!val_.empty()) sv[m] += val_[k] * p[m];
+        if (!grad_.empty())
+          for (int c = 0; c < dim; ++c) sg[m][c] += grad_[k * dim + c] * p[m];
+        if (!hess_.empty())
+          for (int e = 0; e < nh; ++e) sh[m][e] += hess_[k * nh + e] * p[m];
+      }
+    }
+    for (int m = 0; m < L; ++m) {
+      const auto &al = B.alpha(m);
+      const int deg = B.degree(m);
+      if (!val_.empty()) fn_err = std::max(fn_err, std::fabs(sv[m] - (deg == 0 ? 1.0 : 0.0)));
+      if (!grad_.empty())
+        for (int c = 0; c < dim; ++c) {
+          const double exact = (deg == 1 && al[c] == 1) ? 1.0 : 0.0;
+          deriv_err = std::max(deriv_err, std::fabs(sg[m][c] * hs - exact));
+        }
+      if (!hess_.empty())
+        for (int a = 0; a < dim; ++a)
+          for (int b = a; b < dim; ++b) {
+            std::array<int, 3> want{0, 0, 0};
+            ++want[a];
+            ++want[b];
+            const double exact = (al == want) ? (a == b ? 2.0 : 1.0) : 0.0;
+            deriv_err = std::max(deriv_err, std::fabs(sh[m][hessian_index(dim, a, b)] * hs * hs - exact));
+          }
+    }
+  }
+}
+
+}  // namespace mfree

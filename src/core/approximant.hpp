@@ -1,0 +1,97 @@
+// Approximant: shape-function tables (values, gradients, Hessians) of one method at a
+// set of sites (the owned particles or host points), applied to host fields.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "error.hpp"
+#include "kernel.hpp"
+#include "local.hpp"
+#include "particles.hpp"
+
+namespace mfree {
+
+class Approximant {
+ public:
+  Approximant(const ParticleSet *ps, int method);
+
+  void set_kernel(int kernel, double param);
+  void set_order(int order);
+  void set_derivatives(int flags);
+  void set_fallback(int policy);
+  void set_points(int32_t npts, const double *x, int layout, int64_t ld, const double *h,
+                  int64_t h_stride, int mem);
+
+  // Build pattern and tables (positive failures reported, negative ones thrown).
+  Report setup();
+  // Recompute tables on the existing pattern.
+  Report update();
+
+  bool is_setup() const { return setup_done_; }
+  int method() const { return method_; }
+  int dim() const { return ps_->dim(); }
+  int32_t num_sites() const { return nsites_; }
+  int64_t nnz() const { return static_cast<int64_t>(cols_.size()); }
+  int flags() const { return flags_; }
+
+  // out (+)= op(u); checks done by the caller (capi) except consistency of state.
+  void apply(int op, int ncomp, const double *u, int ulayout, int64_t uld, double *out,
+             int olayout, int64_t old, bool add) const;
+  // Output components of op for ncomp input components (throws on misuse).
+  int op_components(int op, int ncomp) const;
+
+  void export_csr(int deriv, int component, int64_t *rowptr, int32_t *cols, double *vals) const;
+  void check_reproduction(int order, double &fn_err, double &deriv_err) const;
+
+  const std::vector<int32_t> &site_status() const { return status_; }
+  const std::vector<int32_t> &site_support() const { return support_; }
+  const std::vector<double> &site_cond() const { return cond_; }
+  const std::vector<int32_t> &site_order() const { return order_used_; }
+
+ private:
+  void validate_config() const;
+  void build_pattern();
+  Report compute(const char *what);
+  double site_x(int32_t s, int c) const;
+  double site_h(int32_t s) const;
+  int32_t site_particle(int32_t s) const { return points_ ? -1 : s; }
+  void site_displacement(int32_t s, int32_t j, double *d) const;
+  double pair_h(int32_t s, int32_t j) const;
+
+  const ParticleSet *ps_;
+  int method_;
+  int kernel_id_ = MFREE_KERNEL_CUBIC_SPLINE;
+  double kernel_param_ = 0.0;
+  std::unique_ptr<Kernel> kernel_;
+  int order_;
+  int flags_ = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
+  int fallback_ = MFREE_FALLBACK_NONE;
+
+  // host points (sites), when set
+  bool points_ = false;
+  int32_t npts_ = 0;
+  VectorArray px_;
+  ScalarArray ph_;
+  Csr point_nbr_;  // neighbours of the points among the particles
+
+  bool setup_done_ = false;
+  int32_t nsites_ = 0;
+  std::vector<int64_t> rowptr_{0};
+  std::vector<int32_t> cols_;
+  std::vector<int32_t> self_;  // position of the site itself in its row, or -1
+  std::vector<double> val_, grad_, hess_;
+  std::vector<int32_t> status_, support_, order_used_;
+  std::vector<double> cond_;
+  std::vector<double> dbuf_, vbuf_, hbuf_;  // per-row scratch, reused
+  LocalWork work_;
+};
+
+// Neighbours among the particles of ps for each host point (site support hp, the set's
+// convention and kappa), skipping particles with a nonzero status.
+void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status,
+                          int32_t npts, const VectorArray &x, const ScalarArray &h, Csr &out);
+
+}  // namespace mfree
