@@ -7,4 +7,4 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bash scripts/deps.sh
 cmake --preset default
 cmake --build --preset default -j"$(nproc)"
-build/default/examples/mfree_demo "$@"
+build/default/examples/demo/mfree_demo "$@"
