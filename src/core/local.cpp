@@ -123,11 +123,24 @@ int shepard(Site &s, bool write) {
   return 0;
 }
 
+// Ratio of the smallest to the largest pivot magnitude of a factorisation.
+template <class V>
+double pivot_ratio(const V &piv) {
+  const double big = piv.cwiseAbs().maxCoeff(), small = piv.cwiseAbs().minCoeff();
+  return big > 0.0 ? small / big : 0.0;
+}
+double pivots(const Eigen::LDLT<Mat> &f) { return pivot_ratio(f.vectorD()); }
+double pivots(const Eigen::PartialPivLU<Mat> &f) { return pivot_ratio(f.matrixLU().diagonal()); }
+
+// Eigen's rcond() estimate is blind to an exactly zero pivot (it reports 1 for
+// [[1,0],[0,0]]), so the smaller of it and the pivot ratio decides.
 template <class Solver>
 bool check_rcond(Site &s, const Solver &solver) {
-  const double rc = solver.rcond();
+  double rc = solver.rcond();
+  if (!std::isfinite(rc)) rc = 0.0;
+  rc = std::min(rc, pivots(solver));
   s.out.cond = rc > 0.0 ? 1.0 / rc : INFINITY;
-  return rc >= kMinRcond && std::isfinite(rc);
+  return rc >= kMinRcond;
 }
 
 // Moving least squares (MLS, weights w) and RKPM (weights w V), order k, with true
