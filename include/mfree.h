@@ -179,6 +179,7 @@ typedef MFREE_ENUM(mfree_fallback) {
 typedef struct mfree_context mfree_context_t;
 typedef struct mfree_particles mfree_particles_t;
 typedef struct mfree_approximant mfree_approximant_t;
+typedef struct mfree_matrix mfree_matrix_t;
 
 /** Called on every failure recorded on a context (from the failing call's thread). */
 typedef void (*mfree_error_handler_t)(void *user, mfree_status_t code, const char *message);
@@ -510,6 +511,52 @@ MFREE_API mfree_status_t mfree_approximant_get_condition(const mfree_approximant
                                                          double *cond);
 MFREE_API mfree_status_t mfree_approximant_get_site_order(const mfree_approximant_t *a,
                                                           int32_t *order);
+
+/* ------------------------------------------------------------------------------------ */
+/* Sparse matrices                                                                        */
+/* ------------------------------------------------------------------------------------ */
+
+/**
+ * A sparse matrix in CSR form (rows sorted by column), as produced by the assembler, or
+ * created from host arrays (copied). Views give zero-copy access to its arrays for
+ * solvers (the SuiteSparse adapter); a view stays valid until the matrix is refilled
+ * with another pattern or destroyed.
+ * @param[in] rowptr  nrows + 1 offsets; @param[in] cols, vals  rowptr[nrows] entries
+ */
+MFREE_API mfree_status_t mfree_matrix_create_csr(mfree_context_t *ctx, int32_t nrows,
+                                                 int32_t ncols, const int64_t *rowptr,
+                                                 const int32_t *cols, const double *vals,
+                                                 mfree_matrix_t **A);
+MFREE_API mfree_status_t mfree_matrix_destroy(mfree_matrix_t **A);
+MFREE_API mfree_status_t mfree_matrix_get_size(const mfree_matrix_t *A, int32_t *nrows,
+                                               int32_t *ncols, int64_t *nnz);
+/** Zero-copy CSR view with the ABI index types. */
+MFREE_API mfree_status_t mfree_matrix_get_csr(const mfree_matrix_t *A,
+                                              const int64_t **rowptr,
+                                              const int32_t **cols, const double **vals);
+/** CSR view with 32-bit offsets (int SuiteSparse variants); MFREE_ERR_UNSUPPORTED when
+ * nnz does not fit. Index arrays are converted once and cached; values are not copied. */
+MFREE_API mfree_status_t mfree_matrix_get_csr_i32(const mfree_matrix_t *A,
+                                                  const int32_t **rowptr,
+                                                  const int32_t **cols, const double **vals);
+/** CSR view with 64-bit offsets and columns (SuiteSparse_long variants). */
+MFREE_API mfree_status_t mfree_matrix_get_csr_i64(const mfree_matrix_t *A,
+                                                  const int64_t **rowptr,
+                                                  const int64_t **cols, const double **vals);
+/** CSC view (computed on first request after a fill, then cached). */
+MFREE_API mfree_status_t mfree_matrix_get_csc(const mfree_matrix_t *A,
+                                              const int64_t **colptr, const int32_t **rows,
+                                              const double **vals);
+/** Pattern counter of this matrix: it changes whenever the matrix gets a new sparsity
+ * pattern (a refill of the values keeps it), so a solver that analysed this matrix
+ * knows when its symbolic analysis must be redone. */
+MFREE_API mfree_status_t mfree_matrix_get_pattern_id(const mfree_matrix_t *A, int64_t *id);
+/** 1 if the matrix is symmetric (checked numerically to round-off), else 0. */
+MFREE_API mfree_status_t mfree_matrix_get_symmetric(const mfree_matrix_t *A,
+                                                    int32_t *symmetric);
+/** y = A x (x of length ncols, y of length nrows; borrowed for the call). */
+MFREE_API mfree_status_t mfree_matrix_apply(const mfree_matrix_t *A, const double *x,
+                                            double *y);
 
 #ifdef __cplusplus
 }

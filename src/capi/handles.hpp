@@ -8,6 +8,7 @@
 
 #include "core/approximant.hpp"
 #include "core/error.hpp"
+#include "core/matrix.hpp"
 #include "core/particles.hpp"
 #include "mfree.h"
 
@@ -36,12 +37,20 @@ struct mfree_approximant {
       : ctx(c), ps(p), a(&p->set, method) {}
 };
 
+struct mfree_matrix {
+  std::atomic<int> refs{1};
+  mfree_context_t *ctx = nullptr;
+  mfree::SparseMatrix m;
+  explicit mfree_matrix(mfree_context_t *c) : ctx(c) {}
+};
+
 namespace mfree {
 
 void retain(mfree_context_t *c);
 void release(mfree_context_t *c);
 void retain(mfree_particles_t *p);
 void release(mfree_particles_t *p);
+void release(mfree_matrix_t *m);
 
 // Record a failure (or a positive report) on the context; returns status unchanged.
 mfree_status_t record(mfree_context_t *ctx, mfree_status_t status, const char *fn,
