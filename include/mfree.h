@@ -218,6 +218,13 @@ MFREE_API mfree_status_t mfree_context_get_last_error(const mfree_context_t *ctx
                                                       mfree_status_t *code, char *message,
                                                       int64_t len);
 
+/** Record a failure on the context as mfree itself does (for adapters and host
+ * wrappers built on mfree): sets the last error code and message and calls the error
+ * handler. Returns code, so that `return mfree_context_set_error(...)` reads naturally.
+ * @param[in] message  NUL-terminated, copied; NULL records an empty message */
+MFREE_API mfree_status_t mfree_context_set_error(mfree_context_t *ctx, mfree_status_t code,
+                                                 const char *message);
+
 /** Install an error handler (NULL removes it). The handler must not call back into
  * mfree with the same context. */
 MFREE_API mfree_status_t mfree_context_set_error_handler(mfree_context_t *ctx,

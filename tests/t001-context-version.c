@@ -92,6 +92,14 @@ static void test_context(void **s) {
   assert_int_equal(mfree_particles_set_num_ghost(ps, 9), MFREE_ERR_ARG);
   assert_int_equal(handler_calls, 1);
 
+  /* adapters record their own failures */
+  assert_int_equal(mfree_context_set_error(ctx, MFREE_FAIL_SINGULAR, "adapter: singular"),
+                   MFREE_FAIL_SINGULAR);
+  assert_int_equal(mfree_context_get_last_error(ctx, &code, msg, sizeof msg), MFREE_SUCCESS);
+  assert_int_equal(code, MFREE_FAIL_SINGULAR);
+  assert_string_equal(msg, "adapter: singular");
+  assert_int_equal(mfree_context_set_error(NULL, MFREE_ERR_ARG, "x"), MFREE_ERR_NULL);
+
   /* threads */
   int32_t nt = -1;
   assert_int_equal(mfree_context_get_num_threads(ctx, &nt), MFREE_SUCCESS);

@@ -55,6 +55,19 @@ mfree_status_t mfree_context_get_last_error(const mfree_context_t *ctx, mfree_st
   return MFREE_SUCCESS;
 }
 
+mfree_status_t mfree_context_set_error(mfree_context_t *ctx, mfree_status_t code,
+                                       const char *message) {
+  if (!ctx) return MFREE_ERR_NULL;
+  try {
+    ctx->last_code = code;
+    ctx->last_message = message ? message : "";
+  } catch (...) {
+    return MFREE_ERR_ALLOC;
+  }
+  if (ctx->handler) ctx->handler(ctx->handler_user, code, ctx->last_message.c_str());
+  return code;
+}
+
 mfree_status_t mfree_context_set_error_handler(mfree_context_t *ctx,
                                                mfree_error_handler_t handler, void *user) {
   if (!ctx) return MFREE_ERR_NULL;
