@@ -172,6 +172,30 @@ typedef MFREE_ENUM(mfree_fallback) {
                                        003 does); sites that still fail are reported */
 } mfree_fallback_t;
 
+/** Weak (Galerkin) and strong (collocation) forms the assembler builds. */
+typedef MFREE_ENUM(mfree_form) {
+  MFREE_FORM_LAPLACE = 1,                      /**< int grad Psi . c grad Phi */
+  MFREE_FORM_ELASTICITY_PLANE_STRESS = 2,      /**< int B_Psi^T D B_Phi, 2D plane stress */
+  MFREE_FORM_ELASTICITY_PLANE_STRAIN = 3,      /**< 2D plane strain */
+  MFREE_FORM_ELASTICITY_3D = 4,                /**< 3D */
+  MFREE_FORM_MASS = 5,                         /**< consistent mass int rho Psi Phi */
+  MFREE_FORM_MASS_LUMPED = 6,                  /**< row-sum lumped mass */
+  MFREE_FORM_COLLOCATION_LAPLACE = 7,          /**< rows -c Lap u = f at the particles */
+  MFREE_FORM_COLLOCATION_PLANE_STRESS = 8,     /**< Navier rows at the particles (001 6.3) */
+  MFREE_FORM_COLLOCATION_PLANE_STRAIN = 9
+} mfree_form_t;
+
+/** How essential boundary conditions are imposed. */
+typedef MFREE_ENUM(mfree_bc) {
+  MFREE_BC_PENALTY = 1,     /**< alpha int Psi (u - g) on boundary quadrature points */
+  MFREE_BC_LAGRANGE = 2,    /**< point multipliers: extra unknowns and rows [K G; G^T 0] */
+  MFREE_BC_COLLOCATION = 3, /**< the rows of the given particles are replaced by
+                                 u^h(x_J) = g(x_J): direct imposition for interpolating
+                                 approximants, boundary collocation otherwise */
+  MFREE_BC_NITSCHE = 4      /**< symmetric Nitsche terms on boundary quadrature points
+                                 with outward normals: consistent, passes patch tests */
+} mfree_bc_t;
+
 /* ------------------------------------------------------------------------------------ */
 /* Opaque handles                                                                         */
 /* ------------------------------------------------------------------------------------ */
@@ -180,6 +204,12 @@ typedef struct mfree_context mfree_context_t;
 typedef struct mfree_particles mfree_particles_t;
 typedef struct mfree_approximant mfree_approximant_t;
 typedef struct mfree_matrix mfree_matrix_t;
+typedef struct mfree_assembler mfree_assembler_t;
+
+/** A host function of position: writes ncomp values at x (dim coordinates). */
+typedef void (*mfree_field_fn)(void *user, const double *x, double *value);
+/** A host inside-test: nonzero when x lies in the domain. */
+typedef int32_t (*mfree_inside_fn)(void *user, const double *x);
 
 /** Called on every failure recorded on a context (from the failing call's thread). */
 typedef void (*mfree_error_handler_t)(void *user, mfree_status_t code, const char *message);
@@ -564,6 +594,127 @@ MFREE_API mfree_status_t mfree_matrix_get_symmetric(const mfree_matrix_t *A,
 /** y = A x (x of length ncols, y of length nrows; borrowed for the call). */
 MFREE_API mfree_status_t mfree_matrix_apply(const mfree_matrix_t *A, const double *x,
                                             double *y);
+
+/* ------------------------------------------------------------------------------------ */
+/* Assembly                                                                               */
+/* ------------------------------------------------------------------------------------ */
+
+/**
+ * An assembler of the given form with trial functions from `trial` and test functions
+ * from `test` (NULL: Bubnov-Galerkin, test = trial; e.g. Shepard test functions with
+ * corrected-derivative trial functions give the Petrov-Galerkin scheme of 000 5.3.1).
+ * The approximants' configuration (method, kernel, order) is copied: the assembler
+ * evaluates its own copies at its quadrature points. Unknowns are node-major,
+ * dof = particle * ncomp + component (ncomp = dim for elasticity, else 1), followed by
+ * Lagrange multipliers. Both approximants must be on the same particle set.
+ */
+MFREE_API mfree_status_t mfree_assembler_create(mfree_context_t *ctx,
+                                                const mfree_approximant_t *trial,
+                                                const mfree_approximant_t *test,
+                                                mfree_form_t form, mfree_assembler_t **as);
+MFREE_API mfree_status_t mfree_assembler_destroy(mfree_assembler_t **as);
+
+/** Young's modulus and Poisson ratio (elasticity forms). Default 1, 0. */
+MFREE_API mfree_status_t mfree_assembler_set_material(mfree_assembler_t *as, double young,
+                                                      double poisson);
+/** Coefficient c of the Laplace forms, or density rho of the mass forms. Default 1. */
+MFREE_API mfree_status_t mfree_assembler_set_coefficient(mfree_assembler_t *as, double c);
+
+/** Nodal quadrature: points = the particles, weights = their volumes (the default). */
+MFREE_API mfree_status_t mfree_assembler_set_quadrature_nodal(mfree_assembler_t *as);
+/**
+ * Background cells: a structured grid of ncells[d] cells over [lo, hi], ngauss^dim
+ * Gauss points per cell; points for which inside() is 0 are dropped (inside may be NULL).
+ */
+MFREE_API mfree_status_t mfree_assembler_set_quadrature_cells(mfree_assembler_t *as,
+                                                              const double *lo,
+                                                              const double *hi,
+                                                              const int32_t *ncells,
+                                                              int32_t ngauss,
+                                                              mfree_inside_fn inside,
+                                                              void *user);
+/** Host points and weights (copied; weights finite and >= 0). */
+MFREE_API mfree_status_t mfree_assembler_set_quadrature_points(mfree_assembler_t *as,
+                                                               int32_t npts,
+                                                               const double *x,
+                                                               mfree_layout_t layout,
+                                                               int64_t ld, const double *w);
+
+/** Body force b(x) (ncomp values), NULL for none. */
+MFREE_API mfree_status_t mfree_assembler_set_body_force(mfree_assembler_t *as,
+                                                        mfree_field_fn f, void *user);
+/**
+ * Natural boundary condition on boundary quadrature points (copied): adds
+ * sum_p w_p Psi_J(x_p) t(x_p) to the load. For collocation forms use
+ * mfree_assembler_add_traction_nodes.
+ */
+MFREE_API mfree_status_t mfree_assembler_add_traction(mfree_assembler_t *as, int32_t npts,
+                                                      const double *x,
+                                                      mfree_layout_t layout, int64_t ld,
+                                                      const double *w, mfree_field_fn t,
+                                                      void *user);
+/** Traction on 2D boundary segments (endpoints a_s, b_s at x[4 s .. 4 s + 3]), with
+ * ngauss Gauss points per segment; a segment of zero length is an input error. */
+MFREE_API mfree_status_t mfree_assembler_add_traction_segments(mfree_assembler_t *as,
+                                                               int32_t nseg,
+                                                               const double *x,
+                                                               int32_t ngauss,
+                                                               mfree_field_fn t, void *user);
+/**
+ * Essential boundary condition u_c = g_c for the components c set in component_mask
+ * (bit c), on boundary quadrature points (copied) with weights w.
+ *  - MFREE_BC_PENALTY: alpha sum_p w_p Psi_J (u - g)(x_p);
+ *  - MFREE_BC_LAGRANGE: one multiplier per point and component, u^h(x_p) = g(x_p)
+ *    (weights unused; point multipliers cannot represent the boundary flux exactly,
+ *    so this does not pass patch tests: prefer Nitsche);
+ *  - MFREE_BC_NITSCHE: -<Psi, (sigma(u) n)_c> - <(sigma(Psi) n)_c, u_c - g_c>
+ *    + beta <Psi, u_c - g_c> with beta from mfree_assembler_set_penalty (default
+ *    100 modulus / mean h); needs the outward unit normals (dim per point).
+ * @param[in] normals  dim values per point (Nitsche), else may be NULL
+ */
+MFREE_API mfree_status_t mfree_assembler_add_dirichlet(mfree_assembler_t *as,
+                                                       mfree_bc_t method, int32_t npts,
+                                                       const double *x,
+                                                       mfree_layout_t layout, int64_t ld,
+                                                       const double *w,
+                                                       const double *normals,
+                                                       int32_t component_mask,
+                                                       mfree_field_fn g, void *user);
+/** Essential condition by row replacement at particles (MFREE_BC_COLLOCATION). */
+MFREE_API mfree_status_t mfree_assembler_add_dirichlet_nodes(mfree_assembler_t *as,
+                                                             int32_t nnodes,
+                                                             const int32_t *nodes,
+                                                             int32_t component_mask,
+                                                             mfree_field_fn g, void *user);
+/** Collocation forms: traction rows sigma(u) n = t at the given particles with outward
+ * normals (dim per node, copied) replace the PDE rows (Laplace: c grad u . n = t). */
+MFREE_API mfree_status_t mfree_assembler_add_traction_nodes(mfree_assembler_t *as,
+                                                            int32_t nnodes,
+                                                            const int32_t *nodes,
+                                                            const double *normals,
+                                                            mfree_field_fn t, void *user);
+/** Penalty factor alpha (default 1e6 times the modulus E or coefficient c), which is
+ * also Nitsche's beta when set (default 100 modulus / mean h). */
+MFREE_API mfree_status_t mfree_assembler_set_penalty(mfree_assembler_t *as, double alpha);
+
+/**
+ * Build the quadrature, the shape-function tables at the quadrature and boundary points,
+ * and the sparsity pattern. A quadrature point outside every support, or a particle
+ * that no quadrature point sees (a zero row), is reported with a positive status
+ * (MFREE_FAIL_NEIGHBORS) instead of yielding a silently singular matrix.
+ */
+MFREE_API mfree_status_t mfree_assembler_setup(mfree_assembler_t *as);
+/** Recompute the tables after particles moved, keeping the pattern (refill only). */
+MFREE_API mfree_status_t mfree_assembler_update(mfree_assembler_t *as);
+/** Number of unknowns (particles * ncomp + multipliers) and quadrature points. */
+MFREE_API mfree_status_t mfree_assembler_get_size(const mfree_assembler_t *as,
+                                                  int32_t *ndofs, int32_t *nquad);
+/** Assemble the system matrix into *K (created when *K is NULL, else refilled: the
+ * pattern is kept when it did not change, so a solver can refactor numerically). */
+MFREE_API mfree_status_t mfree_assembler_assemble_matrix(mfree_assembler_t *as,
+                                                         mfree_matrix_t **K);
+/** Assemble the right-hand side (ndofs values). */
+MFREE_API mfree_status_t mfree_assembler_assemble_rhs(mfree_assembler_t *as, double *f);
 
 #ifdef __cplusplus
 }

@@ -51,6 +51,24 @@ Approximant::Approximant(const ParticleSet *ps, int method) : ps_(ps), method_(m
   kernel_ = std::make_unique<Kernel>(kernel_id_, ps->dim(), kernel_param_);
 }
 
+Approximant::Approximant(const ParticleSet *ps, const ApproxConfig &cfg) : Approximant(ps, cfg.method) {
+  set_kernel(cfg.kernel, cfg.param);
+  if (has_order(method_)) set_order(cfg.order);
+  set_derivatives(cfg.flags);
+  set_fallback(cfg.fallback);
+}
+
+ApproxConfig Approximant::config() const {
+  ApproxConfig c;
+  c.method = method_;
+  c.kernel = kernel_id_;
+  c.param = kernel_param_;
+  c.order = order_;
+  c.flags = flags_;
+  c.fallback = fallback_;
+  return c;
+}
+
 void Approximant::set_kernel(int kernel, double param) {
   auto k = std::make_unique<Kernel>(kernel, ps_->dim(), param);  // validates
   kernel_ = std::move(k);

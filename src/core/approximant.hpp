@@ -14,9 +14,28 @@
 
 namespace mfree {
 
+// Everything that defines an approximant apart from its particle set and sites; the
+// assembler clones it onto its own quadrature points.
+struct ApproxConfig {
+  int method = MFREE_METHOD_MLS;
+  int kernel = MFREE_KERNEL_CUBIC_SPLINE;
+  double param = 0.0;
+  int order = 1;
+  int flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
+  int fallback = MFREE_FALLBACK_NONE;
+};
+
 class Approximant {
  public:
   Approximant(const ParticleSet *ps, int method);
+  Approximant(const ParticleSet *ps, const ApproxConfig &cfg);
+  ApproxConfig config() const;
+  const ParticleSet &particles() const { return *ps_; }
+  const std::vector<int64_t> &rowptr() const { return rowptr_; }
+  const std::vector<int32_t> &cols() const { return cols_; }
+  const std::vector<double> &values() const { return val_; }
+  const std::vector<double> &gradients() const { return grad_; }
+  const std::vector<double> &hessians() const { return hess_; }
 
   void set_kernel(int kernel, double param);
   void set_order(int order);

@@ -1,0 +1,843 @@
+#include "assembler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "basis.hpp"
+#include "quadrature.hpp"
+
+namespace mfree {
+
+namespace {
+
+bool is_particles_only(int m) {
+  return m == MFREE_METHOD_SPH_SYMMETRIC || m == MFREE_METHOD_JOHNSON_BEISSEL ||
+         m == MFREE_METHOD_RANDLES_LIBERSKY;
+}
+
+// Rows of the strain-displacement matrix B(g) for gradient g (Voigt: xx, yy, [zz,] xy
+// [, yz, zx]); B[v][a] is the factor of u_a in strain component v.
+int strain_rows(int dim, const double *g, double B[6][3]) {
+  for (int v = 0; v < 6; ++v) B[v][0] = B[v][1] = B[v][2] = 0.0;
+  if (dim == 2) {
+    B[0][0] = g[0];
+    B[1][1] = g[1];
+    B[2][0] = g[1];
+    B[2][1] = g[0];
+    return 3;
+  }
+  B[0][0] = g[0];
+  B[1][1] = g[1];
+  B[2][2] = g[2];
+  B[3][0] = g[1];
+  B[3][1] = g[0];
+  B[4][1] = g[2];
+  B[4][2] = g[1];
+  B[5][0] = g[2];
+  B[5][2] = g[0];
+  return 6;
+}
+
+// Voigt index of the stress component (a, b).
+int voigt(int dim, int a, int b) {
+  if (a == b) return a;
+  if (dim == 2) return 2;
+  const int lo = std::min(a, b), hi = std::max(a, b);
+  return lo == 0 ? (hi == 1 ? 3 : 5) : 4;
+}
+
+}  // namespace
+
+Assembler::Assembler(const ParticleSet *ps, const ApproxConfig &trial, const ApproxConfig &test,
+                     bool bubnov, int form)
+    : ps_(ps), trial_cfg_(trial), test_cfg_(bubnov ? trial : test), bubnov_(bubnov), form_(form),
+      dim_(ps->dim()) {
+  if (form < MFREE_FORM_LAPLACE || form > MFREE_FORM_COLLOCATION_PLANE_STRAIN)
+    throw Error(MFREE_ERR_ARG, "unknown form " + std::to_string(form));
+  const bool plane = form == MFREE_FORM_ELASTICITY_PLANE_STRESS || form == MFREE_FORM_ELASTICITY_PLANE_STRAIN ||
+                     form == MFREE_FORM_COLLOCATION_PLANE_STRESS || form == MFREE_FORM_COLLOCATION_PLANE_STRAIN;
+  if (plane && dim_ != 2)
+    throw Error(MFREE_ERR_MISMATCH, "plane elasticity needs a 2D particle set, got dimension " + std::to_string(dim_));
+  if (form == MFREE_FORM_ELASTICITY_3D && dim_ != 3)
+    throw Error(MFREE_ERR_MISMATCH, "3D elasticity needs a 3D particle set");
+  if (collocation() && !bubnov)
+    throw Error(MFREE_ERR_ARG, "collocation forms take no test approximant");
+  ncomp_ = elasticity() ? dim_ : 1;
+}
+
+bool Assembler::elasticity() const {
+  return form_ == MFREE_FORM_ELASTICITY_PLANE_STRESS || form_ == MFREE_FORM_ELASTICITY_PLANE_STRAIN ||
+         form_ == MFREE_FORM_ELASTICITY_3D || form_ == MFREE_FORM_COLLOCATION_PLANE_STRESS ||
+         form_ == MFREE_FORM_COLLOCATION_PLANE_STRAIN;
+}
+
+void Assembler::set_material(double young, double poisson) {
+  if (!(std::isfinite(young) && young > 0.0) || !(std::isfinite(poisson) && poisson > -1.0 && poisson < 0.5))
+    throw Error(MFREE_ERR_ARG, "material needs E > 0 and -1 < nu < 1/2");
+  young_ = young;
+  poisson_ = poisson;
+}
+
+void Assembler::set_coefficient(double c) {
+  if (!(std::isfinite(c) && c > 0.0)) throw Error(MFREE_ERR_ARG, "coefficient must be finite and > 0");
+  coef_ = c;
+}
+
+void Assembler::set_penalty(double alpha) {
+  if (!(std::isfinite(alpha) && alpha > 0.0)) throw Error(MFREE_ERR_ARG, "penalty must be finite and > 0");
+  penalty_ = alpha;
+  penalty_set_ = true;
+}
+
+void Assembler::traction_row(const double *g, const double *n, double T[3][3]) const {
+  for (int a = 0; a < 3; ++a) T[a][0] = T[a][1] = T[a][2] = 0.0;
+  if (!elasticity()) {
+    double s = 0.0;
+    for (int d = 0; d < dim_; ++d) s += n[d] * g[d];
+    T[0][0] = coef_ * s;
+    return;
+  }
+  double D[36], B[6][3];
+  int nv = 0;
+  material_matrix(D, nv);
+  const int dstride = dim_ == 2 ? 3 : 6;
+  strain_rows(dim_, g, B);
+  for (int c = 0; c < dim_; ++c)
+    for (int e = 0; e < dim_; ++e) {
+      double s = 0.0;
+      for (int d = 0; d < dim_; ++d) {
+        const int vr = voigt(dim_, c, d);
+        for (int t = 0; t < nv; ++t) s += n[d] * D[vr * dstride + t] * B[t][e];
+      }
+      T[c][e] = s;
+    }
+}
+
+void Assembler::set_quadrature_nodal() {
+  quad_kind_ = 0;
+  qx_.clear();
+  qw_.clear();
+  setup_done_ = false;
+}
+
+void Assembler::check_points(int32_t npts, const double *x, const double *w, const char *what) const {
+  if (npts < 0) throw Error(MFREE_ERR_ARG, std::string(what) + ": negative point count");
+  if (npts > 0 && !x) throw Error(MFREE_ERR_NULL, std::string(what) + ": points are NULL");
+  if (w)
+    for (int32_t p = 0; p < npts; ++p)
+      if (!(std::isfinite(w[p]) && w[p] >= 0.0))
+        throw Error(MFREE_ERR_INPUT, std::string(what) + ": weight " + std::to_string(p) + " = " +
+                                         std::to_string(w[p]) + " is negative or not finite");
+}
+
+void Assembler::read_points(int32_t npts, const double *x, int layout, int64_t ld,
+                            std::vector<double> &out) const {
+  if (layout != MFREE_LAYOUT_AOS && layout != MFREE_LAYOUT_SOA) throw Error(MFREE_ERR_ARG, "unknown layout");
+  if (ld < (layout == MFREE_LAYOUT_AOS ? dim_ : npts)) throw Error(MFREE_ERR_ARG, "leading dimension too small");
+  VectorArray v;
+  v.ptr = x;
+  v.ld = ld;
+  v.layout = layout;
+  out.assign(static_cast<size_t>(npts) * dim_, 0.0);
+  for (int32_t p = 0; p < npts; ++p)
+    for (int c = 0; c < dim_; ++c) {
+      const double val = v(p, c);
+      if (!std::isfinite(val)) throw Error(MFREE_ERR_INPUT, "point " + std::to_string(p) + " is not finite");
+      out[static_cast<size_t>(p) * dim_ + c] = val;
+    }
+}
+
+void Assembler::set_quadrature_cells(const double *lo, const double *hi, const int32_t *ncells, int ngauss,
+                                     mfree_inside_fn inside, void *user) {
+  if (!lo || !hi || !ncells) throw Error(MFREE_ERR_NULL, "lo, hi or ncells is NULL");
+  if (ngauss < 1 || ngauss > 20) throw Error(MFREE_ERR_ARG, "ngauss must be 1..20");
+  for (int c = 0; c < dim_; ++c) {
+    if (!(std::isfinite(lo[c]) && std::isfinite(hi[c]) && hi[c] > lo[c]))
+      throw Error(MFREE_ERR_INPUT, "cell box axis " + std::to_string(c) + " needs finite lo < hi");
+    if (ncells[c] < 1) throw Error(MFREE_ERR_ARG, "ncells must be >= 1");
+  }
+  std::vector<double> g, gw;
+  gauss_legendre(ngauss, g, gw);
+  std::vector<double> x, w;
+  int64_t total = 1;
+  for (int c = 0; c < dim_; ++c) total *= static_cast<int64_t>(ncells[c]) * ngauss;
+  if (total > (int64_t(1) << 31) - 1) throw Error(MFREE_ERR_ARG, "too many quadrature points");
+  double h[3] = {0, 0, 0};
+  for (int c = 0; c < dim_; ++c) h[c] = (hi[c] - lo[c]) / ncells[c];
+  int64_t idx[3] = {0, 0, 0}, per[3] = {1, 1, 1};
+  for (int c = 0; c < dim_; ++c) per[c] = static_cast<int64_t>(ncells[c]) * ngauss;
+  for (int64_t t = 0; t < total; ++t) {
+    int64_t r = t;
+    double p[3] = {0, 0, 0}, wt = 1.0;
+    for (int c = 0; c < dim_; ++c) {
+      idx[c] = r % per[c];
+      r /= per[c];
+      const int64_t cell = idx[c] / ngauss, q = idx[c] % ngauss;
+      p[c] = lo[c] + h[c] * (cell + 0.5 * (1.0 + g[q]));
+      wt *= 0.5 * h[c] * gw[q];
+    }
+    if (inside && !inside(user, p)) continue;
+    for (int c = 0; c < dim_; ++c) x.push_back(p[c]);
+    w.push_back(wt);
+  }
+  qx_ = std::move(x);
+  qw_ = std::move(w);
+  quad_kind_ = 1;
+  setup_done_ = false;
+}
+
+void Assembler::set_quadrature_points(int32_t npts, const double *x, int layout, int64_t ld, const double *w) {
+  check_points(npts, x, w, "quadrature");
+  if (npts > 0 && !w) throw Error(MFREE_ERR_NULL, "quadrature weights are NULL");
+  std::vector<double> pts;
+  read_points(npts, x, layout, ld, pts);
+  qx_ = std::move(pts);
+  qw_.assign(w, w + npts);
+  quad_kind_ = 1;
+  setup_done_ = false;
+}
+
+void Assembler::set_body_force(mfree_field_fn f, void *user) {
+  body_ = f;
+  body_user_ = user;
+}
+
+void Assembler::add_traction(int32_t npts, const double *x, int layout, int64_t ld, const double *w,
+                             mfree_field_fn t, void *user) {
+  if (collocation()) throw Error(MFREE_ERR_UNSUPPORTED, "collocation forms take tractions at nodes (add_traction_nodes)");
+  if (mass()) throw Error(MFREE_ERR_UNSUPPORTED, "mass forms take no loads");
+  check_points(npts, x, w, "traction");
+  if (!t) throw Error(MFREE_ERR_NULL, "traction function is NULL");
+  if (npts > 0 && !w) throw Error(MFREE_ERR_NULL, "traction weights are NULL");
+  auto s = std::make_unique<PointSet>();
+  s->kind = 1;
+  read_points(npts, x, layout, ld, s->x);
+  s->w.assign(w, w + npts);
+  s->fn = t;
+  s->user = user;
+  psets_.push_back(std::move(s));
+  setup_done_ = false;
+}
+
+void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss, mfree_field_fn t, void *user) {
+  if (dim_ != 2) throw Error(MFREE_ERR_UNSUPPORTED, "boundary segments are 2D; give 3D facets as points and weights");
+  if (nseg < 0) throw Error(MFREE_ERR_ARG, "negative segment count");
+  if (nseg > 0 && !x) throw Error(MFREE_ERR_NULL, "segments are NULL");
+  if (ngauss < 1 || ngauss > 20) throw Error(MFREE_ERR_ARG, "ngauss must be 1..20");
+  std::vector<double> g, gw, pts, w;
+  gauss_legendre(ngauss, g, gw);
+  for (int32_t s = 0; s < nseg; ++s) {
+    const double *a = x + 4 * s, *b = a + 2;
+    for (int c = 0; c < 4; ++c)
+      if (!std::isfinite(a[c])) throw Error(MFREE_ERR_INPUT, "segment " + std::to_string(s) + " is not finite");
+    const double len = std::hypot(b[0] - a[0], b[1] - a[1]);
+    if (!(len > 0.0)) throw Error(MFREE_ERR_INPUT, "segment " + std::to_string(s) + " has zero length");
+    for (int q = 0; q < ngauss; ++q) {
+      const double tq = 0.5 * (1.0 + g[q]);
+      pts.push_back(a[0] + tq * (b[0] - a[0]));
+      pts.push_back(a[1] + tq * (b[1] - a[1]));
+      w.push_back(0.5 * len * gw[q]);
+    }
+  }
+  add_traction(static_cast<int32_t>(w.size()), pts.data(), MFREE_LAYOUT_AOS, 2, w.data(), t, user);
+}
+
+void Assembler::add_dirichlet(int method, int32_t npts, const double *x, int layout, int64_t ld,
+                              const double *w, const double *normals, int32_t mask, mfree_field_fn g,
+                              void *user) {
+  if (method != MFREE_BC_PENALTY && method != MFREE_BC_LAGRANGE && method != MFREE_BC_NITSCHE)
+    throw Error(MFREE_ERR_ARG, "add_dirichlet takes MFREE_BC_PENALTY, MFREE_BC_LAGRANGE or MFREE_BC_NITSCHE "
+                               "(row replacement: add_dirichlet_nodes)");
+  if (mass()) throw Error(MFREE_ERR_UNSUPPORTED, "mass forms take no boundary conditions");
+  if (method == MFREE_BC_NITSCHE) {
+    if (npts > 0 && !normals) throw Error(MFREE_ERR_NULL, "Nitsche needs the boundary normals");
+    if (npts > 0 && !w) throw Error(MFREE_ERR_NULL, "Nitsche weights are NULL");
+    if (is_particles_only(trial_cfg_.method) || is_particles_only(test_cfg_.method))
+      throw Error(MFREE_ERR_UNSUPPORTED, "Nitsche needs derivatives at boundary points, which particles-only "
+                                         "methods do not define");
+    for (int32_t p = 0; p < npts; ++p) {
+      double len = 0.0;
+      for (int c = 0; c < dim_; ++c) len += normals[p * dim_ + c] * normals[p * dim_ + c];
+      if (!(std::isfinite(len) && std::fabs(len - 1.0) < 1e-6))
+        throw Error(MFREE_ERR_INPUT, "normal " + std::to_string(p) + " is not a finite unit vector");
+    }
+  }
+  if (collocation()) throw Error(MFREE_ERR_UNSUPPORTED, "collocation forms take Dirichlet nodes");
+  if (mask <= 0 || mask >= (1 << ncomp_)) throw Error(MFREE_ERR_ARG, "component mask selects no valid component");
+  if (!g) throw Error(MFREE_ERR_NULL, "boundary value function is NULL");
+  check_points(npts, x, w, "dirichlet");
+  if (method == MFREE_BC_PENALTY && npts > 0 && !w) throw Error(MFREE_ERR_NULL, "penalty weights are NULL");
+  auto s = std::make_unique<PointSet>();
+  s->kind = method == MFREE_BC_PENALTY ? 2 : method == MFREE_BC_LAGRANGE ? 3 : 4;
+  read_points(npts, x, layout, ld, s->x);
+  if (method == MFREE_BC_NITSCHE) s->normals.assign(normals, normals + static_cast<size_t>(npts) * dim_);
+  if (w) s->w.assign(w, w + npts);
+  else s->w.assign(npts, 1.0);
+  s->mask = mask;
+  s->fn = g;
+  s->user = user;
+  psets_.push_back(std::move(s));
+  setup_done_ = false;
+}
+
+void Assembler::add_dirichlet_nodes(int32_t n, const int32_t *nodes, int32_t mask, mfree_field_fn g, void *user) {
+  if (n < 0) throw Error(MFREE_ERR_ARG, "negative node count");
+  if (n > 0 && !nodes) throw Error(MFREE_ERR_NULL, "nodes are NULL");
+  if (!g) throw Error(MFREE_ERR_NULL, "boundary value function is NULL");
+  if (mask <= 0 || mask >= (1 << ncomp_)) throw Error(MFREE_ERR_ARG, "component mask selects no valid component");
+  for (int32_t k = 0; k < n; ++k)
+    if (nodes[k] < 0 || nodes[k] >= ps_->num_owned())
+      throw Error(MFREE_ERR_INPUT, "node " + std::to_string(nodes[k]) + " is not an owned particle");
+  NodeSet s;
+  s.kind = 1;
+  s.nodes.assign(nodes, nodes + n);
+  s.mask = mask;
+  s.fn = g;
+  s.user = user;
+  nsets_.push_back(std::move(s));
+  setup_done_ = false;
+}
+
+void Assembler::add_traction_nodes(int32_t n, const int32_t *nodes, const double *normals, mfree_field_fn t,
+                                   void *user) {
+  if (!collocation()) throw Error(MFREE_ERR_UNSUPPORTED, "traction rows at nodes are for collocation forms");
+  if (n < 0) throw Error(MFREE_ERR_ARG, "negative node count");
+  if (n > 0 && (!nodes || !normals)) throw Error(MFREE_ERR_NULL, "nodes or normals are NULL");
+  if (!t) throw Error(MFREE_ERR_NULL, "traction function is NULL");
+  for (int32_t k = 0; k < n; ++k) {
+    if (nodes[k] < 0 || nodes[k] >= ps_->num_owned())
+      throw Error(MFREE_ERR_INPUT, "node " + std::to_string(nodes[k]) + " is not an owned particle");
+    double len = 0.0;
+    for (int c = 0; c < dim_; ++c) len += normals[k * dim_ + c] * normals[k * dim_ + c];
+    if (!(std::isfinite(len) && len > 0.0))
+      throw Error(MFREE_ERR_INPUT, "normal of node " + std::to_string(nodes[k]) + " is zero or not finite");
+  }
+  NodeSet s;
+  s.kind = 2;
+  s.nodes.assign(nodes, nodes + n);
+  s.normals.assign(normals, normals + static_cast<size_t>(n) * dim_);
+  s.fn = t;
+  s.user = user;
+  nsets_.push_back(std::move(s));
+  setup_done_ = false;
+}
+
+double Assembler::mean_h() const {
+  double s = 0.0;
+  const int32_t n = ps_->size();
+  for (int32_t i = 0; i < n; ++i) s += ps_->h(i);
+  return n ? s / n : 1.0;
+}
+
+ApproxConfig Assembler::values_config(const ApproxConfig &c) const {
+  // Particles-only methods define derivatives, not values away from the particles:
+  // loads and boundary values use Shepard functions of the same kernel (paper 000
+  // leaves this unspecified, section 5.5 of the spec note).
+  ApproxConfig v = c;
+  if (is_particles_only(c.method)) {
+    v.method = MFREE_METHOD_SHEPARD;
+    v.order = 0;
+  }
+  v.flags = MFREE_DERIV_VALUE;
+  return v;
+}
+
+std::unique_ptr<Approximant> Assembler::make(const ApproxConfig &cfg, const std::vector<double> *pts) const {
+  auto a = std::make_unique<Approximant>(ps_, cfg);
+  if (pts) {
+    const double h = mean_h();
+    const int32_t n = static_cast<int32_t>(pts->size() / dim_);
+    a->set_points(n, n ? pts->data() : nullptr, MFREE_LAYOUT_AOS, dim_, &h, 0, MFREE_COPY);
+  }
+  return a;
+}
+
+void Assembler::material_matrix(double *D, int &nv) const {
+  const double E = young_, nu = poisson_;
+  nv = dim_ == 2 ? 3 : 6;
+  std::fill(D, D + 36, 0.0);
+  if (dim_ == 2) {
+    const bool stress = form_ == MFREE_FORM_ELASTICITY_PLANE_STRESS || form_ == MFREE_FORM_COLLOCATION_PLANE_STRESS;
+    if (stress) {
+      const double f = E / (1.0 - nu * nu);
+      D[0] = f; D[1] = f * nu; D[3] = f * nu; D[4] = f; D[8] = f * (1.0 - nu) / 2.0;
+    } else {
+      const double f = E / ((1.0 + nu) * (1.0 - 2.0 * nu));
+      D[0] = f * (1.0 - nu); D[1] = f * nu; D[3] = f * nu; D[4] = f * (1.0 - nu);
+      D[8] = f * (1.0 - 2.0 * nu) / 2.0;
+    }
+    // row-major 3x3 stored with stride 3
+    return;
+  }
+  const double lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu = E / (2.0 * (1.0 + nu));
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) D[a * 6 + b] = lam + (a == b ? 2.0 * mu : 0.0);
+  for (int a = 3; a < 6; ++a) D[a * 6 + a] = mu;
+}
+
+Report Assembler::build_tables() {
+  Report rep;
+  auto merge = [&](const Report &r, const char *where) {
+    if (!r.ok()) rep.fail(r.status, std::string(where) + ": " + r.message);
+  };
+  const bool nodal = quad_kind_ == 0;
+  if (!nodal && (is_particles_only(trial_cfg_.method) || is_particles_only(test_cfg_.method)))
+    throw Error(MFREE_ERR_UNSUPPORTED, "symmetric SPH, Johnson-Beissel and Randles-Libersky are defined at the "
+                                       "particles: use nodal quadrature");
+  ApproxConfig tc = trial_cfg_, sc = test_cfg_;
+  if (collocation()) {
+    tc.flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT | MFREE_DERIV_HESSIAN;
+    trial_q_ = make(tc, nullptr);
+    merge(trial_q_->setup(), "collocation tables");
+    test_q_.reset();
+    load_q_.reset();
+    trial_nodes_.reset();
+  } else {
+    const bool m = mass();
+    tc.flags = m ? MFREE_DERIV_VALUE : (MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT);
+    sc.flags = tc.flags;
+    if (is_particles_only(tc.method)) tc.flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
+    trial_q_ = make(tc, nodal ? nullptr : &qx_);
+    merge(trial_q_->setup(), "trial functions at the quadrature points");
+    if (!bubnov_) {
+      test_q_ = make(sc, nodal ? nullptr : &qx_);
+      merge(test_q_->setup(), "test functions at the quadrature points");
+    } else {
+      test_q_.reset();
+    }
+    load_q_.reset();
+    if (body_ && !m) {
+      load_q_ = make(values_config(test_cfg_), nodal ? nullptr : &qx_);
+      merge(load_q_->setup(), "test values at the quadrature points");
+    }
+    trial_nodes_.reset();
+    if (!nsets_.empty()) {
+      trial_nodes_ = make(values_config(trial_cfg_), nullptr);
+      merge(trial_nodes_->setup(), "trial values at the particles");
+    }
+  }
+  for (auto &s : psets_) {
+    s->test.reset();
+    s->trial.reset();
+    if (s->kind == 4) {
+      ApproxConfig t = test_cfg_, r = trial_cfg_;
+      t.flags = r.flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
+      s->test = make(t, &s->x);
+      merge(s->test->setup(), "test functions at Nitsche points");
+      s->trial = make(r, &s->x);
+      merge(s->trial->setup(), "trial functions at Nitsche points");
+      continue;
+    }
+    if (s->kind == 1 || s->kind == 2) {
+      s->test = make(values_config(test_cfg_), &s->x);
+      merge(s->test->setup(), "test values at boundary points");
+    }
+    if (s->kind == 2 || s->kind == 3) {
+      s->trial = make(values_config(trial_cfg_), &s->x);
+      merge(s->trial->setup(), "trial values at boundary points");
+    }
+  }
+  return rep;
+}
+
+void Assembler::build_pattern() {
+  const int32_t n = ps_->size(), nc = ncomp_;
+  std::vector<std::vector<int32_t>> rows(n);  // node-level columns per test node
+  auto add_pairs = [&](const Approximant &test, const Approximant &trial, int32_t site) {
+    const auto &tr = test.rowptr(), &kr = trial.rowptr();
+    for (int64_t a = tr[site]; a < tr[site + 1]; ++a) {
+      auto &row = rows[test.cols()[a]];
+      for (int64_t b = kr[site]; b < kr[site + 1]; ++b) row.push_back(trial.cols()[b]);
+    }
+  };
+  const Approximant &trial = *trial_q_;
+  const Approximant &test = test_q_ ? *test_q_ : *trial_q_;
+  if (form_ == MFREE_FORM_MASS_LUMPED) {
+    for (int32_t i = 0; i < n; ++i) rows[i].push_back(i);
+  } else if (collocation()) {
+    for (int32_t s = 0; s < trial.num_sites(); ++s)
+      for (int64_t b = trial.rowptr()[s]; b < trial.rowptr()[s + 1]; ++b) rows[s].push_back(trial.cols()[b]);
+  } else {
+    for (int32_t q = 0; q < trial.num_sites(); ++q) add_pairs(test, trial, q);
+    for (auto &s : psets_)
+      if (s->kind == 2 || s->kind == 4)
+        for (int32_t p = 0; p < s->trial->num_sites(); ++p) add_pairs(*s->test, *s->trial, p);
+  }
+  // Dirichlet/traction rows at nodes: the trial row at the node
+  const Approximant *tn = collocation() ? trial_q_.get() : trial_nodes_.get();
+  for (auto &ns : nsets_)
+    for (int32_t J : ns.nodes)
+      for (int64_t b = tn->rowptr()[J]; b < tn->rowptr()[J + 1]; ++b) rows[J].push_back(tn->cols()[b]);
+  for (auto &r : rows) {
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+  }
+  // multipliers: one per Lagrange point and constrained component
+  nmult_ = 0;
+  std::vector<std::vector<int32_t>> mcols;  // dof columns of each multiplier row
+  for (auto &s : psets_) {
+    if (s->kind != 3) continue;
+    s->first_multiplier = nmult_;
+    const Approximant &a = *s->trial;
+    for (int32_t p = 0; p < a.num_sites(); ++p)
+      for (int c = 0; c < nc; ++c) {
+        if (!(s->mask & (1 << c))) continue;
+        std::vector<int32_t> mc;
+        for (int64_t b = a.rowptr()[p]; b < a.rowptr()[p + 1]; ++b) mc.push_back(a.cols()[b] * nc + c);
+        std::sort(mc.begin(), mc.end());
+        mcols.push_back(std::move(mc));
+        ++nmult_;
+      }
+  }
+  const int32_t nbase = n * nc;
+  ndofs_ = nbase + nmult_;
+  // transpose of the multiplier columns: for each dof, the multipliers touching it
+  std::vector<std::vector<int32_t>> dof_mult(nbase);
+  for (int32_t m = 0; m < nmult_; ++m)
+    for (int32_t d : mcols[m]) dof_mult[d].push_back(nbase + m);
+  rowptr_.assign(static_cast<size_t>(ndofs_) + 1, 0);
+  cols_.clear();
+  for (int32_t J = 0; J < n; ++J)
+    for (int a = 0; a < nc; ++a) {
+      const int32_t dof = J * nc + a;
+      for (int32_t K : rows[J])
+        for (int b = 0; b < nc; ++b) cols_.push_back(K * nc + b);
+      for (int32_t m : dof_mult[dof]) cols_.push_back(m);
+      rowptr_[dof + 1] = static_cast<int64_t>(cols_.size());
+    }
+  for (int32_t m = 0; m < nmult_; ++m) {
+    for (int32_t d : mcols[m]) cols_.push_back(d);
+    rowptr_[nbase + m + 1] = static_cast<int64_t>(cols_.size());
+  }
+  // replaced rows: Dirichlet rows win over traction rows, both over the form's rows
+  row_kind_.assign(nbase, 0);
+  row_set_.assign(nbase, -1);
+  row_node_.assign(nbase, -1);
+  for (int pass = 2; pass >= 1; --pass)
+    for (size_t si = 0; si < nsets_.size(); ++si) {
+      const NodeSet &ns = nsets_[si];
+      if (ns.kind != pass) continue;
+      for (size_t k = 0; k < ns.nodes.size(); ++k)
+        for (int c = 0; c < nc; ++c) {
+          if (ns.kind == 1 && !(ns.mask & (1 << c))) continue;
+          const int32_t dof = ns.nodes[k] * nc + c;
+          row_kind_[dof] = ns.kind;
+          row_set_[dof] = static_cast<int32_t>(si);
+          row_node_[dof] = static_cast<int32_t>(k);
+        }
+    }
+}
+
+Report Assembler::setup() {
+  if (!ps_->is_setup()) throw Error(MFREE_ERR_STATE, "the particle set is not set up");
+  const double modulus = elasticity() ? young_ : coef_;
+  if (!penalty_set_) penalty_ = 1e6 * modulus;
+  nitsche_ = penalty_set_ ? penalty_ : 100.0 * modulus / mean_h();
+  Report rep = build_tables();
+  build_pattern();
+  // diagnostics: quadrature points outside every support; particles no point sees
+  const Approximant &trial = *trial_q_;
+  int64_t bad_q = 0;
+  for (int32_t s = 0; s < trial.num_sites(); ++s)
+    if (trial.site_status()[s] != 0 || trial.rowptr()[s + 1] == trial.rowptr()[s]) ++bad_q;
+  if (bad_q && rep.ok())
+    rep.fail(MFREE_FAIL_NEIGHBORS, std::to_string(bad_q) + " quadrature points are outside every support or failed");
+  for (int32_t d = 0; d < ps_->size() * ncomp_; ++d)
+    if (rowptr_[d + 1] == rowptr_[d] && row_kind_[d] == 0) {
+      rep.fail(MFREE_FAIL_NEIGHBORS, "particle " + std::to_string(d / ncomp_) +
+                                         " is seen by no quadrature point: its row of the matrix is zero");
+      break;
+    }
+  setup_done_ = true;
+  return rep;
+}
+
+Report Assembler::update() {
+  if (!setup_done_) throw Error(MFREE_ERR_STATE, "update called before setup");
+  Report rep;
+  auto upd = [&](Approximant *a) {
+    if (a) {
+      Report r = a->update();
+      if (!r.ok()) rep.fail(r.status, r.message);
+    }
+  };
+  upd(trial_q_.get());
+  upd(test_q_.get());
+  upd(load_q_.get());
+  upd(trial_nodes_.get());
+  for (auto &s : psets_) {
+    upd(s->test.get());
+    upd(s->trial.get());
+  }
+  return rep;
+}
+
+void Assembler::assemble_matrix(SparseMatrix &K) const {
+  if (!setup_done_) throw Error(MFREE_ERR_STATE, "the assembler is not set up");
+  if (K.rows() != ndofs_ || K.rowptr() != rowptr_ || K.colidx() != cols_)
+    K.set_pattern(ndofs_, ndofs_, rowptr_, cols_);
+  std::vector<double> &v = K.values_mut();
+  std::fill(v.begin(), v.end(), 0.0);
+  const int nc = ncomp_, dim = dim_;
+  const int32_t nbase = ps_->size() * nc;
+  auto at = [&](int32_t r, int32_t c) -> double & {
+    const int64_t k = K.find(r, c);
+    if (k < 0) throw Error(MFREE_ERR_INTERNAL, "assembly entry outside the pattern");
+    return v[k];
+  };
+  const Approximant &trial = *trial_q_;
+  const Approximant &test = test_q_ ? *test_q_ : *trial_q_;
+  double D[36];
+  int nv = 0;
+  if (elasticity()) material_matrix(D, nv);
+  const int dstride = dim == 2 ? 3 : 6;
+
+  if (collocation()) {
+    const double E = young_, nu = poisson_;
+    double lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    const double mu = E / (2.0 * (1.0 + nu));
+    if (form_ == MFREE_FORM_COLLOCATION_PLANE_STRESS) lam = 2.0 * lam * mu / (lam + 2.0 * mu);
+    const int nh = hessian_size(dim);
+    const auto &H = trial.hessians();
+    for (int32_t J = 0; J < trial.num_sites(); ++J)
+      for (int64_t k = trial.rowptr()[J]; k < trial.rowptr()[J + 1]; ++k) {
+        const int32_t K2 = trial.cols()[k];
+        double lap = 0.0;
+        for (int d = 0; d < dim; ++d) lap += H[k * nh + hessian_index(dim, d, d)];
+        if (form_ == MFREE_FORM_COLLOCATION_LAPLACE) {
+          if (row_kind_[J] == 0) at(J, K2) += -coef_ * lap;
+          continue;
+        }
+        for (int a = 0; a < nc; ++a) {
+          if (row_kind_[J * nc + a] != 0) continue;
+          for (int b = 0; b < nc; ++b)
+            at(J * nc + a, K2 * nc + b) +=
+                -(mu * lap * (a == b ? 1.0 : 0.0) + (lam + mu) * H[k * nh + hessian_index(dim, a, b)]);
+        }
+      }
+  } else if (form_ == MFREE_FORM_MASS || form_ == MFREE_FORM_MASS_LUMPED) {
+    const auto &Pv = trial.values(), &Tv = test.values();
+    for (int32_t q = 0; q < trial.num_sites(); ++q) {
+      const double w = quad_kind_ == 0 ? ps_->volume(q) : qw_[q];
+      for (int64_t a = test.rowptr()[q]; a < test.rowptr()[q + 1]; ++a)
+        for (int64_t b = trial.rowptr()[q]; b < trial.rowptr()[q + 1]; ++b) {
+          const int32_t J = test.cols()[a], K2 = trial.cols()[b];
+          if (row_kind_[J] != 0) continue;
+          const double m = w * coef_ * Tv[a] * Pv[b];
+          if (form_ == MFREE_FORM_MASS) at(J, K2) += m;
+          else at(J, J) += m;
+        }
+    }
+  } else {
+    const auto &Pg = trial.gradients(), &Tg = test.gradients();
+    std::vector<double> DB;  // per trial neighbour: nv x nc
+    for (int32_t q = 0; q < trial.num_sites(); ++q) {
+      const double w = quad_kind_ == 0 ? ps_->volume(q) : qw_[q];
+      const int64_t b0 = trial.rowptr()[q], b1 = trial.rowptr()[q + 1];
+      if (form_ == MFREE_FORM_LAPLACE) {
+        for (int64_t a = test.rowptr()[q]; a < test.rowptr()[q + 1]; ++a)
+          for (int64_t b = b0; b < b1; ++b) {
+            double dot = 0.0;
+            for (int d = 0; d < dim; ++d) dot += Tg[a * dim + d] * Pg[b * dim + d];
+            const int32_t J = test.cols()[a];
+            if (row_kind_[J] == 0) at(J, trial.cols()[b]) += w * coef_ * dot;
+          }
+        continue;
+      }
+      DB.assign(static_cast<size_t>(b1 - b0) * nv * nc, 0.0);
+      for (int64_t b = b0; b < b1; ++b) {
+        double B[6][3];
+        strain_rows(dim, &Pg[b * dim], B);
+        double *db = &DB[static_cast<size_t>(b - b0) * nv * nc];
+        for (int u = 0; u < nv; ++u)
+          for (int e = 0; e < nc; ++e) {
+            double s = 0.0;
+            for (int t = 0; t < nv; ++t) s += D[u * dstride + t] * B[t][e];
+            db[u * nc + e] = s;
+          }
+      }
+      for (int64_t a = test.rowptr()[q]; a < test.rowptr()[q + 1]; ++a) {
+        double BJ[6][3];
+        strain_rows(dim, &Tg[a * dim], BJ);
+        const int32_t J = test.cols()[a];
+        for (int64_t b = b0; b < b1; ++b) {
+          const double *db = &DB[static_cast<size_t>(b - b0) * nv * nc];
+          const int32_t K2 = trial.cols()[b];
+          for (int c = 0; c < nc; ++c) {
+            if (row_kind_[J * nc + c] != 0) continue;
+            for (int e = 0; e < nc; ++e) {
+              double s = 0.0;
+              for (int u = 0; u < nv; ++u) s += BJ[u][c] * db[u * nc + e];
+              at(J * nc + c, K2 * nc + e) += w * s;
+            }
+          }
+        }
+      }
+    }
+    // penalty and Lagrange terms
+    for (auto &s : psets_) {
+      if (s->kind == 2) {
+        const Approximant &ts = *s->test, &tr = *s->trial;
+        for (int32_t p = 0; p < tr.num_sites(); ++p)
+          for (int64_t a = ts.rowptr()[p]; a < ts.rowptr()[p + 1]; ++a)
+            for (int64_t b = tr.rowptr()[p]; b < tr.rowptr()[p + 1]; ++b)
+              for (int c = 0; c < nc; ++c) {
+                const int32_t J = ts.cols()[a];
+                if (!(s->mask & (1 << c)) || row_kind_[J * nc + c] != 0) continue;
+                at(J * nc + c, tr.cols()[b] * nc + c) +=
+                    penalty_ * s->w[p] * ts.values()[a] * tr.values()[b];
+              }
+      } else if (s->kind == 4) {
+        const Approximant &ts = *s->test, &tr = *s->trial;
+        for (int32_t p = 0; p < tr.num_sites(); ++p) {
+          const double w = s->w[p], *n = &s->normals[static_cast<size_t>(p) * dim];
+          for (int64_t a = ts.rowptr()[p]; a < ts.rowptr()[p + 1]; ++a) {
+            const int32_t J = ts.cols()[a];
+            const double psi = ts.values()[a];
+            double TJ[3][3];
+            traction_row(&ts.gradients()[a * dim], n, TJ);
+            for (int64_t b = tr.rowptr()[p]; b < tr.rowptr()[p + 1]; ++b) {
+              const int32_t K2 = tr.cols()[b];
+              const double phi = tr.values()[b];
+              double TK[3][3];
+              traction_row(&tr.gradients()[b * dim], n, TK);
+              for (int c = 0; c < nc; ++c) {
+                if (!(s->mask & (1 << c))) continue;
+                // consistency: -psi (sigma(u) n)_c in row (J, c)
+                if (row_kind_[J * nc + c] == 0)
+                  for (int e = 0; e < nc; ++e) at(J * nc + c, K2 * nc + e) += -w * psi * TK[c][e];
+                // symmetry: -(sigma(psi e_a) n)_c u_c in rows (J, a)
+                for (int aa = 0; aa < nc; ++aa)
+                  if (row_kind_[J * nc + aa] == 0) at(J * nc + aa, K2 * nc + c) += -w * TJ[c][aa] * phi;
+                // stabilisation
+                if (row_kind_[J * nc + c] == 0) at(J * nc + c, K2 * nc + c) += w * nitsche_ * psi * phi;
+              }
+            }
+          }
+        }
+      } else if (s->kind == 3) {
+        const Approximant &tr = *s->trial;
+        int32_t m = nbase + s->first_multiplier;
+        for (int32_t p = 0; p < tr.num_sites(); ++p)
+          for (int c = 0; c < nc; ++c) {
+            if (!(s->mask & (1 << c))) continue;
+            for (int64_t b = tr.rowptr()[p]; b < tr.rowptr()[p + 1]; ++b) {
+              const int32_t d = tr.cols()[b] * nc + c;
+              at(m, d) += tr.values()[b];
+              if (row_kind_[d] == 0) at(d, m) += tr.values()[b];
+            }
+            ++m;
+          }
+      }
+    }
+  }
+  // replaced rows at nodes
+  const Approximant *tn = collocation() ? trial_q_.get() : trial_nodes_.get();
+  for (int32_t dof = 0; dof < nbase; ++dof) {
+    if (row_kind_[dof] == 0) continue;
+    const int32_t J = dof / nc;
+    const int c = dof % nc;
+    const NodeSet &ns = nsets_[row_set_[dof]];
+    if (row_kind_[dof] == 1) {
+      for (int64_t b = tn->rowptr()[J]; b < tn->rowptr()[J + 1]; ++b)
+        at(dof, tn->cols()[b] * nc + c) += tn->values()[b];
+    } else {
+      const double *nrm = &ns.normals[static_cast<size_t>(row_node_[dof]) * dim];
+      const auto &G = trial_q_->gradients();
+      for (int64_t b = trial_q_->rowptr()[J]; b < trial_q_->rowptr()[J + 1]; ++b) {
+        const int32_t K2 = trial_q_->cols()[b];
+        if (!elasticity()) {
+          double s = 0.0;
+          for (int d = 0; d < dim; ++d) s += nrm[d] * G[b * dim + d];
+          at(dof, K2) += coef_ * s;
+          continue;
+        }
+        double B[6][3];
+        strain_rows(dim, &G[b * dim], B);
+        for (int e = 0; e < nc; ++e) {
+          double s = 0.0;  // (sigma n)_c = sum_d sigma_cd n_d, sigma = D B u
+          for (int d = 0; d < dim; ++d) {
+            const int vr = voigt(dim, c, d);
+            for (int t = 0; t < nv; ++t) s += nrm[d] * D[vr * dstride + t] * B[t][e];
+          }
+          at(dof, K2 * nc + e) += s;
+        }
+      }
+    }
+  }
+}
+
+void Assembler::assemble_rhs(double *f) const {
+  if (!setup_done_) throw Error(MFREE_ERR_STATE, "the assembler is not set up");
+  std::fill(f, f + ndofs_, 0.0);
+  const int nc = ncomp_, dim = dim_;
+  const int32_t nbase = ps_->size() * nc;
+  double val[3], x[3] = {0, 0, 0};
+  if (collocation()) {
+    if (body_)
+      for (int32_t J = 0; J < ps_->num_owned(); ++J) {
+        for (int d = 0; d < dim; ++d) x[d] = ps_->x(J, d);
+        body_(body_user_, x, val);
+        for (int c = 0; c < nc; ++c)
+          if (row_kind_[J * nc + c] == 0) f[J * nc + c] = val[c];
+      }
+  } else if (!mass()) {
+    if (body_ && load_q_) {
+      const Approximant &L = *load_q_;
+      for (int32_t q = 0; q < L.num_sites(); ++q) {
+        const double w = quad_kind_ == 0 ? ps_->volume(q) : qw_[q];
+        for (int d = 0; d < dim; ++d) x[d] = quad_kind_ == 0 ? ps_->x(q, d) : qx_[static_cast<size_t>(q) * dim + d];
+        body_(body_user_, x, val);
+        for (int64_t a = L.rowptr()[q]; a < L.rowptr()[q + 1]; ++a)
+          for (int c = 0; c < nc; ++c) f[L.cols()[a] * nc + c] += w * L.values()[a] * val[c];
+      }
+    }
+    for (auto &s : psets_) {
+      const int32_t np = static_cast<int32_t>(s->w.size());
+      int32_t m = nbase + s->first_multiplier;
+      for (int32_t p = 0; p < np; ++p) {
+        for (int d = 0; d < dim; ++d) x[d] = s->x[static_cast<size_t>(p) * dim + d];
+        s->fn(s->user, x, val);
+        if (s->kind == 4) {
+          const Approximant &ts = *s->test;
+          const double *n = &s->normals[static_cast<size_t>(p) * dim];
+          for (int64_t a = ts.rowptr()[p]; a < ts.rowptr()[p + 1]; ++a) {
+            const int32_t J = ts.cols()[a];
+            double TJ[3][3];
+            traction_row(&ts.gradients()[a * dim], n, TJ);
+            for (int c = 0; c < nc; ++c) {
+              if (!(s->mask & (1 << c))) continue;
+              for (int aa = 0; aa < nc; ++aa) f[J * nc + aa] += -s->w[p] * TJ[c][aa] * val[c];
+              f[J * nc + c] += s->w[p] * nitsche_ * ts.values()[a] * val[c];
+            }
+          }
+        } else if (s->kind == 1 || s->kind == 2) {
+          const Approximant &ts = *s->test;
+          const double fac = s->kind == 1 ? s->w[p] : penalty_ * s->w[p];
+          for (int64_t a = ts.rowptr()[p]; a < ts.rowptr()[p + 1]; ++a)
+            for (int c = 0; c < nc; ++c) {
+              if (s->kind == 2 && !(s->mask & (1 << c))) continue;
+              f[ts.cols()[a] * nc + c] += fac * ts.values()[a] * val[c];
+            }
+        } else {
+          for (int c = 0; c < nc; ++c)
+            if (s->mask & (1 << c)) f[m++] = val[c];
+        }
+      }
+    }
+  }
+  // replaced rows
+  for (int32_t dof = 0; dof < nbase; ++dof) {
+    if (row_kind_[dof] == 0) continue;
+    const int32_t J = dof / nc;
+    const int c = dof % nc;
+    const NodeSet &ns = nsets_[row_set_[dof]];
+    for (int d = 0; d < dim; ++d) x[d] = ps_->x(J, d);
+    ns.fn(ns.user, x, val);
+    f[dof] = val[c];
+  }
+  // rows replaced in the form part were zeroed in the matrix; their loads must be too
+}
+
+}  // namespace mfree

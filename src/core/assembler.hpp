@@ -1,0 +1,108 @@
+// Galerkin (Bubnov and Petrov) and collocation assembly of sparse systems.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "approximant.hpp"
+#include "error.hpp"
+#include "matrix.hpp"
+#include "mfree.h"
+#include "particles.hpp"
+
+namespace mfree {
+
+class Assembler {
+ public:
+  Assembler(const ParticleSet *ps, const ApproxConfig &trial, const ApproxConfig &test, bool bubnov,
+            int form);
+
+  void set_material(double young, double poisson);
+  void set_coefficient(double c);
+  void set_quadrature_nodal();
+  void set_quadrature_cells(const double *lo, const double *hi, const int32_t *ncells, int ngauss,
+                            mfree_inside_fn inside, void *user);
+  void set_quadrature_points(int32_t npts, const double *x, int layout, int64_t ld, const double *w);
+  void set_body_force(mfree_field_fn f, void *user);
+  void add_traction(int32_t npts, const double *x, int layout, int64_t ld, const double *w,
+                    mfree_field_fn t, void *user);
+  void add_traction_segments(int32_t nseg, const double *x, int ngauss, mfree_field_fn t, void *user);
+  void add_dirichlet(int method, int32_t npts, const double *x, int layout, int64_t ld,
+                     const double *w, const double *normals, int32_t mask, mfree_field_fn g,
+                     void *user);
+  void add_dirichlet_nodes(int32_t n, const int32_t *nodes, int32_t mask, mfree_field_fn g, void *user);
+  void add_traction_nodes(int32_t n, const int32_t *nodes, const double *normals, mfree_field_fn t,
+                          void *user);
+  void set_penalty(double alpha);
+
+  Report setup();
+  Report update();
+  bool is_setup() const { return setup_done_; }
+  int32_t ndofs() const { return ndofs_; }
+  int32_t nquad() const { return static_cast<int32_t>(qw_.size()); }
+
+  // Fill K (reusing its pattern when unchanged).
+  void assemble_matrix(SparseMatrix &K) const;
+  void assemble_rhs(double *f) const;
+
+ private:
+  struct PointSet {  // boundary points with weights
+    int kind = 0;    // 1 traction, 2 penalty, 3 Lagrange, 4 Nitsche
+    std::vector<double> x, w, normals;
+    int32_t mask = 0;
+    mfree_field_fn fn = nullptr;
+    void *user = nullptr;
+    std::unique_ptr<Approximant> test, trial;  // values at the points
+    int32_t first_multiplier = 0;
+  };
+  struct NodeSet {
+    int kind = 0;  // 1 Dirichlet rows, 2 traction rows
+    std::vector<int32_t> nodes;
+    std::vector<double> normals;
+    int32_t mask = 0;
+    mfree_field_fn fn = nullptr;
+    void *user = nullptr;
+  };
+
+  bool collocation() const { return form_ >= MFREE_FORM_COLLOCATION_LAPLACE; }
+  bool elasticity() const;
+  bool mass() const { return form_ == MFREE_FORM_MASS || form_ == MFREE_FORM_MASS_LUMPED; }
+  std::unique_ptr<Approximant> make(const ApproxConfig &cfg, const std::vector<double> *pts) const;
+  ApproxConfig values_config(const ApproxConfig &c) const;
+  void check_points(int32_t npts, const double *x, const double *w, const char *what) const;
+  void read_points(int32_t npts, const double *x, int layout, int64_t ld, std::vector<double> &out) const;
+  Report build_tables();
+  void build_pattern();
+  void material_matrix(double *D, int &nv) const;
+  // Traction operator: (sigma(u) n)_c = sum_e T[c][e] u_e for the field u = phi e_e with
+  // gradient g (elasticity), or c n.g (Laplace, T[0][0]).
+  void traction_row(const double *g, const double *n, double T[3][3]) const;
+  double mean_h() const;
+
+  const ParticleSet *ps_;
+  ApproxConfig trial_cfg_, test_cfg_;
+  bool bubnov_;
+  int form_;
+  int dim_, ncomp_;
+  double young_ = 1.0, poisson_ = 0.0, coef_ = 1.0, penalty_ = 0.0, nitsche_ = 0.0;
+  bool penalty_set_ = false;
+
+  int quad_kind_ = 0;  // 0 nodal, 1 cells or points (qx_/qw_)
+  std::vector<double> qx_, qw_;
+  mfree_field_fn body_ = nullptr;
+  void *body_user_ = nullptr;
+  std::vector<std::unique_ptr<PointSet>> psets_;
+  std::vector<NodeSet> nsets_;
+
+  bool setup_done_ = false;
+  int32_t ndofs_ = 0, nmult_ = 0;
+  std::unique_ptr<Approximant> trial_q_, test_q_, load_q_, trial_nodes_;
+  // dof pattern
+  std::vector<int64_t> rowptr_;
+  std::vector<int32_t> cols_;
+  std::vector<int32_t> row_kind_;  // per dof: 0 form, 1 Dirichlet row, 2 traction row
+  std::vector<int32_t> row_set_, row_node_;  // which node set / position replaces the row
+};
+
+}  // namespace mfree
