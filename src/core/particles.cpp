@@ -1,5 +1,6 @@
 #include "particles.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -185,6 +186,7 @@ void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int3
     host_cols_ = cols;
   }
   host_base_ = base;
+  host_rows_ = rows;
   setup_done_ = false;
 }
 
@@ -231,23 +233,41 @@ Report ParticleSet::setup() {
   if (!pos_.set()) throw Error(MFREE_ERR_STATE, "positions are not set");
   if (!host_neighbors() && !h_.set())
     throw Error(MFREE_ERR_STATE, "support sizes are not set (needed by the neighbour search)");
-  if (host_neighbors()) check_host_csr(host_rowptr_, host_cols_, host_base_);
+  if (host_neighbors()) {
+    // The host's rowptr has the owned count of set_neighbors time; a later
+    // set_num_ghost would make us read past it.
+    if (host_rows_ != num_owned())
+      throw Error(MFREE_ERR_MISMATCH, "the host neighbour lists have " + std::to_string(host_rows_) +
+                                          " rows but the set now has " + std::to_string(num_owned()) +
+                                          " owned particles (set_num_ghost after set_neighbors)");
+    check_host_csr(host_rowptr_, host_cols_, host_base_);
+  }
+  // A negative failure (periodic box too small, no memory) changes nothing: the old
+  // statuses go back with the old lists.
+  std::vector<int32_t> before = site_status_;
   Report rep = validate();
   Csr out;
-  if (host_neighbors()) {
-    const int32_t rows = num_owned();
-    out.rowptr.assign(static_cast<size_t>(rows) + 1, 0);
-    out.cols.reserve(static_cast<size_t>(host_rowptr_[rows] - host_base_));
-    for (int32_t i = 0; i < rows; ++i) {
-      if (site_status_[i] == 0)
-        for (int64_t k = host_rowptr_[i] - host_base_; k < host_rowptr_[i + 1] - host_base_; ++k) {
-          const int32_t j = host_cols_[k] - host_base_;
-          if (site_status_[j] == 0) out.cols.push_back(j);
-        }
-      out.rowptr[i + 1] = static_cast<int64_t>(out.cols.size());
+  try {
+    if (host_neighbors()) {
+      const int32_t rows = num_owned();
+      out.rowptr.assign(static_cast<size_t>(rows) + 1, 0);
+      out.cols.reserve(static_cast<size_t>(host_rowptr_[rows] - host_base_));
+      for (int32_t i = 0; i < rows; ++i) {
+        if (site_status_[i] == 0)
+          for (int64_t k = host_rowptr_[i] - host_base_; k < host_rowptr_[i + 1] - host_base_; ++k) {
+            const int32_t j = host_cols_[k] - host_base_;
+            if (site_status_[j] == 0) out.cols.push_back(j);
+          }
+        // get_neighbors promises sorted rows; host rows need not be.
+        std::sort(out.cols.begin() + out.rowptr[i], out.cols.end());
+        out.rowptr[i + 1] = static_cast<int64_t>(out.cols.size());
+      }
+    } else {
+      find_neighbors(*this, site_status_, out);
     }
-  } else {
-    find_neighbors(*this, site_status_, out);
+  } catch (...) {
+    site_status_.swap(before);
+    throw;
   }
   nbr_ = std::move(out);
   setup_done_ = true;

@@ -110,6 +110,7 @@ class ParticleSet {
   const int64_t *host_rowptr_ = nullptr;
   const int32_t *host_cols_ = nullptr;
   int32_t host_base_ = 0;
+  int32_t host_rows_ = 0;  // owned count when the host lists were set
   std::vector<int64_t> host_rowptr_own_;
   std::vector<int32_t> host_cols_own_;
 
