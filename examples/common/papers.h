@@ -37,9 +37,10 @@ double papers_rate(int nn, const int *N, const double *e);
 /* Print ctx's last error for a failed call, prefixed with what; returns 1. */
 int papers_report(mfree_context_t *ctx, mfree_status_t st, const char *what);
 
-/* Options every example understands: --json, --help. Returns 0 on success, 2 on a bad
- * option (after printing usage to stderr). Unknown options are left to the caller when
- * extra is non-NULL: extra(argv, &i) returns 1 if it consumed argv[i] (and maybe more). */
+/* Options every example understands: --json, --help (prints usage, exits 0). Returns 0
+ * on success, 2 on a bad option (after printing usage to stderr). Other options go to
+ * extra when it is non-NULL: extra(argc, argv, &i, user) returns 1 if it consumed
+ * argv[i] (advancing i past any value it took), 0 if the option is unknown or invalid. */
 typedef int (*papers_opt_t)(int argc, char **argv, int *i, void *user);
 int papers_parse(int argc, char **argv, const char *usage, int *json, papers_opt_t extra,
                  void *user);
