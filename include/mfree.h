@@ -693,6 +693,23 @@ MFREE_API mfree_status_t mfree_assembler_add_traction_nodes(mfree_assembler_t *a
                                                             const int32_t *nodes,
                                                             const double *normals,
                                                             mfree_field_fn t, void *user);
+/**
+ * The finite-element blending layer of paper 000 (eqs 100-105): a single layer of
+ * elements (2D: 3-node triangles or 4-node quadrilaterals, counter-clockwise, particle
+ * indices, copied) along the essential boundary; gu lists the layer nodes on that
+ * boundary (the others form the interface to the meshfree region). Inside the layer the
+ * functions become (1 - r) N_I + r Phi_I with r = 3R^2 - 2R^3, R = sum of the FE
+ * functions of the interface nodes; at nodal quadrature points on the boundary the FE
+ * functions are used, the node's volume split among its elements. The boundary nodes
+ * are interpolating there, so u_c = g_c (components in component_mask) is imposed
+ * directly on their unknowns.
+ */
+MFREE_API mfree_status_t mfree_assembler_set_fe_layer(mfree_assembler_t *as, int32_t nelem,
+                                                      int32_t nodes_per_element,
+                                                      const int32_t *connectivity,
+                                                      int32_t ngu, const int32_t *gu,
+                                                      int32_t component_mask,
+                                                      mfree_field_fn g, void *user);
 /** Penalty factor alpha (default 1e6 times the modulus E or coefficient c), which is
  * also Nitsche's beta when set (default 100 modulus / mean h). */
 MFREE_API mfree_status_t mfree_assembler_set_penalty(mfree_assembler_t *as, double alpha);

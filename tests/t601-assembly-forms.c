@@ -274,6 +274,103 @@ static void test_efg_patch_nitsche(void **s) {
   mfree_particles_destroy(&ps);
 }
 
+
+static void lin_scalar(void *u, const double *x, double *v) {
+  (void)u;
+  v[0] = 1.0 + 2.0 * x[0] + 3.0 * x[1];
+}
+
+/* The finite-element blending layer of paper 000 eqs 100-105 (one column of bilinear
+ * elements along x = 0, u imposed on its boundary nodes): blended functions keep linear
+ * completeness, so a Laplace patch test with EFG quadrature converges as the quadrature
+ * order rises, and the boundary nodes carry the prescribed values exactly. Nitsche on
+ * the other three edges. Regular lattice (the layer is a structured column). */
+static void test_fe_layer_patch(void **s) {
+  (void)s;
+  static double xl[2 * N];
+  for (int j = 0; j < M; ++j)
+    for (int i = 0; i < M; ++i) {
+      xl[2 * (j * M + i)] = (double)i / (M - 1);
+      xl[2 * (j * M + i) + 1] = (double)j / (M - 1);
+    }
+  const double h = 1.6 / (M - 1), v = 1.0 / ((M - 1) * (M - 1));
+  mfree_particles_t *ps = NULL;
+  assert_ok(ctx, mfree_particles_create(ctx, 2, N, &ps));
+  assert_ok(ctx, mfree_particles_set_positions(ps, xl, MFREE_LAYOUT_AOS, 2, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_support(ps, &h, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_volumes(ps, &v, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_setup(ps));
+  int32_t conn[4 * (M - 1)], gu[M];
+  for (int j = 0; j < M - 1; ++j) {
+    conn[4 * j] = j * M;
+    conn[4 * j + 1] = j * M + 1;
+    conn[4 * j + 2] = (j + 1) * M + 1;
+    conn[4 * j + 3] = (j + 1) * M;
+  }
+  for (int j = 0; j < M; ++j) gu[j] = j * M;
+  static double bx[2 * 1024], bw[1024], bn[2 * 1024];
+  const int nb4 = boundary_points(bx, bw, bn), nb = 3 * nb4 / 4; /* edges y=0, x=1, y=1 */
+  const int orders[3] = {2, 3, 5};
+  double errs[3];
+  for (int t = 0; t < 3; ++t) {
+    mfree_approximant_t *a = NULL;
+    assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+    mfree_assembler_t *as = NULL;
+    assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_LAPLACE, &as));
+    const double lo[2] = {0, 0}, hi[2] = {1, 1};
+    const int32_t nc[2] = {M - 1, M - 1};
+    assert_ok(ctx, mfree_assembler_set_quadrature_cells(as, lo, hi, nc, orders[t], NULL, NULL));
+    assert_ok(ctx, mfree_assembler_set_fe_layer(as, M - 1, 4, conn, M, gu, 1, lin_scalar, NULL));
+    assert_ok(ctx, mfree_assembler_add_dirichlet(as, MFREE_BC_NITSCHE, nb, bx, MFREE_LAYOUT_AOS, 2, bw, bn, 1,
+                                                 lin_scalar, NULL));
+    assert_ok(ctx, mfree_assembler_setup(as));
+    mfree_matrix_t *K = NULL;
+    assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+    int32_t n = 0;
+    double *A = dense(K, &n);
+    double *f = calloc((size_t)n, sizeof(double));
+    assert_ok(ctx, mfree_assembler_assemble_rhs(as, f));
+    solve(n, A, f);
+    assert_ok(ctx, mfree_approximant_setup(a));
+    double uh[N];
+    assert_ok(ctx, mfree_approximant_apply(a, MFREE_OP_VALUE, 1, f, MFREE_LAYOUT_AOS, 1, uh, MFREE_LAYOUT_AOS, 1));
+    double err = 0.0;
+    for (int i = 0; i < N; ++i) {
+      double u;
+      lin_scalar(NULL, &xl[2 * i], &u);
+      if (i % M == 0) assert_true(fabs(f[i] - u) < 1e-12); /* imposed on the layer's boundary nodes */
+      else err = fmax(err, fabs(uh[i] - u));                /* meshfree nodes: u^h by MLS */
+    }
+    errs[t] = err;
+    free(A);
+    free(f);
+    mfree_matrix_destroy(&K);
+    mfree_assembler_destroy(&as);
+    mfree_approximant_destroy(&a);
+  }
+  assert_true(errs[1] < errs[0] && errs[2] < errs[1]);
+  assert_true(errs[2] < 1e-4);
+  /* bad layers */
+  mfree_approximant_t *a = NULL;
+  mfree_assembler_t *as = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_LAPLACE, &as));
+  int32_t bad[4] = {0, M, M + 1, 1}; /* clockwise: inverted */
+  assert_error(ctx, mfree_assembler_set_fe_layer(as, 1, 4, bad, 1, gu, 1, lin_scalar, NULL), MFREE_ERR_INPUT,
+               "inverted");
+  int32_t far[4] = {0, 1, M + 1, N + 5};
+  assert_error(ctx, mfree_assembler_set_fe_layer(as, 1, 4, far, 1, gu, 1, lin_scalar, NULL), MFREE_ERR_INPUT,
+               "not an owned particle");
+  const int32_t notlayer = N - 1;
+  assert_error(ctx, mfree_assembler_set_fe_layer(as, 1, 4, conn, 1, &notlayer, 1, lin_scalar, NULL),
+               MFREE_ERR_INPUT, "not a layer node");
+  assert_error(ctx, mfree_assembler_set_fe_layer(as, 1, 5, conn, 1, gu, 1, lin_scalar, NULL), MFREE_ERR_ARG,
+               "3 (triangle) or 4");
+  mfree_assembler_destroy(&as);
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
 static void g_zero(void *u, const double *x, double *v) {
   (void)u;
   (void)x;
@@ -371,6 +468,7 @@ int main(void) {
       cmocka_unit_test(test_collocation_exact),
       cmocka_unit_test(test_mass_sums),
       cmocka_unit_test(test_efg_patch_nitsche),
+      cmocka_unit_test(test_fe_layer_patch),
       cmocka_unit_test(test_bad_input),
   };
   return cmocka_run_group_tests(tests, setup, teardown);

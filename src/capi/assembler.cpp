@@ -123,6 +123,12 @@ mfree_status_t mfree_assembler_add_traction_nodes(mfree_assembler_t *as, int32_t
                                                   mfree_field_fn t, void *user) {
   MFREE_AS_SETTER("mfree_assembler_add_traction_nodes", a.add_traction_nodes(nnodes, nodes, normals, t, user));
 }
+mfree_status_t mfree_assembler_set_fe_layer(mfree_assembler_t *as, int32_t nelem, int32_t nodes_per_element,
+                                            const int32_t *connectivity, int32_t ngu, const int32_t *gu,
+                                            int32_t component_mask, mfree_field_fn g, void *user) {
+  MFREE_AS_SETTER("mfree_assembler_set_fe_layer",
+                  a.set_fe_layer(nelem, nodes_per_element, connectivity, ngu, gu, component_mask, g, user));
+}
 mfree_status_t mfree_assembler_set_penalty(mfree_assembler_t *as, double alpha) {
   MFREE_AS_SETTER("mfree_assembler_set_penalty", a.set_penalty(alpha));
 }

@@ -323,6 +323,260 @@ void Assembler::add_traction_nodes(int32_t n, const int32_t *nodes, const double
   setup_done_ = false;
 }
 
+void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, int32_t ngu, const int32_t *gu,
+                             int32_t mask, mfree_field_fn g, void *user) {
+  if (dim_ != 2) throw Error(MFREE_ERR_UNSUPPORTED, "the finite-element layer is implemented in 2D");
+  if (collocation() || mass()) throw Error(MFREE_ERR_UNSUPPORTED, "the finite-element layer is for Galerkin forms");
+  if (npe != 3 && npe != 4) throw Error(MFREE_ERR_ARG, "elements must have 3 (triangle) or 4 (quadrilateral) nodes");
+  if (nelem < 1 || ngu < 1) throw Error(MFREE_ERR_ARG, "the layer needs elements and essential-boundary nodes");
+  if (!conn || !gu) throw Error(MFREE_ERR_NULL, "connectivity or boundary nodes are NULL");
+  if (!g) throw Error(MFREE_ERR_NULL, "boundary value function is NULL");
+  if (mask <= 0 || mask >= (1 << ncomp_)) throw Error(MFREE_ERR_ARG, "component mask selects no valid component");
+  const int32_t n = ps_->num_owned();
+  FeLayer fe;
+  fe.npe = npe;
+  fe.conn.assign(conn, conn + static_cast<size_t>(nelem) * npe);
+  fe.on_gu.assign(ps_->size(), 0);
+  fe.in_layer.assign(ps_->size(), 0);
+  for (int32_t k = 0; k < nelem * npe; ++k) {
+    if (conn[k] < 0 || conn[k] >= n)
+      throw Error(MFREE_ERR_INPUT, "element " + std::to_string(k / npe) + " refers to particle " +
+                                       std::to_string(conn[k]) + ", not an owned particle");
+    fe.in_layer[conn[k]] = 1;
+  }
+  for (int32_t k = 0; k < ngu; ++k) {
+    if (gu[k] < 0 || gu[k] >= n || !fe.in_layer[gu[k]])
+      throw Error(MFREE_ERR_INPUT, "essential-boundary node " + std::to_string(gu[k]) + " is not a layer node");
+    fe.on_gu[gu[k]] = 1;
+  }
+  // orientation: positive Jacobian at every corner (counter-clockwise, not degenerate)
+  for (int32_t e = 0; e < nelem; ++e) {
+    const int32_t *c = &fe.conn[static_cast<size_t>(e) * npe];
+    double xmin[2] = {1e300, 1e300}, xmax[2] = {-1e300, -1e300};
+    for (int a = 0; a < npe; ++a) {
+      const int32_t i = c[a], j = c[(a + 1) % npe], k = c[(a + npe - 1) % npe];
+      const double ax = ps_->x(j, 0) - ps_->x(i, 0), ay = ps_->x(j, 1) - ps_->x(i, 1);
+      const double bx = ps_->x(k, 0) - ps_->x(i, 0), by = ps_->x(k, 1) - ps_->x(i, 1);
+      if (!(ax * by - ay * bx > 0.0))
+        throw Error(MFREE_ERR_INPUT, "layer element " + std::to_string(e) +
+                                         " is inverted or degenerate (nodes must run counter-clockwise)");
+      for (int d = 0; d < 2; ++d) {
+        xmin[d] = std::min(xmin[d], ps_->x(i, d));
+        xmax[d] = std::max(xmax[d], ps_->x(i, d));
+      }
+    }
+    for (int d = 0; d < 2; ++d) {
+      const double pad = 1e-10 * (xmax[d] - xmin[d] + 1.0);
+      fe.bmin.push_back(xmin[d] - pad);
+      fe.bmax.push_back(xmax[d] + pad);
+    }
+  }
+  fe_ = std::move(fe);
+  NodeSet ns;
+  ns.kind = 3;
+  ns.nodes.assign(gu, gu + ngu);
+  ns.mask = mask;
+  ns.fn = g;
+  ns.user = user;
+  nsets_.push_back(std::move(ns));
+  setup_done_ = false;
+}
+
+bool Assembler::fe_shape(int32_t e, const double *x, double *N, double *dN) const {
+  const int npe = fe_.npe;
+  const int32_t *c = &fe_.conn[static_cast<size_t>(e) * npe];
+  if (x[0] < fe_.bmin[2 * e] || x[0] > fe_.bmax[2 * e] || x[1] < fe_.bmin[2 * e + 1] || x[1] > fe_.bmax[2 * e + 1])
+    return false;
+  double X[4][2];
+  for (int a = 0; a < npe; ++a)
+    for (int d = 0; d < 2; ++d) X[a][d] = ps_->x(c[a], d);
+  const double tol = 1e-10;
+  if (npe == 3) {
+    const double j00 = X[1][0] - X[0][0], j01 = X[2][0] - X[0][0], j10 = X[1][1] - X[0][1], j11 = X[2][1] - X[0][1];
+    const double det = j00 * j11 - j01 * j10;
+    const double rx = x[0] - X[0][0], ry = x[1] - X[0][1];
+    const double l1 = (j11 * rx - j01 * ry) / det, l2 = (-j10 * rx + j00 * ry) / det;
+    if (l1 < -tol || l2 < -tol || l1 + l2 > 1.0 + tol) return false;
+    N[0] = 1.0 - l1 - l2;
+    N[1] = l1;
+    N[2] = l2;
+    // dl1/dx = (j11, -j01)/det, dl2/dx = (-j10, j00)/det
+    dN[2] = j11 / det;
+    dN[3] = -j01 / det;
+    dN[4] = -j10 / det;
+    dN[5] = j00 / det;
+    dN[0] = -dN[2] - dN[4];
+    dN[1] = -dN[3] - dN[5];
+    return true;
+  }
+  static const double xi[4] = {-1, 1, 1, -1}, eta[4] = {-1, -1, 1, 1};
+  double u = 0.0, v = 0.0, J[2][2] = {{0, 0}, {0, 0}};
+  for (int it = 0; it < 30; ++it) {
+    double f[2] = {-x[0], -x[1]};
+    J[0][0] = J[0][1] = J[1][0] = J[1][1] = 0.0;
+    for (int a = 0; a < 4; ++a) {
+      const double Na = 0.25 * (1 + xi[a] * u) * (1 + eta[a] * v);
+      const double du = 0.25 * xi[a] * (1 + eta[a] * v), dv = 0.25 * eta[a] * (1 + xi[a] * u);
+      for (int d = 0; d < 2; ++d) {
+        f[d] += Na * X[a][d];
+        J[d][0] += du * X[a][d];
+        J[d][1] += dv * X[a][d];
+      }
+    }
+    const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+    const double su = (J[1][1] * f[0] - J[0][1] * f[1]) / det, sv = (-J[1][0] * f[0] + J[0][0] * f[1]) / det;
+    u -= su;
+    v -= sv;
+    if (std::fabs(su) + std::fabs(sv) < 1e-15) break;
+  }
+  if (std::fabs(u) > 1.0 + tol || std::fabs(v) > 1.0 + tol) return false;
+  J[0][0] = J[0][1] = J[1][0] = J[1][1] = 0.0;
+  double dNu[4], dNv[4];
+  for (int a = 0; a < 4; ++a) {
+    N[a] = 0.25 * (1 + xi[a] * u) * (1 + eta[a] * v);
+    dNu[a] = 0.25 * xi[a] * (1 + eta[a] * v);
+    dNv[a] = 0.25 * eta[a] * (1 + xi[a] * u);
+    for (int d = 0; d < 2; ++d) {
+      J[d][0] += dNu[a] * X[a][d];
+      J[d][1] += dNv[a] * X[a][d];
+    }
+  }
+  const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+  for (int a = 0; a < 4; ++a) {  // grad N = J^-T (dN/du, dN/dv)
+    dN[2 * a] = (J[1][1] * dNu[a] - J[1][0] * dNv[a]) / det;
+    dN[2 * a + 1] = (-J[0][1] * dNu[a] + J[0][0] * dNv[a]) / det;
+  }
+  return true;
+}
+
+void Assembler::fill_qtable(const Approximant &a, QTable &t, const std::vector<double> *w) const {
+  const int dim = dim_;
+  const int32_t nq = a.num_sites();
+  t.w.resize(nq);
+  for (int32_t q = 0; q < nq; ++q) t.w[q] = w ? (*w)[q] : ps_->volume(q);
+  t.rowptr = a.rowptr();
+  t.cols = a.cols();
+  const size_t nnz = t.cols.size();
+  t.val = a.values().empty() ? std::vector<double>(nnz, 0.0) : a.values();
+  t.grad = a.gradients().empty() ? std::vector<double>(nnz * dim, 0.0) : a.gradients();
+}
+
+// Paper 000 eqs 100-105: in the layer, Phi0_I = (1 - r) N_I + r Phi_I with r = 3R^2 - 2R^3,
+// R = sum of the FE functions of the interface nodes; at nodal quadrature points on the
+// essential boundary the functions are the FE ones, the node's volume split among its
+// elements (the Figure 2 procedure).
+void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
+  const int npe = fe_.npe;
+  const int32_t nelem = static_cast<int32_t>(fe_.conn.size() / npe);
+  QTable out;
+  out.rowptr.assign(1, 0);
+  double N[4], dN[8];
+  std::vector<int32_t> cols;
+  std::vector<double> val, grad;
+  auto push = [&](double w) {
+    out.w.push_back(w);
+    out.cols.insert(out.cols.end(), cols.begin(), cols.end());
+    out.val.insert(out.val.end(), val.begin(), val.end());
+    out.grad.insert(out.grad.end(), grad.begin(), grad.end());
+    out.rowptr.push_back(static_cast<int64_t>(out.cols.size()));
+  };
+  for (int32_t q = 0; q < t.size(); ++q) {
+    const int64_t k0 = t.rowptr[q], k1 = t.rowptr[q + 1];
+    cols.assign(t.cols.begin() + k0, t.cols.begin() + k1);
+    val.assign(t.val.begin() + k0, t.val.begin() + k1);
+    grad.assign(t.grad.begin() + 2 * k0, t.grad.begin() + 2 * k1);
+    if (!pts) {
+      if (!fe_.on_gu[q]) {
+        push(t.w[q]);
+        continue;
+      }
+      std::vector<int32_t> elems;
+      for (int32_t e = 0; e < nelem; ++e)
+        for (int a = 0; a < npe; ++a)
+          if (fe_.conn[static_cast<size_t>(e) * npe + a] == q) elems.push_back(e);
+      const double x[2] = {ps_->x(q, 0), ps_->x(q, 1)};
+      for (int32_t e : elems) {
+        fe_shape(e, x, N, dN);
+        cols.clear();
+        val.clear();
+        grad.clear();
+        for (int a = 0; a < npe; ++a) {
+          cols.push_back(fe_.conn[static_cast<size_t>(e) * npe + a]);
+          val.push_back(N[a]);
+          grad.push_back(dN[2 * a]);
+          grad.push_back(dN[2 * a + 1]);
+        }
+        push(t.w[q] / static_cast<double>(elems.size()));
+      }
+      continue;
+    }
+    const double x[2] = {(*pts)[2 * static_cast<size_t>(q)], (*pts)[2 * static_cast<size_t>(q) + 1]};
+    int32_t e = 0;
+    for (; e < nelem; ++e)
+      if (fe_shape(e, x, N, dN)) break;
+    if (e == nelem) {
+      push(t.w[q]);
+      continue;
+    }
+    const int32_t *c = &fe_.conn[static_cast<size_t>(e) * npe];
+    double R = 0.0, gR[2] = {0, 0};
+    for (int a = 0; a < npe; ++a)
+      if (!fe_.on_gu[c[a]]) {
+        R += N[a];
+        gR[0] += dN[2 * a];
+        gR[1] += dN[2 * a + 1];
+      }
+    const double r = 3 * R * R - 2 * R * R * R, dr = 6 * R - 6 * R * R;
+    const double gr[2] = {dr * gR[0], dr * gR[1]};
+    for (size_t k = 0; k < cols.size(); ++k) {  // r Phi
+      const double phi = val[k];
+      for (int d = 0; d < 2; ++d) grad[2 * k + d] = gr[d] * phi + r * grad[2 * k + d];
+      val[k] = r * phi;
+    }
+    for (int a = 0; a < npe; ++a) {  // + (1 - r) N
+      size_t k = 0;
+      while (k < cols.size() && cols[k] != c[a]) ++k;
+      if (k == cols.size()) {
+        cols.push_back(c[a]);
+        val.push_back(0.0);
+        grad.push_back(0.0);
+        grad.push_back(0.0);
+      }
+      val[k] += (1 - r) * N[a];
+      for (int d = 0; d < 2; ++d) grad[2 * k + d] += -gr[d] * N[a] + (1 - r) * dN[2 * a + d];
+    }
+    push(t.w[q]);
+  }
+  t = std::move(out);
+}
+
+void Assembler::build_qtables() {
+  if (collocation()) return;
+  const bool nodal = quad_kind_ == 0;
+  fill_qtable(*trial_q_, qtrial_, nodal ? nullptr : &qw_);
+  if (test_q_) fill_qtable(*test_q_, qtest_, nodal ? nullptr : &qw_);
+  else qtest_ = QTable();
+  if (fe_.npe) {
+    blend_qtable(qtrial_, nodal ? nullptr : &qx_);
+    if (test_q_) blend_qtable(qtest_, nodal ? nullptr : &qx_);
+  }
+  // boundary point sets: the same blending, so that boundary terms inside the layer use
+  // the layer's functions
+  ps_test_.assign(psets_.size(), QTable());
+  ps_trial_.assign(psets_.size(), QTable());
+  for (size_t i = 0; i < psets_.size(); ++i) {
+    PointSet &s = *psets_[i];
+    if (s.test) {
+      fill_qtable(*s.test, ps_test_[i], &s.w);
+      if (fe_.npe) blend_qtable(ps_test_[i], &s.x);
+    }
+    if (s.trial) {
+      fill_qtable(*s.trial, ps_trial_[i], &s.w);
+      if (fe_.npe) blend_qtable(ps_trial_[i], &s.x);
+    }
+  }
+}
+
 double Assembler::mean_h() const {
   double s = 0.0;
   const int32_t n = ps_->size();
@@ -412,7 +666,7 @@ Report Assembler::build_tables() {
       merge(load_q_->setup(), "test values at the quadrature points");
     }
     trial_nodes_.reset();
-    if (!nsets_.empty()) {
+    if (std::any_of(nsets_.begin(), nsets_.end(), [](const NodeSet &n) { return n.kind != 3; })) {
       trial_nodes_ = make(values_config(trial_cfg_), nullptr);
       merge(trial_nodes_->setup(), "trial values at the particles");
     }
@@ -444,31 +698,39 @@ Report Assembler::build_tables() {
 void Assembler::build_pattern() {
   const int32_t n = ps_->size(), nc = ncomp_;
   std::vector<std::vector<int32_t>> rows(n);  // node-level columns per test node
-  auto add_pairs = [&](const Approximant &test, const Approximant &trial, int32_t site) {
-    const auto &tr = test.rowptr(), &kr = trial.rowptr();
-    for (int64_t a = tr[site]; a < tr[site + 1]; ++a) {
-      auto &row = rows[test.cols()[a]];
-      for (int64_t b = kr[site]; b < kr[site + 1]; ++b) row.push_back(trial.cols()[b]);
-    }
-  };
   const Approximant &trial = *trial_q_;
-  const Approximant &test = test_q_ ? *test_q_ : *trial_q_;
   if (form_ == MFREE_FORM_MASS_LUMPED) {
     for (int32_t i = 0; i < n; ++i) rows[i].push_back(i);
   } else if (collocation()) {
     for (int32_t s = 0; s < trial.num_sites(); ++s)
       for (int64_t b = trial.rowptr()[s]; b < trial.rowptr()[s + 1]; ++b) rows[s].push_back(trial.cols()[b]);
   } else {
-    for (int32_t q = 0; q < trial.num_sites(); ++q) add_pairs(test, trial, q);
-    for (auto &s : psets_)
-      if (s->kind == 2 || s->kind == 4)
-        for (int32_t p = 0; p < s->trial->num_sites(); ++p) add_pairs(*s->test, *s->trial, p);
+    const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
+    for (int32_t q = 0; q < qa.size(); ++q)
+      for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a) {
+        auto &row = rows[qb.cols[a]];
+        for (int64_t b = qa.rowptr[q]; b < qa.rowptr[q + 1]; ++b) row.push_back(qa.cols[b]);
+      }
+    for (size_t si = 0; si < psets_.size(); ++si)
+      if (psets_[si]->kind == 2 || psets_[si]->kind == 4) {
+        const QTable &ts = ps_test_[si], &tr = ps_trial_[si];
+        for (int32_t p = 0; p < tr.size(); ++p)
+          for (int64_t a = ts.rowptr[p]; a < ts.rowptr[p + 1]; ++a) {
+            auto &row = rows[ts.cols[a]];
+            for (int64_t b = tr.rowptr[p]; b < tr.rowptr[p + 1]; ++b) row.push_back(tr.cols[b]);
+          }
+      }
   }
   // Dirichlet/traction rows at nodes: the trial row at the node
   const Approximant *tn = collocation() ? trial_q_.get() : trial_nodes_.get();
   for (auto &ns : nsets_)
-    for (int32_t J : ns.nodes)
+    for (int32_t J : ns.nodes) {
+      if (ns.kind == 3) {
+        rows[J].push_back(J);
+        continue;
+      }
       for (int64_t b = tn->rowptr()[J]; b < tn->rowptr()[J + 1]; ++b) rows[J].push_back(tn->cols()[b]);
+    }
   for (auto &r : rows) {
     std::sort(r.begin(), r.end());
     r.erase(std::unique(r.begin(), r.end()), r.end());
@@ -476,10 +738,11 @@ void Assembler::build_pattern() {
   // multipliers: one per Lagrange point and constrained component
   nmult_ = 0;
   std::vector<std::vector<int32_t>> mcols;  // dof columns of each multiplier row
-  for (auto &s : psets_) {
+  for (size_t si = 0; si < psets_.size(); ++si) {
+    auto &s = psets_[si];
     if (s->kind != 3) continue;
     s->first_multiplier = nmult_;
-    const Approximant &a = *s->trial;
+    const QView a{ps_trial_[si]};
     for (int32_t p = 0; p < a.num_sites(); ++p)
       for (int c = 0; c < nc; ++c) {
         if (!(s->mask & (1 << c))) continue;
@@ -514,13 +777,14 @@ void Assembler::build_pattern() {
   row_kind_.assign(nbase, 0);
   row_set_.assign(nbase, -1);
   row_node_.assign(nbase, -1);
-  for (int pass = 2; pass >= 1; --pass)
+  const int passes[3] = {2, 1, 3};  // later passes win: identity > Dirichlet > traction rows
+  for (int pass : passes)
     for (size_t si = 0; si < nsets_.size(); ++si) {
       const NodeSet &ns = nsets_[si];
       if (ns.kind != pass) continue;
       for (size_t k = 0; k < ns.nodes.size(); ++k)
         for (int c = 0; c < nc; ++c) {
-          if (ns.kind == 1 && !(ns.mask & (1 << c))) continue;
+          if (ns.kind != 2 && !(ns.mask & (1 << c))) continue;
           const int32_t dof = ns.nodes[k] * nc + c;
           row_kind_[dof] = ns.kind;
           row_set_[dof] = static_cast<int32_t>(si);
@@ -535,6 +799,7 @@ Report Assembler::setup() {
   if (!penalty_set_) penalty_ = 1e6 * modulus;
   nitsche_ = penalty_set_ ? penalty_ : 100.0 * modulus / mean_h();
   Report rep = build_tables();
+  build_qtables();
   build_pattern();
   // diagnostics: quadrature points outside every support; particles no point sees
   const Approximant &trial = *trial_q_;
@@ -570,6 +835,7 @@ Report Assembler::update() {
     upd(s->test.get());
     upd(s->trial.get());
   }
+  build_qtables();
   return rep;
 }
 
@@ -587,7 +853,6 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
     return v[k];
   };
   const Approximant &trial = *trial_q_;
-  const Approximant &test = test_q_ ? *test_q_ : *trial_q_;
   double D[36];
   int nv = 0;
   if (elasticity()) material_matrix(D, nv);
@@ -617,12 +882,13 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
         }
       }
   } else if (form_ == MFREE_FORM_MASS || form_ == MFREE_FORM_MASS_LUMPED) {
-    const auto &Pv = trial.values(), &Tv = test.values();
-    for (int32_t q = 0; q < trial.num_sites(); ++q) {
-      const double w = quad_kind_ == 0 ? ps_->volume(q) : qw_[q];
-      for (int64_t a = test.rowptr()[q]; a < test.rowptr()[q + 1]; ++a)
-        for (int64_t b = trial.rowptr()[q]; b < trial.rowptr()[q + 1]; ++b) {
-          const int32_t J = test.cols()[a], K2 = trial.cols()[b];
+    const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
+    const auto &Pv = qa.val, &Tv = qb.val;
+    for (int32_t q = 0; q < qa.size(); ++q) {
+      const double w = qa.w[q];
+      for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a)
+        for (int64_t b = qa.rowptr[q]; b < qa.rowptr[q + 1]; ++b) {
+          const int32_t J = qb.cols[a], K2 = qa.cols[b];
           if (row_kind_[J] != 0) continue;
           const double m = w * coef_ * Tv[a] * Pv[b];
           if (form_ == MFREE_FORM_MASS) at(J, K2) += m;
@@ -630,18 +896,19 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
         }
     }
   } else {
-    const auto &Pg = trial.gradients(), &Tg = test.gradients();
+    const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
+    const auto &Pg = qa.grad, &Tg = qb.grad;
     std::vector<double> DB;  // per trial neighbour: nv x nc
-    for (int32_t q = 0; q < trial.num_sites(); ++q) {
-      const double w = quad_kind_ == 0 ? ps_->volume(q) : qw_[q];
-      const int64_t b0 = trial.rowptr()[q], b1 = trial.rowptr()[q + 1];
+    for (int32_t q = 0; q < qa.size(); ++q) {
+      const double w = qa.w[q];
+      const int64_t b0 = qa.rowptr[q], b1 = qa.rowptr[q + 1];
       if (form_ == MFREE_FORM_LAPLACE) {
-        for (int64_t a = test.rowptr()[q]; a < test.rowptr()[q + 1]; ++a)
+        for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a)
           for (int64_t b = b0; b < b1; ++b) {
             double dot = 0.0;
             for (int d = 0; d < dim; ++d) dot += Tg[a * dim + d] * Pg[b * dim + d];
-            const int32_t J = test.cols()[a];
-            if (row_kind_[J] == 0) at(J, trial.cols()[b]) += w * coef_ * dot;
+            const int32_t J = qb.cols[a];
+            if (row_kind_[J] == 0) at(J, qa.cols[b]) += w * coef_ * dot;
           }
         continue;
       }
@@ -657,13 +924,13 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
             db[u * nc + e] = s;
           }
       }
-      for (int64_t a = test.rowptr()[q]; a < test.rowptr()[q + 1]; ++a) {
+      for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a) {
         double BJ[6][3];
         strain_rows(dim, &Tg[a * dim], BJ);
-        const int32_t J = test.cols()[a];
+        const int32_t J = qb.cols[a];
         for (int64_t b = b0; b < b1; ++b) {
           const double *db = &DB[static_cast<size_t>(b - b0) * nv * nc];
-          const int32_t K2 = trial.cols()[b];
+          const int32_t K2 = qa.cols[b];
           for (int c = 0; c < nc; ++c) {
             if (row_kind_[J * nc + c] != 0) continue;
             for (int e = 0; e < nc; ++e) {
@@ -675,10 +942,11 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
         }
       }
     }
-    // penalty and Lagrange terms
-    for (auto &s : psets_) {
+    // penalty, Nitsche and Lagrange terms
+    for (size_t si = 0; si < psets_.size(); ++si) {
+      auto &s = psets_[si];
+      const QView ts{ps_test_[si]}, tr{ps_trial_[si]};
       if (s->kind == 2) {
-        const Approximant &ts = *s->test, &tr = *s->trial;
         for (int32_t p = 0; p < tr.num_sites(); ++p)
           for (int64_t a = ts.rowptr()[p]; a < ts.rowptr()[p + 1]; ++a)
             for (int64_t b = tr.rowptr()[p]; b < tr.rowptr()[p + 1]; ++b)
@@ -689,7 +957,6 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
                     penalty_ * s->w[p] * ts.values()[a] * tr.values()[b];
               }
       } else if (s->kind == 4) {
-        const Approximant &ts = *s->test, &tr = *s->trial;
         for (int32_t p = 0; p < tr.num_sites(); ++p) {
           const double w = s->w[p], *n = &s->normals[static_cast<size_t>(p) * dim];
           for (int64_t a = ts.rowptr()[p]; a < ts.rowptr()[p + 1]; ++a) {
@@ -717,7 +984,6 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
           }
         }
       } else if (s->kind == 3) {
-        const Approximant &tr = *s->trial;
         int32_t m = nbase + s->first_multiplier;
         for (int32_t p = 0; p < tr.num_sites(); ++p)
           for (int c = 0; c < nc; ++c) {
@@ -739,7 +1005,9 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
     const int32_t J = dof / nc;
     const int c = dof % nc;
     const NodeSet &ns = nsets_[row_set_[dof]];
-    if (row_kind_[dof] == 1) {
+    if (row_kind_[dof] == 3) {
+      at(dof, dof) += 1.0;
+    } else if (row_kind_[dof] == 1) {
       for (int64_t b = tn->rowptr()[J]; b < tn->rowptr()[J + 1]; ++b)
         at(dof, tn->cols()[b] * nc + c) += tn->values()[b];
     } else {
@@ -793,14 +1061,15 @@ void Assembler::assemble_rhs(double *f) const {
           for (int c = 0; c < nc; ++c) f[L.cols()[a] * nc + c] += w * L.values()[a] * val[c];
       }
     }
-    for (auto &s : psets_) {
+    for (size_t si = 0; si < psets_.size(); ++si) {
+      auto &s = psets_[si];
+      const QView ts{ps_test_[si]};
       const int32_t np = static_cast<int32_t>(s->w.size());
       int32_t m = nbase + s->first_multiplier;
       for (int32_t p = 0; p < np; ++p) {
         for (int d = 0; d < dim; ++d) x[d] = s->x[static_cast<size_t>(p) * dim + d];
         s->fn(s->user, x, val);
         if (s->kind == 4) {
-          const Approximant &ts = *s->test;
           const double *n = &s->normals[static_cast<size_t>(p) * dim];
           for (int64_t a = ts.rowptr()[p]; a < ts.rowptr()[p + 1]; ++a) {
             const int32_t J = ts.cols()[a];
@@ -813,7 +1082,6 @@ void Assembler::assemble_rhs(double *f) const {
             }
           }
         } else if (s->kind == 1 || s->kind == 2) {
-          const Approximant &ts = *s->test;
           const double fac = s->kind == 1 ? s->w[p] : penalty_ * s->w[p];
           for (int64_t a = ts.rowptr()[p]; a < ts.rowptr()[p + 1]; ++a)
             for (int c = 0; c < nc; ++c) {

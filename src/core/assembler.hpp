@@ -35,6 +35,8 @@ class Assembler {
   void add_traction_nodes(int32_t n, const int32_t *nodes, const double *normals, mfree_field_fn t,
                           void *user);
   void set_penalty(double alpha);
+  void set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, int32_t ngu, const int32_t *gu,
+                    int32_t mask, mfree_field_fn g, void *user);
 
   Report setup();
   Report update();
@@ -56,14 +58,48 @@ class Assembler {
     std::unique_ptr<Approximant> test, trial;  // values at the points
     int32_t first_multiplier = 0;
   };
+  struct BlendedSet;  // per point set: blended test/trial tables (defined below)
   struct NodeSet {
-    int kind = 0;  // 1 Dirichlet rows, 2 traction rows
+    int kind = 0;  // 1 Dirichlet rows, 2 traction rows, 3 identity rows (FE layer nodes)
     std::vector<int32_t> nodes;
     std::vector<double> normals;
     int32_t mask = 0;
     mfree_field_fn fn = nullptr;
     void *user = nullptr;
   };
+
+  // Test or trial functions at the quadrature points (after the FE-layer blending):
+  // weight per point, CSR rows of particles with values and gradients.
+  struct QTable {
+    std::vector<double> w;
+    std::vector<int64_t> rowptr{0};
+    std::vector<int32_t> cols;
+    std::vector<double> val, grad;
+    int32_t size() const { return static_cast<int32_t>(w.size()); }
+  };
+  // Read-only view with the accessor names of Approximant, so loops read alike.
+  struct QView {
+    const QTable &t;
+    const std::vector<int64_t> &rowptr() const { return t.rowptr; }
+    const std::vector<int32_t> &cols() const { return t.cols; }
+    const std::vector<double> &values() const { return t.val; }
+    const std::vector<double> &gradients() const { return t.grad; }
+    int32_t num_sites() const { return t.size(); }
+  };
+  struct FeLayer {
+    int npe = 0;                  // 3 (triangles) or 4 (quadrilaterals); 0: none
+    std::vector<int32_t> conn;    // nelem * npe particle indices
+    std::vector<char> on_gu;      // per particle: node on the essential boundary
+    std::vector<char> in_layer;   // per particle: node of some layer element
+    std::vector<double> bmin, bmax;  // element bounding boxes
+  };
+  void build_qtables();
+  // Copy an approximant's rows; weights w (NULL: the particle volumes).
+  void fill_qtable(const Approximant &a, QTable &t, const std::vector<double> *w) const;
+  // Blend rows at points pts (NULL: the particles, nodal quadrature) with the FE layer.
+  void blend_qtable(QTable &t, const std::vector<double> *pts) const;
+  // FE shape functions of layer element e at x (N[npe], dN[npe*2]); false if x is outside.
+  bool fe_shape(int32_t e, const double *x, double *N, double *dN) const;
 
   bool collocation() const { return form_ >= MFREE_FORM_COLLOCATION_LAPLACE; }
   bool elasticity() const;
@@ -103,6 +139,9 @@ class Assembler {
   std::vector<int32_t> cols_;
   std::vector<int32_t> row_kind_;  // per dof: 0 form, 1 Dirichlet row, 2 traction row
   std::vector<int32_t> row_set_, row_node_;  // which node set / position replaces the row
+  FeLayer fe_;
+  QTable qtrial_, qtest_;
+  std::vector<QTable> ps_test_, ps_trial_;  // per point set (same order as psets_)
 };
 
 }  // namespace mfree
