@@ -230,7 +230,8 @@ static void test_refcount(void **s) {
   assert_ok(NULL, mfree_context_create(&c2));
   mfree_particles_t *ps = NULL;
   const double h = 1.5 / M, v = 1.0 / N;
-  lattice(); /* fills X */
+  mfree_particles_t *filler = lattice(); /* fills X */
+  mfree_particles_destroy(&filler);
   assert_ok(c2, mfree_particles_create(c2, 2, N, &ps));
   assert_ok(c2, mfree_particles_set_positions(ps, X, MFREE_LAYOUT_AOS, 2, MFREE_COPY));
   assert_ok(c2, mfree_particles_set_support(ps, &h, 0, MFREE_COPY));
