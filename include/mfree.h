@@ -94,7 +94,9 @@ typedef MFREE_ENUM(mfree_layout) {
                              (Fortran x(n,3)) */
 } mfree_layout_t;
 
-/** Neighbour criterion for particles i, j at distance r with supports h_i, h_j. */
+/** Neighbour criterion for particles i, j at distance r with supports h_i, h_j.
+ * Supports are closed: a pair within a relative 1e-13 of the limit counts (paper 001's
+ * d <= 2), so pairs exactly on the edge are treated alike whatever their round-off. */
 typedef MFREE_ENUM(mfree_search) {
   MFREE_SEARCH_GATHER = 1,         /**< r < kappa*h_i (row i uses its own support) */
   MFREE_SEARCH_SYMMETRIC_MAX = 2,  /**< r < kappa*max(h_i, h_j) */
@@ -290,7 +292,8 @@ MFREE_API mfree_status_t mfree_kernel_eval(mfree_context_t *ctx, mfree_kernel_t 
                                            const double *r, double *w, double *dwdr,
                                            double *d2wdr2);
 
-/** Support radius R in units of h: W(r, h) = 0 for r >= R h. */
+/** Support radius R in units of h: W(r, h) = 0 for r > R h. The support is closed: at
+ * r = R h (up to a relative 1e-13) W and its derivatives take their values from inside. */
 MFREE_API mfree_status_t mfree_kernel_get_support_radius(mfree_context_t *ctx,
                                                          mfree_kernel_t kernel,
                                                          double param, double *radius);

@@ -79,21 +79,36 @@ static void test_integral_is_one(void **s) {
       }
 }
 
-/* W = dW = d2W = 0 at and beyond the support radius; nonzero just inside. */
+/* W = dW = d2W = 0 beyond the support radius, nonzero just inside; the support is
+ * closed: at r = R h (and within a relative 1e-13 of it, whatever the round-off) the
+ * values are the limits from inside, so W(R) = 0 for every kernel but the truncated
+ * Gaussians, and the revised Gauss keeps its one-sided slope there (001 eq 6.8). */
 static void test_compact_support(void **s) {
   (void)s;
   for (int ki = 0; ki < NKERNELS; ++ki)
     for (int dim = 1; dim <= 3; ++dim) {
-      const double h = 0.8, R = radius_of(kAll[ki]) * h;
-      const double r[4] = {R, R * 1.0000001, 1.5 * R, 10 * R};
-      double w[4], dw[4], d2w[4];
-      assert_ok(ctx, mfree_kernel_eval(ctx, kAll[ki], dim, 0.0, h, 4, r, w, dw, d2w));
-      for (int i = 0; i < 4; ++i) {
+      const mfree_kernel_t k = kAll[ki];
+      const double h = 0.8, R = radius_of(k) * h;
+      const double out[3] = {R * 1.0000001, 1.5 * R, 10 * R};
+      double w[3], dw[3], d2w[3];
+      assert_ok(ctx, mfree_kernel_eval(ctx, k, dim, 0.0, h, 3, out, w, dw, d2w));
+      for (int i = 0; i < 3; ++i) {
         assert_true(w[i] == 0.0);
         assert_true(dw[i] == 0.0);
         assert_true(d2w[i] == 0.0);
       }
-      assert_true(W(kAll[ki], dim, 0.0, h, 0.99 * R) != 0.0);
+      assert_true(W(k, dim, 0.0, h, 0.99 * R) != 0.0);
+      const int truncated = k == MFREE_KERNEL_GAUSSIAN || k == MFREE_KERNEL_SUPER_GAUSS;
+      const double edge[3] = {R, R * (1 + 5e-14), R * (1 - 5e-14)};
+      for (int e = 0; e < 3; ++e) {
+        const double we = W(k, dim, 0.0, h, edge[e]), de = dW(k, dim, 0.0, h, edge[e]);
+        if (!truncated) assert_true(fabs(we) < 1e-12 * W(k, dim, 0.0, h, 0.0));
+        else assert_true(we != 0.0);
+        /* the one-sided slope at the edge equals the slope just inside */
+        const double inside = dW(k, dim, 0.0, h, R * (1 - 1e-9));
+        assert_true(fabs(de - inside) <= 1e-6 * fabs(dW(k, dim, 0.0, h, 0.5 * R)) + 1e-300);
+      }
+      if (k == MFREE_KERNEL_REVISED_GAUSS) assert_true(dW(k, dim, 0.0, h, R) < 0.0);
     }
 }
 

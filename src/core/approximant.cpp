@@ -264,7 +264,7 @@ void Approximant::build_pattern() {
       site_displacement(s, j, d);
       for (int c = 0; c < dim; ++c) r2 += d[c] * d[c];
       const double rad = R * pair_h(s, j);
-      if (r2 < rad * rad) cols_.push_back(j);
+      if (r2 <= rad * rad * (1.0 + kEdgeTol2)) cols_.push_back(j);
     }
     if (me >= 0 && self_[s] < 0) {  // host lists may omit the particle itself
       self_[s] = static_cast<int32_t>(cols_.size() - rowptr_[s]);

@@ -80,7 +80,8 @@ double Kernel::shape(double q) const {
 
 void Kernel::shape(double q, double &f, double &df, double &d2f) const {
   f = df = d2f = 0.0;
-  if (q >= radius_) return;
+  if (q > radius_ * (1.0 + kEdgeTol)) return;
+  if (q > radius_) q = radius_;  // on the edge: the value from inside (closed support)
   switch (id_) {
     case MFREE_KERNEL_CUBIC_SPLINE:
       if (q < 1.0) {

@@ -7,6 +7,14 @@
 
 namespace mfree {
 
+// Supports are closed: a distance within this relative tolerance of the support radius
+// counts as on the support (paper 001's d <= 2), so that pairs exactly on the edge are
+// treated alike whatever the round-off of their coordinates. The neighbour search, the
+// approximant's pattern and the kernel use the same rule.
+constexpr double kEdgeTol = 1e-13;
+// Squared-distance form: d^2 within lim^2 (1 + kEdgeTol)^2.
+constexpr double kEdgeTol2 = 2.0 * kEdgeTol;
+
 class Kernel {
  public:
   // Throws Error(MFREE_ERR_ARG) for an unknown kernel, a dimension outside 1..3 or a

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "approximant.hpp"
+#include "kernel.hpp"
 #include "particles.hpp"
 
 namespace mfree {
@@ -185,7 +186,7 @@ void CellGrid::query(const double *xq, double R, Limit &&lim, std::vector<int32_
             d2 += d * d;
           }
           const double l = lim(j);
-          if (d2 < l * l) row.push_back(j);
+          if (d2 <= l * l * (1.0 + kEdgeTol2)) row.push_back(j);
         }
       }
 }
