@@ -371,6 +371,75 @@ static void test_fe_layer_patch(void **s) {
   mfree_particles_destroy(&ps);
 }
 
+
+/* Particles moved a little (same neighbours): update refills the values into the same
+ * matrix, its pattern (pattern id) is kept, and the values equal a fresh assembly on the
+ * moved particles (issue 4: symbolic and numeric parts are separate). */
+static void test_refill_after_move(void **s) {
+  (void)s;
+  mfree_particles_t *ps = cloud(1.6); /* borrows X */
+  mfree_approximant_t *a = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  mfree_assembler_t *as = NULL;
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_ELASTICITY_PLANE_STRAIN, &as));
+  assert_ok(ctx, mfree_assembler_set_material(as, 10.0, 0.3));
+  assert_ok(ctx, mfree_assembler_setup(as));
+  mfree_matrix_t *K = NULL;
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  int64_t id0 = -1, id1 = -1, nnz0 = 0, nnz1 = 0;
+  assert_ok(ctx, mfree_matrix_get_pattern_id(K, &id0));
+  assert_ok(ctx, mfree_matrix_get_size(K, NULL, NULL, &nnz0));
+  const int64_t *rp;
+  const int32_t *ci;
+  const double *v;
+  assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &v));
+  double *before = malloc(sizeof(double) * (size_t)nnz0);
+  memcpy(before, v, sizeof(double) * (size_t)nnz0);
+
+  for (int i = 0; i < N; ++i) X[2 * i] += 1e-3 / (M - 1) * sin(7.0 * i); /* small move */
+  assert_ok(ctx, mfree_particles_update(ps));
+  assert_ok(ctx, mfree_assembler_update(as));
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  assert_ok(ctx, mfree_matrix_get_pattern_id(K, &id1));
+  assert_ok(ctx, mfree_matrix_get_size(K, NULL, NULL, &nnz1));
+  assert_true(id1 == id0);
+  assert_true(nnz1 == nnz0);
+  assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &v));
+  double change = 0.0, scale = 0.0;
+  for (int64_t k = 0; k < nnz0; ++k) {
+    change = fmax(change, fabs(v[k] - before[k]));
+    scale = fmax(scale, fabs(before[k]));
+  }
+  assert_true(change > 1e-8 * scale); /* the values did change */
+
+  /* a fresh assembler on the moved particles gives the same matrix */
+  mfree_assembler_t *fresh = NULL;
+  mfree_matrix_t *K2 = NULL;
+  assert_ok(ctx, mfree_particles_setup(ps));
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_ELASTICITY_PLANE_STRAIN, &fresh));
+  assert_ok(ctx, mfree_assembler_set_material(fresh, 10.0, 0.3));
+  assert_ok(ctx, mfree_assembler_setup(fresh));
+  assert_ok(ctx, mfree_assembler_assemble_matrix(fresh, &K2));
+  const int64_t *rp2;
+  const int32_t *ci2;
+  const double *v2;
+  int64_t nnz2 = 0;
+  assert_ok(ctx, mfree_matrix_get_size(K2, NULL, NULL, &nnz2));
+  assert_true(nnz2 == nnz0);
+  assert_ok(ctx, mfree_matrix_get_csr(K2, &rp2, &ci2, &v2));
+  for (int64_t k = 0; k < nnz0; ++k) {
+    assert_int_equal(ci2[k], ci[k]);
+    assert_true(fabs(v2[k] - v[k]) <= 1e-12 * scale);
+  }
+  free(before);
+  mfree_matrix_destroy(&K);
+  mfree_matrix_destroy(&K2);
+  mfree_assembler_destroy(&as);
+  mfree_assembler_destroy(&fresh);
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
 static void g_zero(void *u, const double *x, double *v) {
   (void)u;
   (void)x;
@@ -469,6 +538,7 @@ int main(void) {
       cmocka_unit_test(test_mass_sums),
       cmocka_unit_test(test_efg_patch_nitsche),
       cmocka_unit_test(test_fe_layer_patch),
+      cmocka_unit_test(test_refill_after_move),
       cmocka_unit_test(test_bad_input),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
