@@ -76,7 +76,9 @@ typedef MFREE_ENUM(mfree_status) {
   MFREE_FAIL_INVALID_DATA = 2,/**< a borrowed value outside its range (e.g. a volume or
                                    support that became <= 0 after it was set) */
   MFREE_FAIL_SINGULAR = 3,    /**< singular or ill-conditioned local system */
-  MFREE_FAIL_NEIGHBORS = 4    /**< too few neighbours (isolated site, basis too large) */
+  MFREE_FAIL_NEIGHBORS = 4,   /**< too few neighbours (isolated site, basis too large) */
+  MFREE_FAIL_DOMAIN = 5,      /**< a particle left the domain box */
+  MFREE_FAIL_CFL = 6          /**< a time step violates the CFL condition */
 } mfree_status_t;
 
 /** How an input array is held. */
@@ -198,6 +200,18 @@ typedef MFREE_ENUM(mfree_bc) {
                                  with outward normals: consistent, passes patch tests */
 } mfree_bc_t;
 
+/** Native time integrators of paper 003 (eqs 108-121). */
+typedef MFREE_ENUM(mfree_integrator) {
+  MFREE_INTEGRATOR_LEAPFROG = 1,            /**< 003 eqs 108-110 and the ten-step algorithm */
+  MFREE_INTEGRATOR_PREDICTOR_CORRECTOR = 2  /**< 003 eqs 111-119 */
+} mfree_integrator_t;
+
+/** Lumped mass of the Galerkin-SPH fluid (paper 003 Sect. 4.3). */
+typedef MFREE_ENUM(mfree_lumping) {
+  MFREE_LUMP_GALERKIN = 1, /**< M_i = sum_k N_i(x_k) M_k (003 eq 56), the default */
+  MFREE_LUMP_PHYSICAL = 2  /**< M_i = physical particle mass (003 eq 58) */
+} mfree_lumping_t;
+
 /* ------------------------------------------------------------------------------------ */
 /* Opaque handles                                                                         */
 /* ------------------------------------------------------------------------------------ */
@@ -207,6 +221,11 @@ typedef struct mfree_particles mfree_particles_t;
 typedef struct mfree_approximant mfree_approximant_t;
 typedef struct mfree_matrix mfree_matrix_t;
 typedef struct mfree_assembler mfree_assembler_t;
+typedef struct mfree_system mfree_system_t;
+
+/** Progress of a native integration: called after every accepted step; a nonzero
+ * return stops the integration (MFREE_SUCCESS is returned, t tells where). */
+typedef int32_t (*mfree_progress_fn)(void *user, int64_t step, double t, double dt);
 
 /** A host function of position: writes ncomp values at x (dim coordinates). */
 typedef void (*mfree_field_fn)(void *user, const double *x, double *value);
@@ -735,6 +754,90 @@ MFREE_API mfree_status_t mfree_assembler_assemble_matrix(mfree_assembler_t *as,
                                                          mfree_matrix_t **K);
 /** Assemble the right-hand side (ndofs values). */
 MFREE_API mfree_status_t mfree_assembler_assemble_rhs(mfree_assembler_t *as, double *f);
+
+/* ------------------------------------------------------------------------------------ */
+/* Semi-discrete particle systems y' = f(t, y)                                            */
+/* ------------------------------------------------------------------------------------ */
+
+/**
+ * Weakly compressible free-surface flow by Galerkin SPH with MLS shape functions (paper
+ * 003): nodal integration, internal force from the Cauchy stress -p I + 2 mu d' (d' with
+ * the paper's 1/3), Tait equation of state p = kappa ((rho/rho0)^gamma - 1), continuity
+ * collocated at the particles, particles moved with the interpolated velocity, the
+ * wall-particle boundary force of 003 Sect. 6.2, Shepard fallback at degenerate sites.
+ * State y (length (2 dim + 1) n): positions (AoS, dim per particle), velocity parameters
+ * (AoS), densities. The particles' masses are constant.
+ */
+MFREE_API mfree_status_t mfree_system_create_fluid(mfree_context_t *ctx, int32_t dim,
+                                                   int32_t n, mfree_system_t **sys);
+MFREE_API mfree_status_t mfree_system_destroy(mfree_system_t **sys);
+
+/** Rest density rho0 (per particle, stride 0 for one fluid; copied), Tait kappa and
+ * gamma, dynamic viscosity mu. Defaults: 1000, 1, 7, 0. */
+MFREE_API mfree_status_t mfree_system_set_fluid(mfree_system_t *sys, const double *rho0,
+                                                int64_t stride, double kappa, double gamma,
+                                                double mu);
+/** Particle masses (copied; stride 0 = one value). Required. */
+MFREE_API mfree_status_t mfree_system_set_masses(mfree_system_t *sys, const double *m,
+                                                 int64_t stride);
+/** Constant smoothing length h of the cubic-spline MLS weights (paper: 1.5 d). */
+MFREE_API mfree_status_t mfree_system_set_smoothing(mfree_system_t *sys, double h);
+/** Gravity (dim values). Default zero. */
+MFREE_API mfree_status_t mfree_system_set_gravity(mfree_system_t *sys, const double *g);
+MFREE_API mfree_status_t mfree_system_set_lumping(mfree_system_t *sys, mfree_lumping_t lump);
+/**
+ * Solid walls as boundary particles (copied) with unit normals pointing into the fluid;
+ * fluid particles closer than r0 to a wall particle and approaching it feel
+ * (A/r)((r0/r)^4 - (r0/r)^2) n, spread to their neighbours through the shape functions
+ * (003 eqs 122-124; paper: spacing d/3, r0 = 0.7 h, A = 10).
+ */
+MFREE_API mfree_status_t mfree_system_set_walls(mfree_system_t *sys, int32_t nwall,
+                                                const double *x, const double *normals,
+                                                double r0, double strength);
+/** A box the particles must stay in (dim values each); leaving it is
+ * MFREE_FAIL_DOMAIN. Default: none. */
+MFREE_API mfree_status_t mfree_system_set_box(mfree_system_t *sys, const double *lo,
+                                              const double *hi);
+
+/** Length of the state vector. */
+MFREE_API mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq);
+/** ydot = f(t, y) (y and ydot borrowed for the call). Non-finite or out-of-range state
+ * gives a positive status with the particle named, ydot then unspecified. */
+MFREE_API mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y,
+                                          double *ydot);
+/** Mass matrix of the state (identity except the velocity block, which holds the
+ * lumped or, with consistent != 0, the consistent Galerkin mass), so that
+ * M y' = M f(t, y) is the mass-matrix form of the system. */
+MFREE_API mfree_status_t mfree_system_assemble_mass(mfree_system_t *sys, const double *y,
+                                                    int32_t consistent, mfree_matrix_t **M);
+/** S_kj = N_j(x_k) at the state's positions: initial velocity parameters solve
+ * S v = v_hat (003 eq 99). */
+MFREE_API mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys,
+                                                             const double *y,
+                                                             mfree_matrix_t **S);
+/** Pressure at the particles from the state's densities (n values). */
+MFREE_API mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys,
+                                                   const double *y, double *p);
+/** Interpolated velocities v_hat(x_k) (dim per particle, AoS). */
+MFREE_API mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y,
+                                                   double *vhat);
+
+/**
+ * Integrate y from *t to t_end with a native scheme and the CFL step
+ * dt = cfl h / max_i (c_i + |v_i|), c_i = sqrt(gamma kappa / rho_i) (003 eqs 120-121),
+ * capped by dt_max (0: no cap). With cfl <= 0 the step is dt_max, and a step above the
+ * CFL limit returns MFREE_FAIL_CFL before anything is changed. A non-finite state or a
+ * particle outside the box stops the run with a positive status naming the step and
+ * particle; y and *t then hold the last good state.
+ * @param[in,out] y   state, updated in place
+ * @param[in,out] t   time
+ * @param[out] nsteps steps taken (may be NULL)
+ */
+MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
+                                                mfree_integrator_t scheme, double *y,
+                                                double *t, double t_end, double cfl,
+                                                double dt_max, mfree_progress_fn progress,
+                                                void *user, int64_t *nsteps);
 
 #ifdef __cplusplus
 }

@@ -31,7 +31,8 @@ static void test_status_strings(void **s) {
                                 MFREE_ERR_STATE,     MFREE_ERR_ALLOC,    MFREE_ERR_MISMATCH,
                                 MFREE_ERR_UNSUPPORTED, MFREE_ERR_INPUT,  MFREE_ERR_INTERNAL,
                                 MFREE_FAIL_NONFINITE, MFREE_FAIL_INVALID_DATA,
-                                MFREE_FAIL_SINGULAR, MFREE_FAIL_NEIGHBORS};
+                                MFREE_FAIL_SINGULAR, MFREE_FAIL_NEIGHBORS,
+                                MFREE_FAIL_DOMAIN, MFREE_FAIL_CFL};
   const size_t n = sizeof all / sizeof all[0];
   for (size_t i = 0; i < n; ++i) {
     const char *a = mfree_status_string(all[i]);

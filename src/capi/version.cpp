@@ -26,6 +26,8 @@ const char *mfree_status_string(mfree_status_t s) {
     case MFREE_FAIL_INVALID_DATA: return "data value out of range";
     case MFREE_FAIL_SINGULAR: return "singular or ill-conditioned local system";
     case MFREE_FAIL_NEIGHBORS: return "too few neighbours";
+    case MFREE_FAIL_DOMAIN: return "a particle left the domain";
+    case MFREE_FAIL_CFL: return "time step violates the CFL condition";
   }
   return "unknown status";
 }

@@ -1,0 +1,169 @@
+#include "core/fluid.hpp"
+#include "handles.hpp"
+
+struct mfree_system {
+  std::atomic<int> refs{1};
+  mfree_context_t *ctx = nullptr;
+  mfree::FluidSystem sys;
+  mfree_system(mfree_context_t *c, int dim, int32_t n) : ctx(c), sys(dim, n) {}
+};
+
+namespace {
+
+template <class Body>
+mfree_status_t with_sys(mfree_system_t *s, const char *fn, Body &&body) {
+  if (!s) return MFREE_ERR_NULL;
+  return mfree::guard(s->ctx, fn, [&]() { return body(s->sys); });
+}
+template <class Body>
+mfree_status_t with_sys(const mfree_system_t *s, const char *fn, Body &&body) {
+  if (!s) return MFREE_ERR_NULL;
+  return mfree::guard(s->ctx, fn, [&]() { return body(s->sys); });
+}
+
+// Fill *M (created when NULL) through a core routine that writes a SparseMatrix.
+template <class Fill>
+mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, mfree_matrix_t **M, Fill &&fill) {
+  return with_sys(s, fn, [&](mfree::FluidSystem &f) {
+    MFREE_REQUIRE(M, MFREE_ERR_NULL, "output pointer is NULL");
+    mfree_matrix_t *m = *M;
+    bool fresh = false;
+    if (!m) {
+      m = new mfree_matrix_t(s->ctx);
+      mfree::retain(s->ctx);
+      fresh = true;
+    }
+    mfree::Report rep;
+    try {
+      rep = fill(f, m->m);
+    } catch (...) {
+      if (fresh) mfree::release(m);
+      throw;
+    }
+    if (!rep.ok() && fresh) {
+      mfree::release(m);
+      return mfree::finish(s->ctx, fn, rep);
+    }
+    *M = m;
+    return mfree::finish(s->ctx, fn, rep);
+  });
+}
+
+}  // namespace
+
+extern "C" {
+
+mfree_status_t mfree_system_create_fluid(mfree_context_t *ctx, int32_t dim, int32_t n, mfree_system_t **sys) {
+  if (!ctx) return MFREE_ERR_NULL;
+  return mfree::guard(ctx, "mfree_system_create_fluid", [&]() {
+    MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
+    *sys = nullptr;
+    MFREE_REQUIRE(n >= 0, MFREE_ERR_ARG, "particle count " + std::to_string(n) + " is negative");
+    auto *s = new mfree_system_t(ctx, dim, n);
+    mfree::retain(ctx);
+    *sys = s;
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_destroy(mfree_system_t **sys) {
+  if (!sys || !*sys) return MFREE_SUCCESS;
+  mfree_system_t *s = *sys;
+  if (s->refs.fetch_sub(1, std::memory_order_acq_rel) == 1) {
+    mfree_context_t *c = s->ctx;
+    delete s;
+    mfree::release(c);
+  }
+  *sys = nullptr;
+  return MFREE_SUCCESS;
+}
+
+#define MFREE_SYS_SETTER(name, call)                              \
+  return with_sys(sys, name, [&](mfree::FluidSystem &f) {         \
+    call;                                                         \
+    return MFREE_SUCCESS;                                         \
+  })
+
+mfree_status_t mfree_system_set_fluid(mfree_system_t *sys, const double *rho0, int64_t stride, double kappa,
+                                      double gamma, double mu) {
+  MFREE_SYS_SETTER("mfree_system_set_fluid", f.set_fluid(rho0, stride, kappa, gamma, mu));
+}
+mfree_status_t mfree_system_set_masses(mfree_system_t *sys, const double *m, int64_t stride) {
+  MFREE_SYS_SETTER("mfree_system_set_masses", f.set_masses(m, stride));
+}
+mfree_status_t mfree_system_set_smoothing(mfree_system_t *sys, double h) {
+  MFREE_SYS_SETTER("mfree_system_set_smoothing", f.set_smoothing(h));
+}
+mfree_status_t mfree_system_set_gravity(mfree_system_t *sys, const double *g) {
+  MFREE_SYS_SETTER("mfree_system_set_gravity", f.set_gravity(g));
+}
+mfree_status_t mfree_system_set_lumping(mfree_system_t *sys, mfree_lumping_t lump) {
+  MFREE_SYS_SETTER("mfree_system_set_lumping", f.set_lumping(lump));
+}
+mfree_status_t mfree_system_set_walls(mfree_system_t *sys, int32_t nwall, const double *x, const double *normals,
+                                      double r0, double strength) {
+  MFREE_SYS_SETTER("mfree_system_set_walls", f.set_walls(nwall, x, normals, r0, strength));
+}
+mfree_status_t mfree_system_set_box(mfree_system_t *sys, const double *lo, const double *hi) {
+  MFREE_SYS_SETTER("mfree_system_set_box", f.set_box(lo, hi));
+}
+
+mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
+  return with_sys(sys, "mfree_system_get_size", [&](const mfree::FluidSystem &f) {
+    MFREE_REQUIRE(neq, MFREE_ERR_NULL, "output pointer is NULL");
+    *neq = f.neq();
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y, double *ydot) {
+  return with_sys(sys, "mfree_system_rhs", [&](mfree::FluidSystem &f) {
+    MFREE_REQUIRE((y && ydot) || f.neq() == 0, MFREE_ERR_NULL, "y or ydot is NULL");
+    return mfree::finish(sys->ctx, "mfree_system_rhs", f.rhs(t, y, ydot));
+  });
+}
+
+mfree_status_t mfree_system_assemble_mass(mfree_system_t *sys, const double *y, int32_t consistent,
+                                          mfree_matrix_t **M) {
+  if (sys && !y && sys->sys.neq() > 0)
+    return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_mass", "y is NULL");
+  return fill_matrix(sys, "mfree_system_assemble_mass", M, [&](mfree::FluidSystem &f, mfree::SparseMatrix &m) {
+    return f.mass(y, consistent != 0, m);
+  });
+}
+
+mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys, const double *y, mfree_matrix_t **S) {
+  if (sys && !y && sys->sys.neq() > 0)
+    return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_interpolation", "y is NULL");
+  return fill_matrix(sys, "mfree_system_assemble_interpolation", S,
+                     [&](mfree::FluidSystem &f, mfree::SparseMatrix &m) { return f.interpolation(y, m); });
+}
+
+mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double *y, double *p) {
+  return with_sys(sys, "mfree_system_get_pressure", [&](const mfree::FluidSystem &f) {
+    MFREE_REQUIRE((y && p) || f.size() == 0, MFREE_ERR_NULL, "y or p is NULL");
+    f.pressure(y, p);
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, double *vhat) {
+  return with_sys(sys, "mfree_system_get_velocity", [&](mfree::FluidSystem &f) {
+    MFREE_REQUIRE((y && vhat) || f.size() == 0, MFREE_ERR_NULL, "y or vhat is NULL");
+    return mfree::finish(sys->ctx, "mfree_system_get_velocity", f.velocity(y, vhat));
+  });
+}
+
+mfree_status_t mfree_system_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t,
+                                      double t_end, double cfl, double dt_max, mfree_progress_fn progress,
+                                      void *user, int64_t *nsteps) {
+  return with_sys(sys, "mfree_system_integrate", [&](mfree::FluidSystem &f) {
+    MFREE_REQUIRE(t && (y || f.neq() == 0), MFREE_ERR_NULL, "y or t is NULL");
+    int64_t steps = 0;
+    mfree::Report rep = f.integrate(scheme, y, *t, t_end, cfl, dt_max, progress, user, steps);
+    if (nsteps) *nsteps = steps;
+    return mfree::finish(sys->ctx, "mfree_system_integrate", rep);
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,212 @@
+/* Galerkin-SPH fluid system (paper 003): exact conservation of linear and angular
+ * momentum by the nodal-integrated internal forces (003 claims D3/D4; spec 003 section
+ * 4), hydrostatic equilibrium of the interior at t = 0 with the initial densities of
+ * 003 eq 65, and the failure modes of issue 5 (non-finite state, particle leaving the
+ * box, CFL violation), each keeping the last good state. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testutil.h"
+
+static mfree_context_t *ctx;
+static int setup(void **s) { (void)s; return mfree_context_create(&ctx) != MFREE_SUCCESS; }
+static int teardown(void **s) { (void)s; return mfree_context_destroy(&ctx) != MFREE_SUCCESS; }
+
+enum { NX = 12, NZ = 12, N = NX * NZ };
+static const double D = 0.005, RHO0 = 1000.0, G = 9.81, GAMMA = 7.0;
+static double kappa_of(double H) { return 100.0 * RHO0 * 2.0 * G * H / GAMMA; } /* 003 eq 125 */
+
+/* Lattice patch with spacing D; returns the state y (x, v, rho) and masses. */
+static double *patch(double *m, int jitter, int hydrostatic) {
+  double *y = calloc(5 * (size_t)N, sizeof(double));
+  mfree_rng_t r;
+  mfree_rng_seed(&r, 99);
+  const double H = NZ * D, kap = kappa_of(H);
+  for (int j = 0; j < NZ; ++j)
+    for (int i = 0; i < NX; ++i) {
+      const int p = j * NX + i;
+      const double jx = jitter ? 0.2 * D * (2 * mfree_rng_uniform(&r) - 1) : 0.0;
+      const double jz = jitter ? 0.2 * D * (2 * mfree_rng_uniform(&r) - 1) : 0.0;
+      y[2 * p] = (i + 0.5) * D + jx;
+      y[2 * p + 1] = (j + 0.5) * D + jz;
+      const double z = (j + 0.5) * D;
+      const double rho = hydrostatic ? RHO0 * pow(1 + RHO0 * G * (H - z) / kap, 1 / GAMMA) /* 003 eq 65 */
+                                     : RHO0 * (1 + 0.01 * (2 * mfree_rng_uniform(&r) - 1));
+      y[4 * N + p] = rho;
+      m[p] = rho * D * D;
+      if (!hydrostatic) {
+        y[2 * N + 2 * p] = 0.3 * (2 * mfree_rng_uniform(&r) - 1);
+        y[2 * N + 2 * p + 1] = 0.3 * (2 * mfree_rng_uniform(&r) - 1);
+      }
+    }
+  return y;
+}
+
+static mfree_system_t *fluid(const double *m, double H, double mu, int gravity) {
+  mfree_system_t *s = NULL;
+  assert_ok(ctx, mfree_system_create_fluid(ctx, 2, N, &s));
+  assert_ok(ctx, mfree_system_set_fluid(s, &RHO0, 0, kappa_of(H), GAMMA, mu));
+  assert_ok(ctx, mfree_system_set_masses(s, m, 1));
+  assert_ok(ctx, mfree_system_set_smoothing(s, 1.5 * D));
+  if (gravity) {
+    const double g[2] = {0.0, -G};
+    assert_ok(ctx, mfree_system_set_gravity(s, g));
+  }
+  return s;
+}
+
+/* Free patch, no walls, no gravity, random velocities and densities: the lumped-mass
+ * weighted accelerations sum to zero (linear momentum, test functions constant
+ * complete) and so do their moments (angular momentum, linear completeness and a
+ * symmetric Cauchy stress), 003 D3/D4 and spec 000 eqs 106-111, to round-off. */
+static void test_conservation(void **s) {
+  (void)s;
+  for (int lump = MFREE_LUMP_GALERKIN; lump <= MFREE_LUMP_PHYSICAL; ++lump) {
+    double m[N];
+    double *y = patch(m, 1, 0);
+    mfree_system_t *sys = fluid(m, NZ * D, 0.5, 0);
+    assert_ok(ctx, mfree_system_set_lumping(sys, (mfree_lumping_t)lump));
+    int32_t neq = 0;
+    assert_ok(ctx, mfree_system_get_size(sys, &neq));
+    assert_int_equal(neq, 5 * N);
+    double *yd = calloc((size_t)neq, sizeof(double));
+    assert_ok(ctx, mfree_system_rhs(sys, 0.0, y, yd));
+    mfree_matrix_t *M = NULL;
+    assert_ok(ctx, mfree_system_assemble_mass(sys, y, 0, &M));
+    const int64_t *rp;
+    const int32_t *ci;
+    const double *v;
+    assert_ok(ctx, mfree_matrix_get_csr(M, &rp, &ci, &v));
+    double P[2] = {0, 0}, Lz = 0.0, scale = 0.0;
+    for (int i = 0; i < N; ++i) {
+      const int64_t row = 2 * N + 2 * i; /* velocity block, component x of particle i */
+      assert_int_equal(rp[row + 1] - rp[row], 1);
+      const double Mi = v[rp[row]];
+      const double fx = Mi * yd[2 * N + 2 * i], fz = Mi * yd[2 * N + 2 * i + 1];
+      P[0] += fx;
+      P[1] += fz;
+      Lz += y[2 * i] * fz - y[2 * i + 1] * fx;
+      scale += fabs(fx) + fabs(fz);
+    }
+    if (fabs(P[0]) > 1e-12 * scale || fabs(P[1]) > 1e-12 * scale)
+      fail_msg("lumping %d: momentum rate (%g, %g), scale %g", lump, P[0], P[1], scale);
+    if (fabs(Lz) > 1e-12 * scale * NX * D) fail_msg("lumping %d: angular momentum rate %g", lump, Lz);
+    /* the density rates and interpolated velocities are finite, and the mass matrix
+     * holds identity rows for positions and densities */
+    for (int q = 0; q < neq; ++q) assert_true(isfinite(yd[q]));
+    assert_true(v[rp[0]] == 1.0 && ci[rp[0]] == 0);
+    mfree_matrix_destroy(&M);
+    free(yd);
+    free(y);
+    mfree_system_destroy(&sys);
+  }
+}
+
+/* 003 eq 65 initial densities make p = rho0 g (H - z) exactly (eq 64); away from the
+ * free surface and the bottom the pressure gradient then balances gravity: interior
+ * accelerations below 1 % of g at t = 0 (linear completeness of the MLS gradients). */
+static void test_hydrostatic_interior(void **s) {
+  (void)s;
+  double m[N];
+  double *y = patch(m, 0, 1);
+  const double H = NZ * D;
+  mfree_system_t *sys = fluid(m, H, 0.5, 1);
+  double p[N];
+  assert_ok(ctx, mfree_system_get_pressure(sys, y, p));
+  for (int i = 0; i < N; ++i) assert_true(fabs(p[i] - RHO0 * G * (H - y[2 * i + 1])) < 1e-9 * RHO0 * G * H);
+  double *yd = calloc(5 * (size_t)N, sizeof(double));
+  assert_ok(ctx, mfree_system_rhs(sys, 0.0, y, yd));
+  int checked = 0;
+  for (int i = 0; i < N; ++i) {
+    const double x = y[2 * i], z = y[2 * i + 1], h = 1.5 * D;
+    if (x < 3 * h || x > NX * D - 3 * h || z < 3 * h || z > H - 3 * h) continue;
+    const double ax = yd[2 * N + 2 * i], az = yd[2 * N + 2 * i + 1];
+    if (fabs(ax) > 0.01 * G || fabs(az) > 0.01 * G) fail_msg("particle %d at z %g: a = (%g, %g)", i, z, ax, az);
+    ++checked;
+  }
+  assert_true(checked > 0);
+  free(yd);
+  free(y);
+  mfree_system_destroy(&sys);
+}
+
+static int count_steps(void *user, int64_t step, double t, double dt) {
+  (void)t;
+  (void)dt;
+  *(int64_t *)user = step;
+  return 0;
+}
+
+static void test_failures(void **s) {
+  (void)s;
+  double m[N];
+  double *y = patch(m, 1, 0);
+  mfree_system_t *sys = NULL;
+  assert_error(ctx, mfree_system_create_fluid(ctx, 1, N, &sys), MFREE_ERR_ARG, "2D or 3D");
+  assert_error(ctx, mfree_system_create_fluid(ctx, 2, -1, &sys), MFREE_ERR_ARG, "negative");
+  assert_int_equal(mfree_system_create_fluid(NULL, 2, N, &sys), MFREE_ERR_NULL);
+  assert_ok(ctx, mfree_system_create_fluid(ctx, 2, N, &sys));
+  double *yd = calloc(5 * (size_t)N, sizeof(double));
+  assert_error(ctx, mfree_system_rhs(sys, 0.0, y, yd), MFREE_ERR_STATE, "masses");
+  mfree_system_destroy(&sys);
+
+  sys = fluid(m, NZ * D, 0.5, 0);
+  assert_error(ctx, mfree_system_set_fluid(sys, &RHO0, 0, -1.0, GAMMA, 0.0), MFREE_ERR_ARG, "kappa");
+  const double badm = -1.0;
+  assert_error(ctx, mfree_system_set_masses(sys, &badm, 0), MFREE_ERR_INPUT, "mass");
+  assert_error(ctx, mfree_system_set_smoothing(sys, 0.0), MFREE_ERR_ARG, "h must be");
+  const double wn[2] = {0.0, 2.0}, wx[2] = {0.0, 0.0};
+  assert_error(ctx, mfree_system_set_walls(sys, 1, wx, wn, 0.01, 10.0), MFREE_ERR_INPUT, "unit vector");
+  assert_error(ctx, mfree_system_rhs(sys, 0.0, NULL, yd), MFREE_ERR_NULL, "NULL");
+
+  /* non-finite state: positive status naming the particle */
+  double keep = y[2 * N + 7];
+  y[2 * N + 7] = NAN;
+  assert_error(ctx, mfree_system_rhs(sys, 0.0, y, yd), MFREE_FAIL_NONFINITE, "particle 3");
+  y[2 * N + 7] = keep;
+  keep = y[4 * N + 5];
+  y[4 * N + 5] = -1.0;
+  assert_error(ctx, mfree_system_rhs(sys, 0.0, y, yd), MFREE_FAIL_INVALID_DATA, "particle 5");
+  y[4 * N + 5] = keep;
+
+  /* a fixed step above the CFL limit: positive status before anything changes */
+  double *y0 = malloc(5 * sizeof(double) * N);
+  memcpy(y0, y, 5 * sizeof(double) * N);
+  double t = 0.0;
+  int64_t ns = -1;
+  assert_error(ctx, mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.0, 1e-2, NULL, NULL, &ns),
+               MFREE_FAIL_CFL, "CFL");
+  assert_memory_equal(y, y0, 5 * sizeof(double) * N);
+  assert_true(t == 0.0);
+
+  /* particles leave a tight box: positive status, the last good state kept */
+  const double lo[2] = {-0.001, -0.001}, hi[2] = {NX * D + 0.001, NZ * D + 0.001};
+  assert_ok(ctx, mfree_system_set_box(sys, lo, hi));
+  int64_t seen = 0;
+  const mfree_status_t st =
+      mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.3, 0.0, count_steps, &seen, &ns);
+  assert_int_equal(st, MFREE_FAIL_DOMAIN);
+  char msg[512];
+  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  assert_non_null(strstr(msg, "left the box"));
+  assert_int_equal(ns, seen);
+  for (int i = 0; i < N; ++i) /* the returned state is inside */
+    for (int c = 0; c < 2; ++c) assert_true(y[2 * i + c] >= lo[c] && y[2 * i + c] <= hi[c]);
+  assert_true(t > 0.0 && t < 1.0);
+  assert_error(ctx, mfree_system_integrate(sys, (mfree_integrator_t)9, y, &t, 1.0, 0.3, 0.0, NULL, NULL, &ns),
+               MFREE_ERR_ARG, "integrator");
+  free(y0);
+  free(yd);
+  free(y);
+  mfree_system_destroy(&sys);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_conservation),
+      cmocka_unit_test(test_hydrostatic_interior),
+      cmocka_unit_test(test_failures),
+  };
+  return cmocka_run_group_tests(tests, setup, teardown);
+}
