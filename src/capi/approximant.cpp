@@ -14,16 +14,6 @@ void release_approximant(mfree_approximant_t *a) {
   }
 }
 
-template <class Body>
-mfree_status_t with_a(mfree_approximant_t *a, const char *fn, Body &&body) {
-  if (!a) return MFREE_ERR_NULL;
-  return mfree::guard(a->ctx, fn, [&]() { return body(a->a); });
-}
-template <class Body>
-mfree_status_t with_a(const mfree_approximant_t *a, const char *fn, Body &&body) {
-  if (!a) return MFREE_ERR_NULL;
-  return mfree::guard(a->ctx, fn, [&]() { return body(a->a); });
-}
 
 void check_layout(int layout, int64_t ld, int64_t need_aos, int64_t need_soa, const char *what) {
   if (layout != MFREE_LAYOUT_AOS && layout != MFREE_LAYOUT_SOA)
@@ -44,7 +34,7 @@ void copy_site_vector(const mfree::Approximant &ap, const std::vector<T> &v, T *
 mfree_status_t apply_impl(const mfree_approximant_t *a, const char *fn, mfree_op_t op,
                           int32_t ncomp, const double *u, mfree_layout_t ulayout, int64_t uld,
                           double *out, mfree_layout_t olayout, int64_t old, bool add) {
-  return with_a(a, fn, [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, fn, [&](const mfree::Approximant &ap) {
     MFREE_REQUIRE(ap.is_setup(), MFREE_ERR_STATE, "the approximant is not set up (call setup)");
     MFREE_REQUIRE(ncomp >= 1, MFREE_ERR_ARG, "ncomp = " + std::to_string(ncomp) + " must be >= 1");
     const int ocomp = ap.op_components(op, ncomp);
@@ -96,28 +86,28 @@ mfree_status_t mfree_approximant_destroy(mfree_approximant_t **a) {
 
 mfree_status_t mfree_approximant_set_kernel(mfree_approximant_t *a, mfree_kernel_t kernel,
                                             double param) {
-  return with_a(a, "mfree_approximant_set_kernel", [&](mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_set_kernel", [&](mfree::Approximant &ap) {
     ap.set_kernel(kernel, param);
     return MFREE_SUCCESS;
   });
 }
 
 mfree_status_t mfree_approximant_set_order(mfree_approximant_t *a, int32_t order) {
-  return with_a(a, "mfree_approximant_set_order", [&](mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_set_order", [&](mfree::Approximant &ap) {
     ap.set_order(order);
     return MFREE_SUCCESS;
   });
 }
 
 mfree_status_t mfree_approximant_set_derivatives(mfree_approximant_t *a, int32_t flags) {
-  return with_a(a, "mfree_approximant_set_derivatives", [&](mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_set_derivatives", [&](mfree::Approximant &ap) {
     ap.set_derivatives(flags);
     return MFREE_SUCCESS;
   });
 }
 
 mfree_status_t mfree_approximant_set_fallback(mfree_approximant_t *a, mfree_fallback_t policy) {
-  return with_a(a, "mfree_approximant_set_fallback", [&](mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_set_fallback", [&](mfree::Approximant &ap) {
     ap.set_fallback(policy);
     return MFREE_SUCCESS;
   });
@@ -126,14 +116,14 @@ mfree_status_t mfree_approximant_set_fallback(mfree_approximant_t *a, mfree_fall
 mfree_status_t mfree_approximant_set_points(mfree_approximant_t *a, int32_t npts,
                                             const double *x, mfree_layout_t layout, int64_t ld,
                                             const double *h, int64_t h_stride, mfree_mem_t mem) {
-  return with_a(a, "mfree_approximant_set_points", [&](mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_set_points", [&](mfree::Approximant &ap) {
     ap.set_points(npts, x, layout, ld, h, h_stride, mem);
     return MFREE_SUCCESS;
   });
 }
 
 mfree_status_t mfree_approximant_setup(mfree_approximant_t *a) {
-  return with_a(a, "mfree_approximant_setup", [&](mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_setup", [&](mfree::Approximant &ap) {
     mfree::ParticleSet &set = a->ps->set;
     mfree::Report pre;
     if (!set.is_setup()) pre = set.setup();
@@ -144,7 +134,7 @@ mfree_status_t mfree_approximant_setup(mfree_approximant_t *a) {
 }
 
 mfree_status_t mfree_approximant_update(mfree_approximant_t *a) {
-  return with_a(a, "mfree_approximant_update", [&](mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_update", [&](mfree::Approximant &ap) {
     return mfree::finish(a->ctx, "mfree_approximant_update", ap.update());
   });
 }
@@ -165,7 +155,7 @@ mfree_status_t mfree_approximant_apply_add(const mfree_approximant_t *a, mfree_o
 }
 
 mfree_status_t mfree_approximant_get_num_sites(const mfree_approximant_t *a, int32_t *nsites) {
-  return with_a(a, "mfree_approximant_get_num_sites", [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_get_num_sites", [&](const mfree::Approximant &ap) {
     MFREE_REQUIRE(nsites, MFREE_ERR_NULL, "output pointer is NULL");
     MFREE_REQUIRE(ap.is_setup(), MFREE_ERR_STATE, "the approximant is not set up");
     *nsites = ap.num_sites();
@@ -174,7 +164,7 @@ mfree_status_t mfree_approximant_get_num_sites(const mfree_approximant_t *a, int
 }
 
 mfree_status_t mfree_approximant_get_nnz(const mfree_approximant_t *a, int64_t *nnz) {
-  return with_a(a, "mfree_approximant_get_nnz", [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_get_nnz", [&](const mfree::Approximant &ap) {
     MFREE_REQUIRE(nnz, MFREE_ERR_NULL, "output pointer is NULL");
     MFREE_REQUIRE(ap.is_setup(), MFREE_ERR_STATE, "the approximant is not set up");
     *nnz = ap.nnz();
@@ -185,7 +175,7 @@ mfree_status_t mfree_approximant_get_nnz(const mfree_approximant_t *a, int64_t *
 mfree_status_t mfree_approximant_assemble_csr(const mfree_approximant_t *a, mfree_deriv_t deriv,
                                               int32_t component, int64_t *rowptr, int32_t *cols,
                                               double *vals) {
-  return with_a(a, "mfree_approximant_assemble_csr", [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_assemble_csr", [&](const mfree::Approximant &ap) {
     MFREE_REQUIRE(ap.is_setup(), MFREE_ERR_STATE, "the approximant is not set up");
     MFREE_REQUIRE(rowptr || cols || vals, MFREE_ERR_NULL, "all outputs are NULL");
     ap.export_csr(deriv, component, rowptr, cols, vals);
@@ -195,7 +185,7 @@ mfree_status_t mfree_approximant_assemble_csr(const mfree_approximant_t *a, mfre
 
 mfree_status_t mfree_approximant_check_reproduction(const mfree_approximant_t *a, int32_t order,
                                                     double *fn_err, double *deriv_err) {
-  return with_a(a, "mfree_approximant_check_reproduction", [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_check_reproduction", [&](const mfree::Approximant &ap) {
     MFREE_REQUIRE(fn_err && deriv_err, MFREE_ERR_NULL, "output pointer is NULL");
     MFREE_REQUIRE(ap.is_setup(), MFREE_ERR_STATE, "the approximant is not set up");
     ap.check_reproduction(order, *fn_err, *deriv_err);
@@ -205,7 +195,7 @@ mfree_status_t mfree_approximant_check_reproduction(const mfree_approximant_t *a
 
 mfree_status_t mfree_approximant_get_site_status(const mfree_approximant_t *a, int32_t *status,
                                                  int32_t *nfailed) {
-  return with_a(a, "mfree_approximant_get_site_status", [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_get_site_status", [&](const mfree::Approximant &ap) {
     MFREE_REQUIRE(status || nfailed, MFREE_ERR_NULL, "both outputs are NULL");
     MFREE_REQUIRE(ap.is_setup(), MFREE_ERR_STATE, "the approximant is not set up");
     const auto &st = ap.site_status();
@@ -217,21 +207,21 @@ mfree_status_t mfree_approximant_get_site_status(const mfree_approximant_t *a, i
 }
 
 mfree_status_t mfree_approximant_get_neighbor_counts(const mfree_approximant_t *a, int32_t *counts) {
-  return with_a(a, "mfree_approximant_get_neighbor_counts", [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_get_neighbor_counts", [&](const mfree::Approximant &ap) {
     copy_site_vector(ap, ap.site_support(), counts);
     return MFREE_SUCCESS;
   });
 }
 
 mfree_status_t mfree_approximant_get_condition(const mfree_approximant_t *a, double *cond) {
-  return with_a(a, "mfree_approximant_get_condition", [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_get_condition", [&](const mfree::Approximant &ap) {
     copy_site_vector(ap, ap.site_cond(), cond);
     return MFREE_SUCCESS;
   });
 }
 
 mfree_status_t mfree_approximant_get_site_order(const mfree_approximant_t *a, int32_t *order) {
-  return with_a(a, "mfree_approximant_get_site_order", [&](const mfree::Approximant &ap) {
+  return mfree::with_handle(a, "mfree_approximant_get_site_order", [&](const mfree::Approximant &ap) {
     copy_site_vector(ap, ap.site_order(), order);
     return MFREE_SUCCESS;
   });

@@ -9,6 +9,8 @@ struct mfree_assembler {
   mfree_assembler(mfree_context_t *c, mfree_particles_t *p, const mfree::ApproxConfig &trial,
                   const mfree::ApproxConfig &test, bool bubnov, int form)
       : ctx(c), ps(p), as(&p->set, trial, test, bubnov, form) {}
+  mfree::Assembler &core() { return as; }
+  const mfree::Assembler &core() const { return as; }
 };
 
 namespace {
@@ -23,16 +25,6 @@ void release_assembler(mfree_assembler_t *a) {
   }
 }
 
-template <class Body>
-mfree_status_t with_as(mfree_assembler_t *a, const char *fn, Body &&body) {
-  if (!a) return MFREE_ERR_NULL;
-  return mfree::guard(a->ctx, fn, [&]() { return body(a->as); });
-}
-template <class Body>
-mfree_status_t with_as(const mfree_assembler_t *a, const char *fn, Body &&body) {
-  if (!a) return MFREE_ERR_NULL;
-  return mfree::guard(a->ctx, fn, [&]() { return body(a->as); });
-}
 
 }  // namespace
 
@@ -66,7 +58,7 @@ mfree_status_t mfree_assembler_destroy(mfree_assembler_t **as) {
 }
 
 #define MFREE_AS_SETTER(name, call)                                             \
-  return with_as(as, name, [&](mfree::Assembler &a) {                           \
+  return mfree::with_handle(as, name, [&](mfree::Assembler &a) {                           \
     call;                                                                       \
     return MFREE_SUCCESS;                                                       \
   })
@@ -134,7 +126,7 @@ mfree_status_t mfree_assembler_set_penalty(mfree_assembler_t *as, double alpha) 
 }
 
 mfree_status_t mfree_assembler_setup(mfree_assembler_t *as) {
-  return with_as(as, "mfree_assembler_setup", [&](mfree::Assembler &a) {
+  return mfree::with_handle(as, "mfree_assembler_setup", [&](mfree::Assembler &a) {
     mfree::ParticleSet &set = as->ps->set;
     mfree::Report pre;
     if (!set.is_setup()) pre = set.setup();
@@ -145,13 +137,13 @@ mfree_status_t mfree_assembler_setup(mfree_assembler_t *as) {
 }
 
 mfree_status_t mfree_assembler_update(mfree_assembler_t *as) {
-  return with_as(as, "mfree_assembler_update", [&](mfree::Assembler &a) {
+  return mfree::with_handle(as, "mfree_assembler_update", [&](mfree::Assembler &a) {
     return mfree::finish(as->ctx, "mfree_assembler_update", a.update());
   });
 }
 
 mfree_status_t mfree_assembler_get_size(const mfree_assembler_t *as, int32_t *ndofs, int32_t *nquad) {
-  return with_as(as, "mfree_assembler_get_size", [&](const mfree::Assembler &a) {
+  return mfree::with_handle(as, "mfree_assembler_get_size", [&](const mfree::Assembler &a) {
     MFREE_REQUIRE(a.is_setup(), MFREE_ERR_STATE, "the assembler is not set up");
     if (ndofs) *ndofs = a.ndofs();
     if (nquad) *nquad = a.nquad();
@@ -160,7 +152,7 @@ mfree_status_t mfree_assembler_get_size(const mfree_assembler_t *as, int32_t *nd
 }
 
 mfree_status_t mfree_assembler_assemble_matrix(mfree_assembler_t *as, mfree_matrix_t **K) {
-  return with_as(as, "mfree_assembler_assemble_matrix", [&](mfree::Assembler &a) {
+  return mfree::with_handle(as, "mfree_assembler_assemble_matrix", [&](mfree::Assembler &a) {
     MFREE_REQUIRE(K, MFREE_ERR_NULL, "output pointer is NULL");
     MFREE_REQUIRE(a.is_setup(), MFREE_ERR_STATE, "the assembler is not set up");
     mfree_matrix_t *m = *K;
@@ -182,7 +174,7 @@ mfree_status_t mfree_assembler_assemble_matrix(mfree_assembler_t *as, mfree_matr
 }
 
 mfree_status_t mfree_assembler_assemble_rhs(mfree_assembler_t *as, double *f) {
-  return with_as(as, "mfree_assembler_assemble_rhs", [&](mfree::Assembler &a) {
+  return mfree::with_handle(as, "mfree_assembler_assemble_rhs", [&](mfree::Assembler &a) {
     MFREE_REQUIRE(a.is_setup(), MFREE_ERR_STATE, "the assembler is not set up");
     MFREE_REQUIRE(f || a.ndofs() == 0, MFREE_ERR_NULL, "output pointer is NULL");
     a.assemble_rhs(f);

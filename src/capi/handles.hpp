@@ -26,6 +26,8 @@ struct mfree_particles {
   mfree_context_t *ctx = nullptr;
   mfree::ParticleSet set;
   mfree_particles(mfree_context_t *c, int dim, int32_t n) : ctx(c), set(dim, n) {}
+  mfree::ParticleSet &core() { return set; }
+  const mfree::ParticleSet &core() const { return set; }
 };
 
 struct mfree_approximant {
@@ -35,6 +37,8 @@ struct mfree_approximant {
   mfree::Approximant a;
   mfree_approximant(mfree_context_t *c, mfree_particles_t *p, int method)
       : ctx(c), ps(p), a(&p->set, method) {}
+  mfree::Approximant &core() { return a; }
+  const mfree::Approximant &core() const { return a; }
 };
 
 struct mfree_matrix {
@@ -42,6 +46,8 @@ struct mfree_matrix {
   mfree_context_t *ctx = nullptr;
   mfree::SparseMatrix m;
   explicit mfree_matrix(mfree_context_t *c) : ctx(c) {}
+  mfree::SparseMatrix &core() { return m; }
+  const mfree::SparseMatrix &core() const { return m; }
 };
 
 namespace mfree {
@@ -70,6 +76,14 @@ mfree_status_t guard(mfree_context_t *ctx, const char *fn, Body &&body) noexcept
   } catch (...) {
     return record(ctx, MFREE_ERR_INTERNAL, fn, "internal error: unknown exception");
   }
+}
+
+// Run body(core object) of a handle inside the guard; a NULL handle has no context to
+// record a message on, so it only returns MFREE_ERR_NULL. H::core() gives the object.
+template <class H, class Body>
+mfree_status_t with_handle(H *h, const char *fn, Body &&body) noexcept {
+  if (!h) return MFREE_ERR_NULL;
+  return guard(h->ctx, fn, [&]() { return body(h->core()); });
 }
 
 // Report a data-dependent outcome: record its message if it failed, return its status.

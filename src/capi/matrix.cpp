@@ -14,11 +14,6 @@ void release(mfree_matrix_t *m) {
 }  // namespace mfree
 
 namespace {
-template <class Body>
-mfree_status_t with_m(const mfree_matrix_t *m, const char *fn, Body &&body) {
-  if (!m) return MFREE_ERR_NULL;
-  return mfree::guard(m->ctx, fn, [&]() { return body(m->m); });
-}
 }  // namespace
 
 extern "C" {
@@ -66,7 +61,7 @@ mfree_status_t mfree_matrix_destroy(mfree_matrix_t **A) {
 
 mfree_status_t mfree_matrix_get_size(const mfree_matrix_t *A, int32_t *nrows, int32_t *ncols,
                                      int64_t *nnz) {
-  return with_m(A, "mfree_matrix_get_size", [&](const mfree::SparseMatrix &m) {
+  return mfree::with_handle(A, "mfree_matrix_get_size", [&](const mfree::SparseMatrix &m) {
     if (nrows) *nrows = m.rows();
     if (ncols) *ncols = m.cols();
     if (nnz) *nnz = m.nnz();
@@ -76,7 +71,7 @@ mfree_status_t mfree_matrix_get_size(const mfree_matrix_t *A, int32_t *nrows, in
 
 mfree_status_t mfree_matrix_get_csr(const mfree_matrix_t *A, const int64_t **rowptr,
                                     const int32_t **cols, const double **vals) {
-  return with_m(A, "mfree_matrix_get_csr", [&](const mfree::SparseMatrix &m) {
+  return mfree::with_handle(A, "mfree_matrix_get_csr", [&](const mfree::SparseMatrix &m) {
     MFREE_REQUIRE(rowptr && cols && vals, MFREE_ERR_NULL, "output pointer is NULL");
     *rowptr = m.rowptr().data();
     *cols = m.colidx().data();
@@ -87,7 +82,7 @@ mfree_status_t mfree_matrix_get_csr(const mfree_matrix_t *A, const int64_t **row
 
 mfree_status_t mfree_matrix_get_csr_i32(const mfree_matrix_t *A, const int32_t **rowptr,
                                         const int32_t **cols, const double **vals) {
-  return with_m(A, "mfree_matrix_get_csr_i32", [&](const mfree::SparseMatrix &m) {
+  return mfree::with_handle(A, "mfree_matrix_get_csr_i32", [&](const mfree::SparseMatrix &m) {
     MFREE_REQUIRE(rowptr && cols && vals, MFREE_ERR_NULL, "output pointer is NULL");
     *rowptr = m.rowptr32();
     *cols = m.colidx().data();
@@ -98,7 +93,7 @@ mfree_status_t mfree_matrix_get_csr_i32(const mfree_matrix_t *A, const int32_t *
 
 mfree_status_t mfree_matrix_get_csr_i64(const mfree_matrix_t *A, const int64_t **rowptr,
                                         const int64_t **cols, const double **vals) {
-  return with_m(A, "mfree_matrix_get_csr_i64", [&](const mfree::SparseMatrix &m) {
+  return mfree::with_handle(A, "mfree_matrix_get_csr_i64", [&](const mfree::SparseMatrix &m) {
     MFREE_REQUIRE(rowptr && cols && vals, MFREE_ERR_NULL, "output pointer is NULL");
     *rowptr = m.rowptr().data();
     *cols = m.colidx64();
@@ -109,7 +104,7 @@ mfree_status_t mfree_matrix_get_csr_i64(const mfree_matrix_t *A, const int64_t *
 
 mfree_status_t mfree_matrix_get_csc(const mfree_matrix_t *A, const int64_t **colptr,
                                     const int32_t **rows, const double **vals) {
-  return with_m(A, "mfree_matrix_get_csc", [&](const mfree::SparseMatrix &m) {
+  return mfree::with_handle(A, "mfree_matrix_get_csc", [&](const mfree::SparseMatrix &m) {
     MFREE_REQUIRE(colptr && rows && vals, MFREE_ERR_NULL, "output pointer is NULL");
     m.csc(colptr, rows, vals);
     return MFREE_SUCCESS;
@@ -117,7 +112,7 @@ mfree_status_t mfree_matrix_get_csc(const mfree_matrix_t *A, const int64_t **col
 }
 
 mfree_status_t mfree_matrix_get_pattern_id(const mfree_matrix_t *A, int64_t *id) {
-  return with_m(A, "mfree_matrix_get_pattern_id", [&](const mfree::SparseMatrix &m) {
+  return mfree::with_handle(A, "mfree_matrix_get_pattern_id", [&](const mfree::SparseMatrix &m) {
     MFREE_REQUIRE(id, MFREE_ERR_NULL, "output pointer is NULL");
     *id = m.pattern_id();
     return MFREE_SUCCESS;
@@ -125,7 +120,7 @@ mfree_status_t mfree_matrix_get_pattern_id(const mfree_matrix_t *A, int64_t *id)
 }
 
 mfree_status_t mfree_matrix_get_symmetric(const mfree_matrix_t *A, int32_t *symmetric) {
-  return with_m(A, "mfree_matrix_get_symmetric", [&](const mfree::SparseMatrix &m) {
+  return mfree::with_handle(A, "mfree_matrix_get_symmetric", [&](const mfree::SparseMatrix &m) {
     MFREE_REQUIRE(symmetric, MFREE_ERR_NULL, "output pointer is NULL");
     *symmetric = m.symmetric() ? 1 : 0;
     return MFREE_SUCCESS;
@@ -133,7 +128,7 @@ mfree_status_t mfree_matrix_get_symmetric(const mfree_matrix_t *A, int32_t *symm
 }
 
 mfree_status_t mfree_matrix_apply(const mfree_matrix_t *A, const double *x, double *y) {
-  return with_m(A, "mfree_matrix_apply", [&](const mfree::SparseMatrix &m) {
+  return mfree::with_handle(A, "mfree_matrix_apply", [&](const mfree::SparseMatrix &m) {
     MFREE_REQUIRE((x || m.cols() == 0) && (y || m.rows() == 0), MFREE_ERR_NULL, "x or y is NULL");
     m.apply(x, y);
     return MFREE_SUCCESS;

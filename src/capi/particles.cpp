@@ -16,16 +16,6 @@ void release(mfree_particles_t *p) {
 namespace {
 
 // Common prologue of every particle-set call: a NULL handle cannot carry a message.
-template <class Body>
-mfree_status_t with_set(mfree_particles_t *ps, const char *fn, Body &&body) {
-  if (!ps) return MFREE_ERR_NULL;
-  return mfree::guard(ps->ctx, fn, [&]() { return body(ps->set); });
-}
-template <class Body>
-mfree_status_t with_set(const mfree_particles_t *ps, const char *fn, Body &&body) {
-  if (!ps) return MFREE_ERR_NULL;
-  return mfree::guard(ps->ctx, fn, [&]() { return body(ps->set); });
-}
 
 }  // namespace
 
@@ -52,7 +42,7 @@ mfree_status_t mfree_particles_destroy(mfree_particles_t **ps) {
 }
 
 mfree_status_t mfree_particles_set_num_ghost(mfree_particles_t *ps, int32_t n_ghost) {
-  return with_set(ps, "mfree_particles_set_num_ghost", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_num_ghost", [&](mfree::ParticleSet &s) {
     s.set_num_ghost(n_ghost);
     return MFREE_SUCCESS;
   });
@@ -61,7 +51,7 @@ mfree_status_t mfree_particles_set_num_ghost(mfree_particles_t *ps, int32_t n_gh
 mfree_status_t mfree_particles_set_positions(mfree_particles_t *ps, const double *x,
                                              mfree_layout_t layout, int64_t ld,
                                              mfree_mem_t mem) {
-  return with_set(ps, "mfree_particles_set_positions", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_positions", [&](mfree::ParticleSet &s) {
     s.set_positions(x, layout, ld, mem);
     return MFREE_SUCCESS;
   });
@@ -69,7 +59,7 @@ mfree_status_t mfree_particles_set_positions(mfree_particles_t *ps, const double
 
 mfree_status_t mfree_particles_set_volumes(mfree_particles_t *ps, const double *v,
                                            int64_t stride, mfree_mem_t mem) {
-  return with_set(ps, "mfree_particles_set_volumes", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_volumes", [&](mfree::ParticleSet &s) {
     s.set_volumes(v, stride, mem);
     return MFREE_SUCCESS;
   });
@@ -77,7 +67,7 @@ mfree_status_t mfree_particles_set_volumes(mfree_particles_t *ps, const double *
 
 mfree_status_t mfree_particles_set_masses(mfree_particles_t *ps, const double *m,
                                           int64_t stride, mfree_mem_t mem) {
-  return with_set(ps, "mfree_particles_set_masses", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_masses", [&](mfree::ParticleSet &s) {
     s.set_masses(m, stride, mem);
     return MFREE_SUCCESS;
   });
@@ -85,7 +75,7 @@ mfree_status_t mfree_particles_set_masses(mfree_particles_t *ps, const double *m
 
 mfree_status_t mfree_particles_set_densities(mfree_particles_t *ps, const double *rho,
                                              int64_t stride, mfree_mem_t mem) {
-  return with_set(ps, "mfree_particles_set_densities", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_densities", [&](mfree::ParticleSet &s) {
     s.set_densities(rho, stride, mem);
     return MFREE_SUCCESS;
   });
@@ -93,7 +83,7 @@ mfree_status_t mfree_particles_set_densities(mfree_particles_t *ps, const double
 
 mfree_status_t mfree_particles_set_support(mfree_particles_t *ps, const double *h,
                                            int64_t stride, mfree_mem_t mem) {
-  return with_set(ps, "mfree_particles_set_support", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_support", [&](mfree::ParticleSet &s) {
     s.set_support(h, stride, mem);
     return MFREE_SUCCESS;
   });
@@ -101,7 +91,7 @@ mfree_status_t mfree_particles_set_support(mfree_particles_t *ps, const double *
 
 mfree_status_t mfree_particles_set_search(mfree_particles_t *ps, mfree_search_t convention,
                                           double kappa) {
-  return with_set(ps, "mfree_particles_set_search", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_search", [&](mfree::ParticleSet &s) {
     s.set_search(convention, kappa);
     return MFREE_SUCCESS;
   });
@@ -109,7 +99,7 @@ mfree_status_t mfree_particles_set_search(mfree_particles_t *ps, mfree_search_t 
 
 mfree_status_t mfree_particles_set_periodic(mfree_particles_t *ps, const double *lo,
                                             const double *hi, const int32_t *periodic) {
-  return with_set(ps, "mfree_particles_set_periodic", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_periodic", [&](mfree::ParticleSet &s) {
     s.set_periodic(lo, hi, periodic);
     return MFREE_SUCCESS;
   });
@@ -118,26 +108,26 @@ mfree_status_t mfree_particles_set_periodic(mfree_particles_t *ps, const double 
 mfree_status_t mfree_particles_set_neighbors(mfree_particles_t *ps, const int64_t *rowptr,
                                              const int32_t *cols, int32_t index_base,
                                              mfree_mem_t mem) {
-  return with_set(ps, "mfree_particles_set_neighbors", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_set_neighbors", [&](mfree::ParticleSet &s) {
     s.set_neighbors(rowptr, cols, index_base, mem);
     return MFREE_SUCCESS;
   });
 }
 
 mfree_status_t mfree_particles_setup(mfree_particles_t *ps) {
-  return with_set(ps, "mfree_particles_setup", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_setup", [&](mfree::ParticleSet &s) {
     return mfree::finish(ps->ctx, "mfree_particles_setup", s.setup());
   });
 }
 
 mfree_status_t mfree_particles_update(mfree_particles_t *ps) {
-  return with_set(ps, "mfree_particles_update", [&](mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_update", [&](mfree::ParticleSet &s) {
     return mfree::finish(ps->ctx, "mfree_particles_update", s.update());
   });
 }
 
 mfree_status_t mfree_particles_get_dimension(const mfree_particles_t *ps, int32_t *dim) {
-  return with_set(ps, "mfree_particles_get_dimension", [&](const mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_get_dimension", [&](const mfree::ParticleSet &s) {
     MFREE_REQUIRE(dim, MFREE_ERR_NULL, "output pointer is NULL");
     *dim = s.dim();
     return MFREE_SUCCESS;
@@ -146,7 +136,7 @@ mfree_status_t mfree_particles_get_dimension(const mfree_particles_t *ps, int32_
 
 mfree_status_t mfree_particles_get_size(const mfree_particles_t *ps, int32_t *n,
                                         int32_t *n_ghost) {
-  return with_set(ps, "mfree_particles_get_size", [&](const mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_get_size", [&](const mfree::ParticleSet &s) {
     if (n) *n = s.size();
     if (n_ghost) *n_ghost = s.num_ghost();
     return MFREE_SUCCESS;
@@ -154,7 +144,7 @@ mfree_status_t mfree_particles_get_size(const mfree_particles_t *ps, int32_t *n,
 }
 
 mfree_status_t mfree_particles_get_neighbor_nnz(const mfree_particles_t *ps, int64_t *nnz) {
-  return with_set(ps, "mfree_particles_get_neighbor_nnz", [&](const mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_get_neighbor_nnz", [&](const mfree::ParticleSet &s) {
     MFREE_REQUIRE(nnz, MFREE_ERR_NULL, "output pointer is NULL");
     MFREE_REQUIRE(s.is_setup(), MFREE_ERR_STATE, "the particle set is not set up");
     *nnz = s.neighbors().nnz();
@@ -164,7 +154,7 @@ mfree_status_t mfree_particles_get_neighbor_nnz(const mfree_particles_t *ps, int
 
 mfree_status_t mfree_particles_get_neighbors(const mfree_particles_t *ps, int64_t *rowptr,
                                              int32_t *cols) {
-  return with_set(ps, "mfree_particles_get_neighbors", [&](const mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_get_neighbors", [&](const mfree::ParticleSet &s) {
     MFREE_REQUIRE(s.is_setup(), MFREE_ERR_STATE, "the particle set is not set up");
     const mfree::Csr &g = s.neighbors();
     MFREE_REQUIRE(rowptr, MFREE_ERR_NULL, "rowptr is NULL");
@@ -176,7 +166,7 @@ mfree_status_t mfree_particles_get_neighbors(const mfree_particles_t *ps, int64_
 }
 
 mfree_status_t mfree_particles_get_volumes(const mfree_particles_t *ps, double *v) {
-  return with_set(ps, "mfree_particles_get_volumes", [&](const mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_get_volumes", [&](const mfree::ParticleSet &s) {
     MFREE_REQUIRE(v || s.size() == 0, MFREE_ERR_NULL, "output pointer is NULL");
     MFREE_REQUIRE(s.has_volumes(), MFREE_ERR_STATE,
                   "neither volumes nor both masses and densities are set");
@@ -187,7 +177,7 @@ mfree_status_t mfree_particles_get_volumes(const mfree_particles_t *ps, double *
 
 mfree_status_t mfree_particles_get_site_status(const mfree_particles_t *ps, int32_t *status,
                                                int32_t *nfailed) {
-  return with_set(ps, "mfree_particles_get_site_status", [&](const mfree::ParticleSet &s) {
+  return mfree::with_handle(ps, "mfree_particles_get_site_status", [&](const mfree::ParticleSet &s) {
     MFREE_REQUIRE(status || nfailed, MFREE_ERR_NULL, "both outputs are NULL");
     MFREE_REQUIRE(s.is_setup(), MFREE_ERR_STATE, "the particle set is not set up");
     const auto &st = s.site_status();

@@ -6,25 +6,17 @@ struct mfree_system {
   mfree_context_t *ctx = nullptr;
   mfree::FluidSystem sys;
   mfree_system(mfree_context_t *c, int dim, int32_t n) : ctx(c), sys(dim, n) {}
+  mfree::FluidSystem &core() { return sys; }
+  const mfree::FluidSystem &core() const { return sys; }
 };
 
 namespace {
 
-template <class Body>
-mfree_status_t with_sys(mfree_system_t *s, const char *fn, Body &&body) {
-  if (!s) return MFREE_ERR_NULL;
-  return mfree::guard(s->ctx, fn, [&]() { return body(s->sys); });
-}
-template <class Body>
-mfree_status_t with_sys(const mfree_system_t *s, const char *fn, Body &&body) {
-  if (!s) return MFREE_ERR_NULL;
-  return mfree::guard(s->ctx, fn, [&]() { return body(s->sys); });
-}
 
 // Fill *M (created when NULL) through a core routine that writes a SparseMatrix.
 template <class Fill>
 mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, mfree_matrix_t **M, Fill &&fill) {
-  return with_sys(s, fn, [&](mfree::FluidSystem &f) {
+  return mfree::with_handle(s, fn, [&](mfree::FluidSystem &f) {
     MFREE_REQUIRE(M, MFREE_ERR_NULL, "output pointer is NULL");
     mfree_matrix_t *m = *M;
     bool fresh = false;
@@ -79,7 +71,7 @@ mfree_status_t mfree_system_destroy(mfree_system_t **sys) {
 }
 
 #define MFREE_SYS_SETTER(name, call)                              \
-  return with_sys(sys, name, [&](mfree::FluidSystem &f) {         \
+  return mfree::with_handle(sys, name, [&](mfree::FluidSystem &f) {         \
     call;                                                         \
     return MFREE_SUCCESS;                                         \
   })
@@ -109,7 +101,7 @@ mfree_status_t mfree_system_set_box(mfree_system_t *sys, const double *lo, const
 }
 
 mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
-  return with_sys(sys, "mfree_system_get_size", [&](const mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_get_size", [&](const mfree::FluidSystem &f) {
     MFREE_REQUIRE(neq, MFREE_ERR_NULL, "output pointer is NULL");
     *neq = f.neq();
     return MFREE_SUCCESS;
@@ -117,7 +109,7 @@ mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
 }
 
 mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y, double *ydot) {
-  return with_sys(sys, "mfree_system_rhs", [&](mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_rhs", [&](mfree::FluidSystem &f) {
     MFREE_REQUIRE((y && ydot) || f.neq() == 0, MFREE_ERR_NULL, "y or ydot is NULL");
     return mfree::finish(sys->ctx, "mfree_system_rhs", f.rhs(t, y, ydot));
   });
@@ -140,7 +132,7 @@ mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys, const do
 }
 
 mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double *y, double *p) {
-  return with_sys(sys, "mfree_system_get_pressure", [&](const mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_get_pressure", [&](const mfree::FluidSystem &f) {
     MFREE_REQUIRE((y && p) || f.size() == 0, MFREE_ERR_NULL, "y or p is NULL");
     f.pressure(y, p);
     return MFREE_SUCCESS;
@@ -148,7 +140,7 @@ mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double
 }
 
 mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, double *vhat) {
-  return with_sys(sys, "mfree_system_get_velocity", [&](mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_get_velocity", [&](mfree::FluidSystem &f) {
     MFREE_REQUIRE((y && vhat) || f.size() == 0, MFREE_ERR_NULL, "y or vhat is NULL");
     return mfree::finish(sys->ctx, "mfree_system_get_velocity", f.velocity(y, vhat));
   });
@@ -157,7 +149,7 @@ mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, d
 mfree_status_t mfree_system_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t,
                                       double t_end, double cfl, double dt_max, mfree_progress_fn progress,
                                       void *user, int64_t *nsteps) {
-  return with_sys(sys, "mfree_system_integrate", [&](mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_integrate", [&](mfree::FluidSystem &f) {
     MFREE_REQUIRE(t && (y || f.neq() == 0), MFREE_ERR_NULL, "y or t is NULL");
     int64_t steps = 0;
     mfree::Report rep = f.integrate(scheme, y, *t, t_end, cfl, dt_max, progress, user, steps);

@@ -229,6 +229,24 @@ int mls(Site &s, int order, bool rkpm) {
   return 0;
 }
 
+// Methods that estimate Taylor coefficients Q_alpha (SSPH, KB Method 2, MSPH) read the
+// value, gradient and Hessian rows off the same coefficients: f = Q_0,
+// df/dx_i = Q_{e_i} / hs, d2f/dx_i dx_k = alpha! Q_{e_i + e_k} / hs^2. row(m, scale,
+// dst, stride) writes the shape functions of coefficient m.
+template <class Row>
+void write_coefficient_rows(Site &s, const Basis &B, double ih, Row &&row) {
+  const int dim = s.dim;
+  if (s.cfg.want_value) row(0, 1.0, s.out.phi, 1);
+  if (s.cfg.want_grad)
+    for (int i = 0; i < dim; ++i) row(B.linear(i), ih, s.out.grad + i, dim);
+  if (s.cfg.want_hess)
+    for (int i = 0; i < dim; ++i)
+      for (int k = i; k < dim; ++k) {
+        const int m = B.quadratic(i, k);
+        row(m, B.factorial(m) * ih * ih, s.out.hess + hessian_index(dim, i, k), s.nh);
+      }
+}
+
 // Weighted Taylor fit (SSPH, 001 eqs 3.3-3.10, weights W V; KB Method 2, 000 eqs 63-64,
 // weights phi^S): K = sum omega p p^T, Q = K^-1 sum omega p f. Value Q_0, derivatives
 // alpha! Q_alpha / hs^|alpha|; the kernel is never differentiated.
@@ -262,15 +280,7 @@ int taylor_fit(Site &s, int order, const double *omega) {
       dst[j * stride] = scale * omega[j] * t;
     }
   };
-  if (s.cfg.want_value) row(0, 1.0, s.out.phi, 1);
-  if (s.cfg.want_grad)
-    for (int i = 0; i < dim; ++i) row(B.linear(i), ih, s.out.grad + i, dim);
-  if (s.cfg.want_hess)
-    for (int i = 0; i < dim; ++i)
-      for (int k = i; k < dim; ++k) {
-        const int m = B.quadratic(i, k);
-        row(m, B.factorial(m) * ih * ih, s.out.hess + hessian_index(dim, i, k), s.nh);
-      }
+  write_coefficient_rows(s, B, ih, row);
   return 0;
 }
 
@@ -320,15 +330,7 @@ int msph(Site &s, int order) {
       dst[j * stride] = scale * t * s.in.vol[j];
     }
   };
-  if (s.cfg.want_value) row(0, 1.0, s.out.phi, 1);
-  if (s.cfg.want_grad)
-    for (int i = 0; i < dim; ++i) row(B.linear(i), ih, s.out.grad + i, dim);
-  if (s.cfg.want_hess)
-    for (int i = 0; i < dim; ++i)
-      for (int k = i; k < dim; ++k) {
-        const int m = B.quadratic(i, k);
-        row(m, B.factorial(m) * ih * ih, s.out.hess + hessian_index(dim, i, k), s.nh);
-      }
+  write_coefficient_rows(s, B, ih, row);
   return 0;
 }
 
