@@ -226,6 +226,8 @@ typedef struct mfree_system mfree_system_t;
 /** Progress of a native integration: called after every accepted step; a nonzero
  * return stops the integration (MFREE_SUCCESS is returned, t tells where). */
 typedef int32_t (*mfree_progress_fn)(void *user, int64_t step, double t, double dt);
+/** A load history g(t): scales the boundary data of an elastodynamic system. */
+typedef double (*mfree_history_fn)(void *user, double t);
 
 /** A host function of position: writes ncomp values at x (dim coordinates). */
 typedef void (*mfree_field_fn)(void *user, const double *x, double *value);
@@ -838,6 +840,28 @@ MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
                                                 double *t, double t_end, double cfl,
                                                 double dt_max, mfree_progress_fn progress,
                                                 void *user, int64_t *nsteps);
+
+/**
+ * Linear elastodynamics by strong-form collocation (paper 001 Sect. 6.4): rho u'' =
+ * Navier(u) + b at the interior particles of a set-up collocation assembler
+ * (MFREE_FORM_COLLOCATION_PLANE_STRESS/STRAIN; MFREE_FORM_COLLOCATION_LAPLACE with c = E
+ * gives the 1D bar rho u'' = E u''), its traction and displacement rows kept as
+ * constraints that fix the boundary particles' displacements at every evaluation (the
+ * boundary data scaled by the load history g(t), default 1). State y: displacements then
+ * velocities (ncomp per particle each); the entries of the boundary unknowns are
+ * overwritten. The system keeps the assembler alive; integrate with
+ * MFREE_INTEGRATOR_LEAPFROG (central differences, CFL dt <= dx_min / c).
+ */
+MFREE_API mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx,
+                                                           mfree_assembler_t *as,
+                                                           double density,
+                                                           mfree_system_t **sys);
+MFREE_API mfree_status_t mfree_system_set_load_history(mfree_system_t *sys,
+                                                       mfree_history_fn g, void *user);
+/** Stress at the particles (1D: sigma = E u'; 2D: xx, yy, xy), boundary constraints
+ * applied at time t. */
+MFREE_API mfree_status_t mfree_system_get_stress(mfree_system_t *sys, double t,
+                                                 const double *y, double *sigma);
 
 #ifdef __cplusplus
 }

@@ -1,21 +1,7 @@
 #include "core/assembler.hpp"
 #include "handles.hpp"
 
-struct mfree_assembler {
-  std::atomic<int> refs{1};
-  mfree_context_t *ctx = nullptr;
-  mfree_particles_t *ps = nullptr;  // retained
-  mfree::Assembler as;
-  mfree_assembler(mfree_context_t *c, mfree_particles_t *p, const mfree::ApproxConfig &trial,
-                  const mfree::ApproxConfig &test, bool bubnov, int form)
-      : ctx(c), ps(p), as(&p->set, trial, test, bubnov, form) {}
-  mfree::Assembler &core() { return as; }
-  const mfree::Assembler &core() const { return as; }
-};
-
-namespace {
-
-void release_assembler(mfree_assembler_t *a) {
+void mfree::release(mfree_assembler_t *a) {
   if (a && a->refs.fetch_sub(1, std::memory_order_acq_rel) == 1) {
     mfree_particles_t *p = a->ps;
     mfree_context_t *c = a->ctx;
@@ -25,8 +11,6 @@ void release_assembler(mfree_assembler_t *a) {
   }
 }
 
-
-}  // namespace
 
 extern "C" {
 
@@ -52,7 +36,7 @@ mfree_status_t mfree_assembler_create(mfree_context_t *ctx, const mfree_approxim
 
 mfree_status_t mfree_assembler_destroy(mfree_assembler_t **as) {
   if (!as || !*as) return MFREE_SUCCESS;
-  release_assembler(*as);
+  mfree::release(*as);
   *as = nullptr;
   return MFREE_SUCCESS;
 }

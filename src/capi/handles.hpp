@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/approximant.hpp"
+#include "core/assembler.hpp"
 #include "core/error.hpp"
 #include "core/matrix.hpp"
 #include "core/particles.hpp"
@@ -50,6 +51,18 @@ struct mfree_matrix {
   const mfree::SparseMatrix &core() const { return m; }
 };
 
+struct mfree_assembler {
+  std::atomic<int> refs{1};
+  mfree_context_t *ctx = nullptr;
+  mfree_particles_t *ps = nullptr;  // retained
+  mfree::Assembler as;
+  mfree_assembler(mfree_context_t *c, mfree_particles_t *p, const mfree::ApproxConfig &trial,
+                  const mfree::ApproxConfig &test, bool bubnov, int form)
+      : ctx(c), ps(p), as(&p->set, trial, test, bubnov, form) {}
+  mfree::Assembler &core() { return as; }
+  const mfree::Assembler &core() const { return as; }
+};
+
 namespace mfree {
 
 void retain(mfree_context_t *c);
@@ -57,6 +70,7 @@ void release(mfree_context_t *c);
 void retain(mfree_particles_t *p);
 void release(mfree_particles_t *p);
 void release(mfree_matrix_t *m);
+void release(mfree_assembler_t *a);
 
 // Record a failure (or a positive report) on the context; returns status unchanged.
 mfree_status_t record(mfree_context_t *ctx, mfree_status_t status, const char *fn,

@@ -1,22 +1,37 @@
+#include "core/elastodynamics.hpp"
 #include "core/fluid.hpp"
 #include "handles.hpp"
 
 struct mfree_system {
   std::atomic<int> refs{1};
   mfree_context_t *ctx = nullptr;
-  mfree::FluidSystem sys;
-  mfree_system(mfree_context_t *c, int dim, int32_t n) : ctx(c), sys(dim, n) {}
-  mfree::FluidSystem &core() { return sys; }
-  const mfree::FluidSystem &core() const { return sys; }
+  mfree_assembler_t *as = nullptr;  // retained by elastodynamic systems
+  std::unique_ptr<mfree::System> sys;
+  mfree::System &core() { return *sys; }
+  const mfree::System &core() const { return *sys; }
 };
 
 namespace {
+
+// The concrete kind a kind-specific call needs, or MFREE_ERR_UNSUPPORTED.
+template <class T>
+T &kind(mfree::System &s, const char *what) {
+  T *t = dynamic_cast<T *>(&s);
+  if (!t) throw mfree::Error(MFREE_ERR_UNSUPPORTED, std::string("this system has no ") + what);
+  return *t;
+}
+template <class T>
+const T &kind(const mfree::System &s, const char *what) {
+  const T *t = dynamic_cast<const T *>(&s);
+  if (!t) throw mfree::Error(MFREE_ERR_UNSUPPORTED, std::string("this system has no ") + what);
+  return *t;
+}
 
 
 // Fill *M (created when NULL) through a core routine that writes a SparseMatrix.
 template <class Fill>
 mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, mfree_matrix_t **M, Fill &&fill) {
-  return mfree::with_handle(s, fn, [&](mfree::FluidSystem &f) {
+  return mfree::with_handle(s, fn, [&](mfree::System &f) {
     MFREE_REQUIRE(M, MFREE_ERR_NULL, "output pointer is NULL");
     mfree_matrix_t *m = *M;
     bool fresh = false;
@@ -51,7 +66,10 @@ mfree_status_t mfree_system_create_fluid(mfree_context_t *ctx, int32_t dim, int3
     MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
     *sys = nullptr;
     MFREE_REQUIRE(n >= 0, MFREE_ERR_ARG, "particle count " + std::to_string(n) + " is negative");
-    auto *s = new mfree_system_t(ctx, dim, n);
+    auto impl = std::make_unique<mfree::FluidSystem>(dim, n);
+    auto *s = new mfree_system_t();
+    s->ctx = ctx;
+    s->sys = std::move(impl);
     mfree::retain(ctx);
     *sys = s;
     return MFREE_SUCCESS;
@@ -63,17 +81,20 @@ mfree_status_t mfree_system_destroy(mfree_system_t **sys) {
   mfree_system_t *s = *sys;
   if (s->refs.fetch_sub(1, std::memory_order_acq_rel) == 1) {
     mfree_context_t *c = s->ctx;
+    mfree_assembler_t *a = s->as;
     delete s;
+    mfree::release(a);
     mfree::release(c);
   }
   *sys = nullptr;
   return MFREE_SUCCESS;
 }
 
-#define MFREE_SYS_SETTER(name, call)                              \
-  return mfree::with_handle(sys, name, [&](mfree::FluidSystem &f) {         \
-    call;                                                         \
-    return MFREE_SUCCESS;                                         \
+#define MFREE_SYS_SETTER(name, call)                                          \
+  return mfree::with_handle(sys, name, [&](mfree::System &base) {             \
+    auto &f = kind<mfree::FluidSystem>(base, "fluid parameters (not a fluid)"); \
+    call;                                                                     \
+    return MFREE_SUCCESS;                                                     \
   })
 
 mfree_status_t mfree_system_set_fluid(mfree_system_t *sys, const double *rho0, int64_t stride, double kappa,
@@ -101,7 +122,7 @@ mfree_status_t mfree_system_set_box(mfree_system_t *sys, const double *lo, const
 }
 
 mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
-  return mfree::with_handle(sys, "mfree_system_get_size", [&](const mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_get_size", [&](const mfree::System &f) {
     MFREE_REQUIRE(neq, MFREE_ERR_NULL, "output pointer is NULL");
     *neq = f.neq();
     return MFREE_SUCCESS;
@@ -109,7 +130,7 @@ mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
 }
 
 mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y, double *ydot) {
-  return mfree::with_handle(sys, "mfree_system_rhs", [&](mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_rhs", [&](mfree::System &f) {
     MFREE_REQUIRE((y && ydot) || f.neq() == 0, MFREE_ERR_NULL, "y or ydot is NULL");
     return mfree::finish(sys->ctx, "mfree_system_rhs", f.rhs(t, y, ydot));
   });
@@ -117,22 +138,24 @@ mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y, 
 
 mfree_status_t mfree_system_assemble_mass(mfree_system_t *sys, const double *y, int32_t consistent,
                                           mfree_matrix_t **M) {
-  if (sys && !y && sys->sys.neq() > 0)
+  if (sys && !y && sys->sys->neq() > 0)
     return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_mass", "y is NULL");
-  return fill_matrix(sys, "mfree_system_assemble_mass", M, [&](mfree::FluidSystem &f, mfree::SparseMatrix &m) {
+  return fill_matrix(sys, "mfree_system_assemble_mass", M, [&](mfree::System &f, mfree::SparseMatrix &m) {
     return f.mass(y, consistent != 0, m);
   });
 }
 
 mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys, const double *y, mfree_matrix_t **S) {
-  if (sys && !y && sys->sys.neq() > 0)
+  if (sys && !y && sys->sys->neq() > 0)
     return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_interpolation", "y is NULL");
-  return fill_matrix(sys, "mfree_system_assemble_interpolation", S,
-                     [&](mfree::FluidSystem &f, mfree::SparseMatrix &m) { return f.interpolation(y, m); });
+  return fill_matrix(sys, "mfree_system_assemble_interpolation", S, [&](mfree::System &f, mfree::SparseMatrix &m) {
+    return kind<mfree::FluidSystem>(f, "interpolation matrix (not a fluid)").interpolation(y, m);
+  });
 }
 
 mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double *y, double *p) {
-  return mfree::with_handle(sys, "mfree_system_get_pressure", [&](const mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_get_pressure", [&](const mfree::System &base) {
+    const auto &f = kind<mfree::FluidSystem>(base, "pressure (not a fluid)");
     MFREE_REQUIRE((y && p) || f.size() == 0, MFREE_ERR_NULL, "y or p is NULL");
     f.pressure(y, p);
     return MFREE_SUCCESS;
@@ -140,7 +163,8 @@ mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double
 }
 
 mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, double *vhat) {
-  return mfree::with_handle(sys, "mfree_system_get_velocity", [&](mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_get_velocity", [&](mfree::System &base) {
+    auto &f = kind<mfree::FluidSystem>(base, "interpolated velocity (not a fluid)");
     MFREE_REQUIRE((y && vhat) || f.size() == 0, MFREE_ERR_NULL, "y or vhat is NULL");
     return mfree::finish(sys->ctx, "mfree_system_get_velocity", f.velocity(y, vhat));
   });
@@ -149,12 +173,47 @@ mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, d
 mfree_status_t mfree_system_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t,
                                       double t_end, double cfl, double dt_max, mfree_progress_fn progress,
                                       void *user, int64_t *nsteps) {
-  return mfree::with_handle(sys, "mfree_system_integrate", [&](mfree::FluidSystem &f) {
+  return mfree::with_handle(sys, "mfree_system_integrate", [&](mfree::System &f) {
     MFREE_REQUIRE(t && (y || f.neq() == 0), MFREE_ERR_NULL, "y or t is NULL");
     int64_t steps = 0;
     mfree::Report rep = f.integrate(scheme, y, *t, t_end, cfl, dt_max, progress, user, steps);
     if (nsteps) *nsteps = steps;
     return mfree::finish(sys->ctx, "mfree_system_integrate", rep);
+  });
+}
+
+mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx, mfree_assembler_t *as, double density,
+                                                mfree_system_t **sys) {
+  if (!ctx) return MFREE_ERR_NULL;
+  return mfree::guard(ctx, "mfree_system_create_elastodynamic", [&]() {
+    MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
+    *sys = nullptr;
+    MFREE_REQUIRE(as, MFREE_ERR_NULL, "assembler is NULL");
+    auto impl = std::make_unique<mfree::ElasticSystem>(&as->as, density);
+    auto *s = new mfree_system_t();
+    s->ctx = ctx;
+    s->as = as;
+    s->sys = std::move(impl);
+    mfree::retain(ctx);
+    as->refs.fetch_add(1, std::memory_order_relaxed);
+    *sys = s;
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_set_load_history(mfree_system_t *sys, mfree_history_fn g, void *user) {
+  return mfree::with_handle(sys, "mfree_system_set_load_history", [&](mfree::System &base) {
+    kind<mfree::ElasticSystem>(base, "load history (not elastodynamic)").set_load_history(g, user);
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_get_stress(mfree_system_t *sys, double t, const double *y, double *sigma) {
+  return mfree::with_handle(sys, "mfree_system_get_stress", [&](mfree::System &base) {
+    const auto &e = kind<mfree::ElasticSystem>(base, "stress output (not elastodynamic)");
+    MFREE_REQUIRE(y && sigma, MFREE_ERR_NULL, "y or sigma is NULL");
+    e.stress(t, y, sigma);
+    return MFREE_SUCCESS;
   });
 }
 

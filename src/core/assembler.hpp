@@ -48,6 +48,18 @@ class Assembler {
   void assemble_matrix(SparseMatrix &K) const;
   void assemble_rhs(double *f) const;
 
+  // For systems built on a collocation assembler: the form, components per particle,
+  // which rows the boundary conditions replaced, and the trial tables at the particles.
+  int form() const { return form_; }
+  int ncomp() const { return ncomp_; }
+  bool is_collocation() const { return collocation(); }
+  const std::vector<int32_t> &row_kinds() const { return row_kind_; }
+  const Approximant *collocation_tables() const { return collocation() ? trial_q_.get() : nullptr; }
+  double young() const { return young_; }
+  double poisson() const { return poisson_; }
+  double coefficient() const { return coef_; }
+  const ParticleSet &particles() const { return *ps_; }
+
  private:
   struct PointSet {  // boundary points with weights
     int kind = 0;    // 1 traction, 2 penalty, 3 Lagrange, 4 Nitsche

@@ -12,10 +12,11 @@
 #include "matrix.hpp"
 #include "mfree.h"
 #include "particles.hpp"
+#include "system.hpp"
 
 namespace mfree {
 
-class FluidSystem {
+class FluidSystem : public System {
  public:
   FluidSystem(int dim, int32_t n);
 
@@ -29,15 +30,15 @@ class FluidSystem {
 
   int dim() const { return dim_; }
   int32_t size() const { return n_; }
-  int32_t neq() const { return (2 * dim_ + 1) * n_; }
+  int32_t neq() const override { return (2 * dim_ + 1) * n_; }
 
-  Report rhs(double t, const double *y, double *ydot);
-  Report mass(const double *y, bool consistent, SparseMatrix &M);
+  Report rhs(double t, const double *y, double *ydot) override;
+  Report mass(const double *y, bool consistent, SparseMatrix &M) override;
   Report interpolation(const double *y, SparseMatrix &S);
   void pressure(const double *y, double *p) const;
   Report velocity(const double *y, double *vhat);
   Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
-                   mfree_progress_fn progress, void *user, int64_t &nsteps);
+                   mfree_progress_fn progress, void *user, int64_t &nsteps) override;
 
  private:
   void check_ready() const;

@@ -1,0 +1,56 @@
+// Linear elastodynamics by strong-form collocation (paper 001 Sect. 6.4): rho u'' =
+// Navier(u) + b at interior particles, boundary rows (tractions, displacements) kept as
+// algebraic constraints, solved for the boundary unknowns at every evaluation.
+#pragma once
+
+#include <Eigen/SparseLU>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "assembler.hpp"
+#include "system.hpp"
+
+namespace mfree {
+
+class ElasticSystem : public System {
+ public:
+  // as: a set-up collocation assembler (its matrix and right-hand side define the
+  // operator and the boundary data); the caller keeps it alive.
+  ElasticSystem(const Assembler *as, double density);
+
+  void set_load_history(double (*fn)(void *, double), void *user);
+
+  int32_t neq() const override { return 2 * nd_; }
+  Report rhs(double t, const double *y, double *ydot) override;
+  Report mass(const double *y, bool consistent, SparseMatrix &M) override;
+  Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
+                   mfree_progress_fn progress, void *user, int64_t &nsteps) override;
+
+  int stress_components() const { return dim_ == 1 ? 1 : (dim_ == 2 ? 3 : 6); }
+  // Stress at the particles from the displacements of y (boundary unknowns enforced).
+  void stress(double t, const double *y, double *sigma) const;
+  double wave_speed() const { return c_; }
+  double min_spacing() const { return dx_min_; }
+
+ private:
+  double history(double t) const { return hist_ ? hist_(hist_user_, t) : 1.0; }
+  void enforce_boundary(double t, double *u) const;
+  void accel(const double *u, double *a) const;
+  Report check(const double *y, const std::string &when) const;
+
+  const Assembler *as_;
+  double rho_;
+  int dim_, nc_;
+  int32_t nd_;
+  SparseMatrix K_;
+  std::vector<double> f0_;
+  std::vector<int32_t> bdofs_, bpos_;  // boundary dofs and each dof's position among them
+  std::unique_ptr<Eigen::SparseLU<Eigen::SparseMatrix<double>>> lu_;
+  double (*hist_)(void *, double) = nullptr;
+  void *hist_user_ = nullptr;
+  double c_ = 0.0, dx_min_ = 0.0;
+  mutable std::vector<double> rb_, work_;
+};
+
+}  // namespace mfree

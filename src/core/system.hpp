@@ -1,0 +1,23 @@
+// Semi-discrete particle systems y' = f(t, y): the interface shared by the fluid of
+// paper 003 and the elastodynamic collocation system of paper 001.
+#pragma once
+
+#include <cstdint>
+
+#include "error.hpp"
+#include "matrix.hpp"
+#include "mfree.h"
+
+namespace mfree {
+
+class System {
+ public:
+  virtual ~System() = default;
+  virtual int32_t neq() const = 0;
+  virtual Report rhs(double t, const double *y, double *ydot) = 0;
+  virtual Report mass(const double *y, bool consistent, SparseMatrix &M) = 0;
+  virtual Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
+                           mfree_progress_fn progress, void *user, int64_t &nsteps) = 0;
+};
+
+}  // namespace mfree
