@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "kernel.hpp"
+
 namespace mfree {
 
 FluidSystem::FluidSystem(int dim, int32_t n) : dim_(dim), n_(n), ps_(dim, n) {
@@ -148,6 +150,7 @@ Report FluidSystem::prepare(const double *y) {
   }
   r = approx_->setup();
   if (!r.ok()) return r;
+  shepard_ill_conditioned();
   if (walls_) {
     VectorArray xa;
     xa.ptr = y;
@@ -162,11 +165,52 @@ Report FluidSystem::prepare(const double *y) {
   return rep;
 }
 
+void FluidSystem::shepard_ill_conditioned() {
+  // 003 Sect. 6: where the linear-basis moment matrix is ill-conditioned, not only
+  // singular, the constant basis is used: Shepard functions N_j = W_j V_j / sum W V. The
+  // paper gives no tolerance. A lattice site has a condition estimate of 10-15, a free
+  // edge or corner 30-60; a particle left in a thin sheet or strand climbs past 1e3 within
+  // a few steps, and its gradients then drive the density negative in one step (dam
+  // break along the wall, T ~ 2.2, at every resolution and CFL number tried).
+  N_ = approx_->values();
+  G_ = approx_->gradients();
+  const auto &cond = approx_->site_cond();
+  const auto &rp = approx_->rowptr();
+  const auto &cols = approx_->cols();
+  constexpr double tol = 100.0;
+  const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim_, 0.0);
+  for (int32_t k = 0; k < n_; ++k) {
+    if (!(cond[k] > tol)) continue;
+    double S = 0.0, dS[3] = {0, 0, 0};
+    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
+      const int32_t j = cols[e];
+      double r2 = 0.0, dx[3] = {0, 0, 0};
+      for (int c = 0; c < dim_; ++c) {
+        dx[c] = ps_.x(k, c) - ps_.x(j, c);
+        r2 += dx[c] * dx[c];
+      }
+      const double r = std::sqrt(r2);
+      double w, dw, d2w;
+      kern.eval(r, h_, w, dw, d2w);
+      N_[e] = w * vol_[j];
+      S += N_[e];
+      for (int c = 0; c < dim_; ++c) {
+        G_[e * dim_ + c] = r > 0.0 ? dw * dx[c] / r * vol_[j] : 0.0;
+        dS[c] += G_[e * dim_ + c];
+      }
+    }
+    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
+      N_[e] /= S;
+      for (int c = 0; c < dim_; ++c) G_[e * dim_ + c] = (G_[e * dim_ + c] - N_[e] * dS[c]) / S;
+    }
+  }
+}
+
 void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, double *drho) const {
   const auto &rp = approx_->rowptr();
   const auto &cols = approx_->cols();
-  const auto &N = approx_->values();
-  const auto &G = approx_->gradients();
+  const auto &N = N_;
+  const auto &G = G_;
   for (int32_t k = 0; k < n_; ++k) {
     double vh[3] = {0, 0, 0}, div = 0.0;
     for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
@@ -187,8 +231,8 @@ Report FluidSystem::accel(const double *v, const double *rho, double *a) {
   const int dim = dim_;
   const auto &rp = approx_->rowptr();
   const auto &cols = approx_->cols();
-  const auto &N = approx_->values();
-  const auto &G = approx_->gradients();
+  const auto &N = N_;
+  const auto &G = G_;
   force_.assign(static_cast<size_t>(n_) * dim, 0.0);
   lumped_.assign(n_, 0.0);
   fb_.assign(static_cast<size_t>(n_) * dim, 0.0);
@@ -291,7 +335,7 @@ Report FluidSystem::interpolation(const double *y, SparseMatrix &S) {
   // rows are not guaranteed sorted by column: sort each row with its values
   std::vector<int64_t> rp = approx_->rowptr();
   std::vector<int32_t> cols = approx_->cols();
-  std::vector<double> vals = approx_->values();
+  std::vector<double> vals = N_;
   for (int32_t k = 0; k < n_; ++k) {
     std::vector<std::pair<int32_t, double>> row;
     for (int64_t e = rp[k]; e < rp[k + 1]; ++e) row.push_back({cols[e], vals[e]});
@@ -313,7 +357,7 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   const size_t nd = static_cast<size_t>(dim) * n_;
   const auto &rp = approx_->rowptr();
   const auto &cols = approx_->cols();
-  const auto &N = approx_->values();
+  const auto &N = N_;
   // node-level velocity block: consistent m_ij = sum_k N_i(x_k) N_j(x_k) M_k (003 eq 42),
   // or the lumped row sums
   std::vector<std::vector<std::pair<int32_t, double>>> rows(n_);

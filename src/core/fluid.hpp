@@ -46,6 +46,9 @@ class FluidSystem : public System {
   Report prepare(const double *y);
   // Acceleration parameters a (dim per particle) from the prepared tables and v, rho.
   Report accel(const double *v, const double *rho, double *a);
+  // Copies the approximant's tables into N_, G_ and replaces the rows of ill-conditioned
+  // sites by Shepard functions (003 Sect. 6).
+  void shepard_ill_conditioned();
   // Interpolated velocities and density rates for velocity parameters v.
   void kinematics(const double *v, const double *rho, double *vhat, double *drho) const;
   double stable_dt(const double *y) const;  // h / max(c_i + |v_i|)
@@ -65,6 +68,7 @@ class FluidSystem : public System {
 
   ParticleSet ps_;
   std::vector<double> vol_;
+  std::vector<double> N_, G_;  // shape-function values and gradients used by the model
   std::unique_ptr<Approximant> approx_;
   Csr wall_nbr_;
   // scratch (reused, sized once)

@@ -1,0 +1,2357 @@
+!> module mfree: Fortran 2008 bindings of the mfree C ABI (include/mfree.h).
+!>
+!> Two layers, both public:
+!>  - raw interfaces named <C name>_c, one per public C function, bound with
+!>    bind(C, name="<C name>") and declared with the exact C types (int32_t ->
+!>    integer(c_int32_t), int64_t -> integer(c_int64_t), double -> real(c_double),
+!>    enumerations -> integer(c_int), handles -> type(c_ptr), function pointers ->
+!>    type(c_funptr); pointers that may be NULL are type(c_ptr), value);
+!>  - typed wrappers named exactly like the C functions, taking the handle types
+!>    type(mfree_context), type(mfree_particles), ... so that the compiler rejects a
+!>    particle set passed where an approximant is expected, optional arguments where C
+!>    accepts NULL, and Fortran strings where C takes or returns char *.
+!> Every function returns the C status as integer(c_int) (MFREE_SUCCESS = 0).
+!>
+!> Borrowed arrays (MFREE_BORROW): mfree keeps the address of the host's array and
+!> re-reads it at every setup / update / apply. Give such arrays the TARGET attribute
+!> (or POINTER), pass whole contiguous arrays (never an array section, an expression or
+!> a constant, which would pass the address of a temporary), and keep them alive until
+!> the object is destroyed or the array is replaced. Fortran x(3,n) is
+!> MFREE_LAYOUT_AOS with ld = 3 (also for dim = 2: the third row is skipped), x(n,3) is
+!> MFREE_LAYOUT_SOA with ld = n.
+!>
+!> Indices: mfree_particles_set_neighbors takes 1-based lists with index_base = 1.
+!> Everything mfree returns (neighbour lists, CSR tables, matrix views) and the particle
+!> indices mfree_assembler_add_dirichlet_nodes / add_traction_nodes / set_fe_layer take
+!> are 0-based, as in C.
+module mfree
+  use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_char, &
+    c_ptr, c_funptr, c_null_ptr, c_null_funptr, c_null_char, c_size_t, c_loc, c_funloc, &
+    c_f_pointer, c_associated
+  implicit none
+  private
+
+  ! ---- version of the headers this module was built from (CMake project version) ----
+  include 'mfree_version.inc'
+
+  ! ---- status codes (mfree_status_t); values frozen --------------------------------
+  integer(c_int), parameter, public :: MFREE_SUCCESS = 0
+  integer(c_int), parameter, public :: MFREE_ERR_NULL = -1
+  integer(c_int), parameter, public :: MFREE_ERR_ARG = -2
+  integer(c_int), parameter, public :: MFREE_ERR_STATE = -3
+  integer(c_int), parameter, public :: MFREE_ERR_ALLOC = -4
+  integer(c_int), parameter, public :: MFREE_ERR_MISMATCH = -5
+  integer(c_int), parameter, public :: MFREE_ERR_UNSUPPORTED = -6
+  integer(c_int), parameter, public :: MFREE_ERR_INPUT = -7
+  integer(c_int), parameter, public :: MFREE_ERR_INTERNAL = -99
+  integer(c_int), parameter, public :: MFREE_FAIL_NONFINITE = 1
+  integer(c_int), parameter, public :: MFREE_FAIL_INVALID_DATA = 2
+  integer(c_int), parameter, public :: MFREE_FAIL_SINGULAR = 3
+  integer(c_int), parameter, public :: MFREE_FAIL_NEIGHBORS = 4
+  integer(c_int), parameter, public :: MFREE_FAIL_DOMAIN = 5
+  integer(c_int), parameter, public :: MFREE_FAIL_CFL = 6
+
+  ! ---- mfree_mem_t ---------------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_COPY = 1
+  integer(c_int), parameter, public :: MFREE_BORROW = 2
+
+  ! ---- mfree_layout_t ------------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_LAYOUT_AOS = 1
+  integer(c_int), parameter, public :: MFREE_LAYOUT_SOA = 2
+
+  ! ---- mfree_search_t ------------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_SEARCH_GATHER = 1
+  integer(c_int), parameter, public :: MFREE_SEARCH_SYMMETRIC_MAX = 2
+  integer(c_int), parameter, public :: MFREE_SEARCH_SYMMETRIC_MEAN = 3
+
+  ! ---- mfree_kernel_t ------------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_KERNEL_CUBIC_SPLINE = 1
+  integer(c_int), parameter, public :: MFREE_KERNEL_QUARTIC = 2
+  integer(c_int), parameter, public :: MFREE_KERNEL_QUINTIC_SPLINE = 3
+  integer(c_int), parameter, public :: MFREE_KERNEL_GAUSSIAN = 4
+  integer(c_int), parameter, public :: MFREE_KERNEL_SUPER_GAUSS = 5
+  integer(c_int), parameter, public :: MFREE_KERNEL_REVISED_GAUSS = 6
+  integer(c_int), parameter, public :: MFREE_KERNEL_REVISED_SUPER_GAUSS = 7
+  integer(c_int), parameter, public :: MFREE_KERNEL_WENDLAND_C2 = 8
+  integer(c_int), parameter, public :: MFREE_KERNEL_WENDLAND_C4 = 9
+  integer(c_int), parameter, public :: MFREE_KERNEL_LINEAR = 10
+  integer(c_int), parameter, public :: MFREE_KERNEL_QUADRATIC = 11
+  integer(c_int), parameter, public :: MFREE_KERNEL_QUARTIC_SPLINE = 12
+
+  ! ---- mfree_method_t ------------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_METHOD_SPH = 1
+  integer(c_int), parameter, public :: MFREE_METHOD_SPH_SYMMETRIC = 2
+  integer(c_int), parameter, public :: MFREE_METHOD_SHEPARD = 3
+  integer(c_int), parameter, public :: MFREE_METHOD_MLS = 4
+  integer(c_int), parameter, public :: MFREE_METHOD_RKPM = 5
+  integer(c_int), parameter, public :: MFREE_METHOD_JOHNSON_BEISSEL = 6
+  integer(c_int), parameter, public :: MFREE_METHOD_RANDLES_LIBERSKY = 7
+  integer(c_int), parameter, public :: MFREE_METHOD_KB_METHOD1 = 8
+  integer(c_int), parameter, public :: MFREE_METHOD_KB_METHOD2 = 9
+  integer(c_int), parameter, public :: MFREE_METHOD_KB_METHOD3 = 10
+  integer(c_int), parameter, public :: MFREE_METHOD_MSPH = 11
+  integer(c_int), parameter, public :: MFREE_METHOD_SSPH = 12
+
+  ! ---- mfree_deriv_t (bit flags: combine with ior) --------------------------------
+  integer(c_int), parameter, public :: MFREE_DERIV_VALUE = 1
+  integer(c_int), parameter, public :: MFREE_DERIV_GRADIENT = 2
+  integer(c_int), parameter, public :: MFREE_DERIV_HESSIAN = 4
+
+  ! ---- mfree_op_t ----------------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_OP_VALUE = 1
+  integer(c_int), parameter, public :: MFREE_OP_GRADIENT = 2
+  integer(c_int), parameter, public :: MFREE_OP_DIVERGENCE = 3
+  integer(c_int), parameter, public :: MFREE_OP_LAPLACIAN = 4
+  integer(c_int), parameter, public :: MFREE_OP_HESSIAN = 5
+
+  ! ---- mfree_fallback_t ----------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_FALLBACK_NONE = 1
+  integer(c_int), parameter, public :: MFREE_FALLBACK_LOWER_ORDER = 2
+
+  ! ---- mfree_form_t --------------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_FORM_LAPLACE = 1
+  integer(c_int), parameter, public :: MFREE_FORM_ELASTICITY_PLANE_STRESS = 2
+  integer(c_int), parameter, public :: MFREE_FORM_ELASTICITY_PLANE_STRAIN = 3
+  integer(c_int), parameter, public :: MFREE_FORM_ELASTICITY_3D = 4
+  integer(c_int), parameter, public :: MFREE_FORM_MASS = 5
+  integer(c_int), parameter, public :: MFREE_FORM_MASS_LUMPED = 6
+  integer(c_int), parameter, public :: MFREE_FORM_COLLOCATION_LAPLACE = 7
+  integer(c_int), parameter, public :: MFREE_FORM_COLLOCATION_PLANE_STRESS = 8
+  integer(c_int), parameter, public :: MFREE_FORM_COLLOCATION_PLANE_STRAIN = 9
+
+  ! ---- mfree_bc_t ----------------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_BC_PENALTY = 1
+  integer(c_int), parameter, public :: MFREE_BC_LAGRANGE = 2
+  integer(c_int), parameter, public :: MFREE_BC_COLLOCATION = 3
+  integer(c_int), parameter, public :: MFREE_BC_NITSCHE = 4
+
+  ! ---- mfree_integrator_t --------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_INTEGRATOR_LEAPFROG = 1
+  integer(c_int), parameter, public :: MFREE_INTEGRATOR_PREDICTOR_CORRECTOR = 2
+
+  ! ---- mfree_lumping_t -----------------------------------------------------------
+  integer(c_int), parameter, public :: MFREE_LUMP_GALERKIN = 1
+  integer(c_int), parameter, public :: MFREE_LUMP_PHYSICAL = 2
+
+  ! ---- typed handles: one C handle each; null until created, null again after destroy
+  type, public :: mfree_context
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_context
+  type, public :: mfree_particles
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_particles
+  type, public :: mfree_approximant
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_approximant
+  type, public :: mfree_matrix
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_matrix
+  type, public :: mfree_assembler
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_assembler
+  type, public :: mfree_system
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_system
+
+  ! ---- host callbacks: write bind(C) procedures with these interfaces ---------------
+  abstract interface
+    !> mfree_field_fn: write the ncomp values of a field at x (dim coordinates).
+    subroutine mfree_field_fn(user, x, value) bind(C)
+      import :: c_ptr, c_double
+      type(c_ptr), value :: user
+      real(c_double), intent(in) :: x(*)
+      real(c_double), intent(out) :: value(*)
+    end subroutine mfree_field_fn
+    !> mfree_inside_fn: nonzero when x lies in the domain.
+    integer(c_int32_t) function mfree_inside_fn(user, x) bind(C)
+      import :: c_ptr, c_double, c_int32_t
+      type(c_ptr), value :: user
+      real(c_double), intent(in) :: x(*)
+    end function mfree_inside_fn
+    !> mfree_error_handler_t: message is a NUL-terminated C string (mfree_c_string).
+    subroutine mfree_error_handler(user, code, message) bind(C)
+      import :: c_ptr, c_int
+      type(c_ptr), value :: user
+      integer(c_int), value :: code
+      type(c_ptr), value :: message
+    end subroutine mfree_error_handler
+    !> mfree_progress_fn: after every accepted step of mfree_system_integrate; return
+    !> nonzero to stop.
+    integer(c_int32_t) function mfree_progress_fn(user, step, t, dt) bind(C)
+      import :: c_ptr, c_int32_t, c_int64_t, c_double
+      type(c_ptr), value :: user
+      integer(c_int64_t), value :: step
+      real(c_double), value :: t, dt
+    end function mfree_progress_fn
+    !> mfree_history_fn: the load history g(t) of an elastodynamic system.
+    real(c_double) function mfree_history_fn(user, t) bind(C)
+      import :: c_ptr, c_double
+      type(c_ptr), value :: user
+      real(c_double), value :: t
+    end function mfree_history_fn
+  end interface
+  public :: mfree_field_fn, mfree_inside_fn, mfree_error_handler, mfree_progress_fn
+  public :: mfree_history_fn
+
+  ! ---- raw bind(C) interfaces: one per public function of mfree.h ------------------
+  interface
+    ! -- version and status
+    type(c_ptr) function mfree_version_string_c() &
+        bind(C, name="mfree_version_string")
+      import :: c_ptr
+    end function mfree_version_string_c
+
+    integer(c_int) function mfree_version_get_c(major, minor, patch) &
+        bind(C, name="mfree_version_get")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: major
+      type(c_ptr), value :: minor
+      type(c_ptr), value :: patch
+    end function mfree_version_get_c
+
+    type(c_ptr) function mfree_status_string_c(status) &
+        bind(C, name="mfree_status_string")
+      import :: c_int, c_ptr
+      integer(c_int), value :: status
+    end function mfree_status_string_c
+
+    ! -- context
+    integer(c_int) function mfree_context_create_c(ctx) &
+        bind(C, name="mfree_context_create")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(out) :: ctx
+    end function mfree_context_create_c
+
+    integer(c_int) function mfree_context_destroy_c(ctx) &
+        bind(C, name="mfree_context_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: ctx
+    end function mfree_context_destroy_c
+
+    integer(c_int) function mfree_context_get_last_error_c(ctx, code, message, len) &
+        bind(C, name="mfree_context_get_last_error")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: ctx
+      type(c_ptr), value :: code
+      type(c_ptr), value :: message
+      integer(c_int64_t), value :: len
+    end function mfree_context_get_last_error_c
+
+    integer(c_int) function mfree_context_set_error_c(ctx, code, message) &
+        bind(C, name="mfree_context_set_error")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int), value :: code
+      type(c_ptr), value :: message
+    end function mfree_context_set_error_c
+
+    integer(c_int) function mfree_context_set_error_handler_c(ctx, handler, user) &
+        bind(C, name="mfree_context_set_error_handler")
+      import :: c_int, c_ptr, c_funptr
+      type(c_ptr), value :: ctx
+      type(c_funptr), value :: handler
+      type(c_ptr), value :: user
+    end function mfree_context_set_error_handler_c
+
+    integer(c_int) function mfree_context_set_num_threads_c(ctx, nthreads) &
+        bind(C, name="mfree_context_set_num_threads")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: nthreads
+    end function mfree_context_set_num_threads_c
+
+    integer(c_int) function mfree_context_get_num_threads_c(ctx, nthreads) &
+        bind(C, name="mfree_context_get_num_threads")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), intent(out) :: nthreads
+    end function mfree_context_get_num_threads_c
+
+    ! -- kernels
+    integer(c_int) function mfree_kernel_eval_c(ctx, kernel, dim, param, h, n, r, w, dwdr, &
+                                                d2wdr2) &
+        bind(C, name="mfree_kernel_eval")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int), value :: kernel
+      integer(c_int32_t), value :: dim
+      real(c_double), value :: param
+      real(c_double), value :: h
+      integer(c_int64_t), value :: n
+      real(c_double), intent(in) :: r(*)
+      type(c_ptr), value :: w
+      type(c_ptr), value :: dwdr
+      type(c_ptr), value :: d2wdr2
+    end function mfree_kernel_eval_c
+
+    integer(c_int) function mfree_kernel_get_support_radius_c(ctx, kernel, param, radius) &
+        bind(C, name="mfree_kernel_get_support_radius")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int), value :: kernel
+      real(c_double), value :: param
+      real(c_double), intent(out) :: radius
+    end function mfree_kernel_get_support_radius_c
+
+    integer(c_int) function mfree_kernel_get_normalization_c(ctx, kernel, dim, param, c) &
+        bind(C, name="mfree_kernel_get_normalization")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int), value :: kernel
+      integer(c_int32_t), value :: dim
+      real(c_double), value :: param
+      real(c_double), intent(out) :: c
+    end function mfree_kernel_get_normalization_c
+
+    ! -- particle sets
+    integer(c_int) function mfree_particles_create_c(ctx, dim, n, ps) &
+        bind(C, name="mfree_particles_create")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: dim
+      integer(c_int32_t), value :: n
+      type(c_ptr), intent(out) :: ps
+    end function mfree_particles_create_c
+
+    integer(c_int) function mfree_particles_destroy_c(ps) &
+        bind(C, name="mfree_particles_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: ps
+    end function mfree_particles_destroy_c
+
+    integer(c_int) function mfree_particles_set_num_ghost_c(ps, n_ghost) &
+        bind(C, name="mfree_particles_set_num_ghost")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int32_t), value :: n_ghost
+    end function mfree_particles_set_num_ghost_c
+
+    integer(c_int) function mfree_particles_set_positions_c(ps, x, layout, ld, mem) &
+        bind(C, name="mfree_particles_set_positions")
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), intent(in), target :: x(*)
+      integer(c_int), value :: layout
+      integer(c_int64_t), value :: ld
+      integer(c_int), value :: mem
+    end function mfree_particles_set_positions_c
+
+    integer(c_int) function mfree_particles_set_volumes_c(ps, v, stride, mem) &
+        bind(C, name="mfree_particles_set_volumes")
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), intent(in), target :: v(*)
+      integer(c_int64_t), value :: stride
+      integer(c_int), value :: mem
+    end function mfree_particles_set_volumes_c
+
+    integer(c_int) function mfree_particles_set_masses_c(ps, m, stride, mem) &
+        bind(C, name="mfree_particles_set_masses")
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), intent(in), target :: m(*)
+      integer(c_int64_t), value :: stride
+      integer(c_int), value :: mem
+    end function mfree_particles_set_masses_c
+
+    integer(c_int) function mfree_particles_set_densities_c(ps, rho, stride, mem) &
+        bind(C, name="mfree_particles_set_densities")
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), intent(in), target :: rho(*)
+      integer(c_int64_t), value :: stride
+      integer(c_int), value :: mem
+    end function mfree_particles_set_densities_c
+
+    integer(c_int) function mfree_particles_set_support_c(ps, h, stride, mem) &
+        bind(C, name="mfree_particles_set_support")
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), intent(in), target :: h(*)
+      integer(c_int64_t), value :: stride
+      integer(c_int), value :: mem
+    end function mfree_particles_set_support_c
+
+    integer(c_int) function mfree_particles_set_search_c(ps, convention, kappa) &
+        bind(C, name="mfree_particles_set_search")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int), value :: convention
+      real(c_double), value :: kappa
+    end function mfree_particles_set_search_c
+
+    integer(c_int) function mfree_particles_set_periodic_c(ps, lo, hi, periodic) &
+        bind(C, name="mfree_particles_set_periodic")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), intent(in) :: lo(*)
+      real(c_double), intent(in) :: hi(*)
+      integer(c_int32_t), intent(in) :: periodic(*)
+    end function mfree_particles_set_periodic_c
+
+    integer(c_int) function mfree_particles_set_neighbors_c(ps, rowptr, cols, index_base, mem) &
+        bind(C, name="mfree_particles_set_neighbors")
+      import :: c_int, c_int32_t, c_int64_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int64_t), intent(in), target :: rowptr(*)
+      integer(c_int32_t), intent(in), target :: cols(*)
+      integer(c_int32_t), value :: index_base
+      integer(c_int), value :: mem
+    end function mfree_particles_set_neighbors_c
+
+    integer(c_int) function mfree_particles_setup_c(ps) &
+        bind(C, name="mfree_particles_setup")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ps
+    end function mfree_particles_setup_c
+
+    integer(c_int) function mfree_particles_update_c(ps) &
+        bind(C, name="mfree_particles_update")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ps
+    end function mfree_particles_update_c
+
+    integer(c_int) function mfree_particles_get_dimension_c(ps, dim) &
+        bind(C, name="mfree_particles_get_dimension")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int32_t), intent(out) :: dim
+    end function mfree_particles_get_dimension_c
+
+    integer(c_int) function mfree_particles_get_size_c(ps, n, n_ghost) &
+        bind(C, name="mfree_particles_get_size")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ps
+      type(c_ptr), value :: n
+      type(c_ptr), value :: n_ghost
+    end function mfree_particles_get_size_c
+
+    integer(c_int) function mfree_particles_get_neighbor_nnz_c(ps, nnz) &
+        bind(C, name="mfree_particles_get_neighbor_nnz")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int64_t), intent(out) :: nnz
+    end function mfree_particles_get_neighbor_nnz_c
+
+    integer(c_int) function mfree_particles_get_neighbors_c(ps, rowptr, cols) &
+        bind(C, name="mfree_particles_get_neighbors")
+      import :: c_int, c_int32_t, c_int64_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int64_t), intent(out) :: rowptr(*)
+      integer(c_int32_t), intent(out) :: cols(*)
+    end function mfree_particles_get_neighbors_c
+
+    integer(c_int) function mfree_particles_get_volumes_c(ps, v) &
+        bind(C, name="mfree_particles_get_volumes")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), intent(out) :: v(*)
+    end function mfree_particles_get_volumes_c
+
+    integer(c_int) function mfree_particles_get_site_status_c(ps, status, nfailed) &
+        bind(C, name="mfree_particles_get_site_status")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ps
+      type(c_ptr), value :: status
+      type(c_ptr), value :: nfailed
+    end function mfree_particles_get_site_status_c
+
+    ! -- approximants
+    integer(c_int) function mfree_approximant_create_c(ctx, ps, method, a) &
+        bind(C, name="mfree_approximant_create")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ctx
+      type(c_ptr), value :: ps
+      integer(c_int), value :: method
+      type(c_ptr), intent(out) :: a
+    end function mfree_approximant_create_c
+
+    integer(c_int) function mfree_approximant_destroy_c(a) &
+        bind(C, name="mfree_approximant_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: a
+    end function mfree_approximant_destroy_c
+
+    integer(c_int) function mfree_approximant_set_kernel_c(a, kernel, param) &
+        bind(C, name="mfree_approximant_set_kernel")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int), value :: kernel
+      real(c_double), value :: param
+    end function mfree_approximant_set_kernel_c
+
+    integer(c_int) function mfree_approximant_set_order_c(a, order) &
+        bind(C, name="mfree_approximant_set_order")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int32_t), value :: order
+    end function mfree_approximant_set_order_c
+
+    integer(c_int) function mfree_approximant_set_derivatives_c(a, flags) &
+        bind(C, name="mfree_approximant_set_derivatives")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int32_t), value :: flags
+    end function mfree_approximant_set_derivatives_c
+
+    integer(c_int) function mfree_approximant_set_fallback_c(a, policy) &
+        bind(C, name="mfree_approximant_set_fallback")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int), value :: policy
+    end function mfree_approximant_set_fallback_c
+
+    integer(c_int) function mfree_approximant_set_points_c(a, npts, x, layout, ld, h, &
+                                                           h_stride, mem) &
+        bind(C, name="mfree_approximant_set_points")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int32_t), value :: npts
+      real(c_double), intent(in), target :: x(*)
+      integer(c_int), value :: layout
+      integer(c_int64_t), value :: ld
+      real(c_double), intent(in), target :: h(*)
+      integer(c_int64_t), value :: h_stride
+      integer(c_int), value :: mem
+    end function mfree_approximant_set_points_c
+
+    integer(c_int) function mfree_approximant_setup_c(a) &
+        bind(C, name="mfree_approximant_setup")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: a
+    end function mfree_approximant_setup_c
+
+    integer(c_int) function mfree_approximant_update_c(a) &
+        bind(C, name="mfree_approximant_update")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: a
+    end function mfree_approximant_update_c
+
+    integer(c_int) function mfree_approximant_apply_c(a, op, ncomp, u, ulayout, uld, out, &
+                                                      olayout, old) &
+        bind(C, name="mfree_approximant_apply")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int), value :: op
+      integer(c_int32_t), value :: ncomp
+      real(c_double), intent(in) :: u(*)
+      integer(c_int), value :: ulayout
+      integer(c_int64_t), value :: uld
+      real(c_double), intent(out) :: out(*)
+      integer(c_int), value :: olayout
+      integer(c_int64_t), value :: old
+    end function mfree_approximant_apply_c
+
+    integer(c_int) function mfree_approximant_apply_add_c(a, op, ncomp, u, ulayout, uld, &
+                                                          out, olayout, old) &
+        bind(C, name="mfree_approximant_apply_add")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int), value :: op
+      integer(c_int32_t), value :: ncomp
+      real(c_double), intent(in) :: u(*)
+      integer(c_int), value :: ulayout
+      integer(c_int64_t), value :: uld
+      real(c_double), intent(inout) :: out(*)
+      integer(c_int), value :: olayout
+      integer(c_int64_t), value :: old
+    end function mfree_approximant_apply_add_c
+
+    integer(c_int) function mfree_approximant_get_num_sites_c(a, nsites) &
+        bind(C, name="mfree_approximant_get_num_sites")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int32_t), intent(out) :: nsites
+    end function mfree_approximant_get_num_sites_c
+
+    integer(c_int) function mfree_approximant_get_nnz_c(a, nnz) &
+        bind(C, name="mfree_approximant_get_nnz")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int64_t), intent(out) :: nnz
+    end function mfree_approximant_get_nnz_c
+
+    integer(c_int) function mfree_approximant_assemble_csr_c(a, deriv, component, rowptr, &
+                                                             cols, vals) &
+        bind(C, name="mfree_approximant_assemble_csr")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int), value :: deriv
+      integer(c_int32_t), value :: component
+      type(c_ptr), value :: rowptr
+      type(c_ptr), value :: cols
+      type(c_ptr), value :: vals
+    end function mfree_approximant_assemble_csr_c
+
+    integer(c_int) function mfree_approximant_check_reproduction_c(a, order, fn_err, &
+                                                                   deriv_err) &
+        bind(C, name="mfree_approximant_check_reproduction")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int32_t), value :: order
+      real(c_double), intent(out) :: fn_err
+      real(c_double), intent(out) :: deriv_err
+    end function mfree_approximant_check_reproduction_c
+
+    integer(c_int) function mfree_approximant_get_site_status_c(a, status, nfailed) &
+        bind(C, name="mfree_approximant_get_site_status")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: a
+      type(c_ptr), value :: status
+      type(c_ptr), value :: nfailed
+    end function mfree_approximant_get_site_status_c
+
+    integer(c_int) function mfree_approximant_get_neighbor_counts_c(a, counts) &
+        bind(C, name="mfree_approximant_get_neighbor_counts")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int32_t), intent(out) :: counts(*)
+    end function mfree_approximant_get_neighbor_counts_c
+
+    integer(c_int) function mfree_approximant_get_condition_c(a, cond) &
+        bind(C, name="mfree_approximant_get_condition")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: a
+      real(c_double), intent(out) :: cond(*)
+    end function mfree_approximant_get_condition_c
+
+    integer(c_int) function mfree_approximant_get_site_order_c(a, order) &
+        bind(C, name="mfree_approximant_get_site_order")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int32_t), intent(out) :: order(*)
+    end function mfree_approximant_get_site_order_c
+
+    ! -- sparse matrices
+    integer(c_int) function mfree_matrix_create_csr_c(ctx, nrows, ncols, rowptr, cols, &
+                                                      vals, A) &
+        bind(C, name="mfree_matrix_create_csr")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: nrows
+      integer(c_int32_t), value :: ncols
+      integer(c_int64_t), intent(in) :: rowptr(*)
+      integer(c_int32_t), intent(in) :: cols(*)
+      real(c_double), intent(in) :: vals(*)
+      type(c_ptr), intent(out) :: A
+    end function mfree_matrix_create_csr_c
+
+    integer(c_int) function mfree_matrix_destroy_c(A) &
+        bind(C, name="mfree_matrix_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: A
+    end function mfree_matrix_destroy_c
+
+    integer(c_int) function mfree_matrix_get_size_c(A, nrows, ncols, nnz) &
+        bind(C, name="mfree_matrix_get_size")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: A
+      type(c_ptr), value :: nrows
+      type(c_ptr), value :: ncols
+      type(c_ptr), value :: nnz
+    end function mfree_matrix_get_size_c
+
+    integer(c_int) function mfree_matrix_get_csr_c(A, rowptr, cols, vals) &
+        bind(C, name="mfree_matrix_get_csr")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: A
+      type(c_ptr), intent(out) :: rowptr
+      type(c_ptr), intent(out) :: cols
+      type(c_ptr), intent(out) :: vals
+    end function mfree_matrix_get_csr_c
+
+    integer(c_int) function mfree_matrix_get_csr_i32_c(A, rowptr, cols, vals) &
+        bind(C, name="mfree_matrix_get_csr_i32")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: A
+      type(c_ptr), intent(out) :: rowptr
+      type(c_ptr), intent(out) :: cols
+      type(c_ptr), intent(out) :: vals
+    end function mfree_matrix_get_csr_i32_c
+
+    integer(c_int) function mfree_matrix_get_csr_i64_c(A, rowptr, cols, vals) &
+        bind(C, name="mfree_matrix_get_csr_i64")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: A
+      type(c_ptr), intent(out) :: rowptr
+      type(c_ptr), intent(out) :: cols
+      type(c_ptr), intent(out) :: vals
+    end function mfree_matrix_get_csr_i64_c
+
+    integer(c_int) function mfree_matrix_get_csc_c(A, colptr, rows, vals) &
+        bind(C, name="mfree_matrix_get_csc")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: A
+      type(c_ptr), intent(out) :: colptr
+      type(c_ptr), intent(out) :: rows
+      type(c_ptr), intent(out) :: vals
+    end function mfree_matrix_get_csc_c
+
+    integer(c_int) function mfree_matrix_get_pattern_id_c(A, id) &
+        bind(C, name="mfree_matrix_get_pattern_id")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: A
+      integer(c_int64_t), intent(out) :: id
+    end function mfree_matrix_get_pattern_id_c
+
+    integer(c_int) function mfree_matrix_get_symmetric_c(A, symmetric) &
+        bind(C, name="mfree_matrix_get_symmetric")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: A
+      integer(c_int32_t), intent(out) :: symmetric
+    end function mfree_matrix_get_symmetric_c
+
+    integer(c_int) function mfree_matrix_apply_c(A, x, y) &
+        bind(C, name="mfree_matrix_apply")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: A
+      real(c_double), intent(in) :: x(*)
+      real(c_double), intent(out) :: y(*)
+    end function mfree_matrix_apply_c
+
+    ! -- assembly
+    integer(c_int) function mfree_assembler_create_c(ctx, trial, test, form, as) &
+        bind(C, name="mfree_assembler_create")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ctx
+      type(c_ptr), value :: trial
+      type(c_ptr), value :: test
+      integer(c_int), value :: form
+      type(c_ptr), intent(out) :: as
+    end function mfree_assembler_create_c
+
+    integer(c_int) function mfree_assembler_destroy_c(as) &
+        bind(C, name="mfree_assembler_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: as
+    end function mfree_assembler_destroy_c
+
+    integer(c_int) function mfree_assembler_set_material_c(as, young, poisson) &
+        bind(C, name="mfree_assembler_set_material")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: as
+      real(c_double), value :: young
+      real(c_double), value :: poisson
+    end function mfree_assembler_set_material_c
+
+    integer(c_int) function mfree_assembler_set_coefficient_c(as, c) &
+        bind(C, name="mfree_assembler_set_coefficient")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: as
+      real(c_double), value :: c
+    end function mfree_assembler_set_coefficient_c
+
+    integer(c_int) function mfree_assembler_set_quadrature_nodal_c(as) &
+        bind(C, name="mfree_assembler_set_quadrature_nodal")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: as
+    end function mfree_assembler_set_quadrature_nodal_c
+
+    integer(c_int) function mfree_assembler_set_quadrature_cells_c(as, lo, hi, ncells, &
+                                                                   ngauss, inside, user) &
+        bind(C, name="mfree_assembler_set_quadrature_cells")
+      import :: c_int, c_int32_t, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      real(c_double), intent(in) :: lo(*)
+      real(c_double), intent(in) :: hi(*)
+      integer(c_int32_t), intent(in) :: ncells(*)
+      integer(c_int32_t), value :: ngauss
+      type(c_funptr), value :: inside
+      type(c_ptr), value :: user
+    end function mfree_assembler_set_quadrature_cells_c
+
+    integer(c_int) function mfree_assembler_set_quadrature_points_c(as, npts, x, layout, &
+                                                                    ld, w) &
+        bind(C, name="mfree_assembler_set_quadrature_points")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: as
+      integer(c_int32_t), value :: npts
+      real(c_double), intent(in) :: x(*)
+      integer(c_int), value :: layout
+      integer(c_int64_t), value :: ld
+      real(c_double), intent(in) :: w(*)
+    end function mfree_assembler_set_quadrature_points_c
+
+    integer(c_int) function mfree_assembler_set_body_force_c(as, f, user) &
+        bind(C, name="mfree_assembler_set_body_force")
+      import :: c_int, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      type(c_funptr), value :: f
+      type(c_ptr), value :: user
+    end function mfree_assembler_set_body_force_c
+
+    integer(c_int) function mfree_assembler_add_traction_c(as, npts, x, layout, ld, w, t, &
+                                                           user) &
+        bind(C, name="mfree_assembler_add_traction")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      integer(c_int32_t), value :: npts
+      real(c_double), intent(in) :: x(*)
+      integer(c_int), value :: layout
+      integer(c_int64_t), value :: ld
+      real(c_double), intent(in) :: w(*)
+      type(c_funptr), value :: t
+      type(c_ptr), value :: user
+    end function mfree_assembler_add_traction_c
+
+    integer(c_int) function mfree_assembler_add_traction_segments_c(as, nseg, x, ngauss, t, &
+                                                                    user) &
+        bind(C, name="mfree_assembler_add_traction_segments")
+      import :: c_int, c_int32_t, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      integer(c_int32_t), value :: nseg
+      real(c_double), intent(in) :: x(*)
+      integer(c_int32_t), value :: ngauss
+      type(c_funptr), value :: t
+      type(c_ptr), value :: user
+    end function mfree_assembler_add_traction_segments_c
+
+    integer(c_int) function mfree_assembler_add_dirichlet_c(as, method, npts, x, layout, &
+                                                            ld, w, normals, component_mask, &
+                                                            g, user) &
+        bind(C, name="mfree_assembler_add_dirichlet")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      integer(c_int), value :: method
+      integer(c_int32_t), value :: npts
+      real(c_double), intent(in) :: x(*)
+      integer(c_int), value :: layout
+      integer(c_int64_t), value :: ld
+      real(c_double), intent(in) :: w(*)
+      type(c_ptr), value :: normals
+      integer(c_int32_t), value :: component_mask
+      type(c_funptr), value :: g
+      type(c_ptr), value :: user
+    end function mfree_assembler_add_dirichlet_c
+
+    integer(c_int) function mfree_assembler_add_dirichlet_nodes_c(as, nnodes, nodes, &
+                                                                  component_mask, g, user) &
+        bind(C, name="mfree_assembler_add_dirichlet_nodes")
+      import :: c_int, c_int32_t, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      integer(c_int32_t), value :: nnodes
+      integer(c_int32_t), intent(in) :: nodes(*)
+      integer(c_int32_t), value :: component_mask
+      type(c_funptr), value :: g
+      type(c_ptr), value :: user
+    end function mfree_assembler_add_dirichlet_nodes_c
+
+    integer(c_int) function mfree_assembler_add_traction_nodes_c(as, nnodes, nodes, &
+                                                                 normals, t, user) &
+        bind(C, name="mfree_assembler_add_traction_nodes")
+      import :: c_int, c_int32_t, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      integer(c_int32_t), value :: nnodes
+      integer(c_int32_t), intent(in) :: nodes(*)
+      real(c_double), intent(in) :: normals(*)
+      type(c_funptr), value :: t
+      type(c_ptr), value :: user
+    end function mfree_assembler_add_traction_nodes_c
+
+    integer(c_int) function mfree_assembler_set_fe_layer_c(as, nelem, nodes_per_element, &
+                                                           connectivity, ngu, gu, &
+                                                           component_mask, g, user) &
+        bind(C, name="mfree_assembler_set_fe_layer")
+      import :: c_int, c_int32_t, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      integer(c_int32_t), value :: nelem
+      integer(c_int32_t), value :: nodes_per_element
+      integer(c_int32_t), intent(in) :: connectivity(*)
+      integer(c_int32_t), value :: ngu
+      integer(c_int32_t), intent(in) :: gu(*)
+      integer(c_int32_t), value :: component_mask
+      type(c_funptr), value :: g
+      type(c_ptr), value :: user
+    end function mfree_assembler_set_fe_layer_c
+
+    integer(c_int) function mfree_assembler_set_penalty_c(as, alpha) &
+        bind(C, name="mfree_assembler_set_penalty")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: as
+      real(c_double), value :: alpha
+    end function mfree_assembler_set_penalty_c
+
+    integer(c_int) function mfree_assembler_setup_c(as) &
+        bind(C, name="mfree_assembler_setup")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: as
+    end function mfree_assembler_setup_c
+
+    integer(c_int) function mfree_assembler_update_c(as) &
+        bind(C, name="mfree_assembler_update")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: as
+    end function mfree_assembler_update_c
+
+    integer(c_int) function mfree_assembler_get_size_c(as, ndofs, nquad) &
+        bind(C, name="mfree_assembler_get_size")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: as
+      type(c_ptr), value :: ndofs
+      type(c_ptr), value :: nquad
+    end function mfree_assembler_get_size_c
+
+    integer(c_int) function mfree_assembler_assemble_matrix_c(as, K) &
+        bind(C, name="mfree_assembler_assemble_matrix")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: as
+      type(c_ptr), intent(inout) :: K
+    end function mfree_assembler_assemble_matrix_c
+
+    integer(c_int) function mfree_assembler_assemble_rhs_c(as, f) &
+        bind(C, name="mfree_assembler_assemble_rhs")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: as
+      real(c_double), intent(out) :: f(*)
+    end function mfree_assembler_assemble_rhs_c
+
+    ! -- semi-discrete particle systems
+    integer(c_int) function mfree_system_create_fluid_c(ctx, dim, n, sys) &
+        bind(C, name="mfree_system_create_fluid")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: dim
+      integer(c_int32_t), value :: n
+      type(c_ptr), intent(out) :: sys
+    end function mfree_system_create_fluid_c
+
+    integer(c_int) function mfree_system_destroy_c(sys) &
+        bind(C, name="mfree_system_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: sys
+    end function mfree_system_destroy_c
+
+    integer(c_int) function mfree_system_set_fluid_c(sys, rho0, stride, kappa, gamma, mu) &
+        bind(C, name="mfree_system_set_fluid")
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: rho0(*)
+      integer(c_int64_t), value :: stride
+      real(c_double), value :: kappa
+      real(c_double), value :: gamma
+      real(c_double), value :: mu
+    end function mfree_system_set_fluid_c
+
+    integer(c_int) function mfree_system_set_masses_c(sys, m, stride) &
+        bind(C, name="mfree_system_set_masses")
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: m(*)
+      integer(c_int64_t), value :: stride
+    end function mfree_system_set_masses_c
+
+    integer(c_int) function mfree_system_set_smoothing_c(sys, h) &
+        bind(C, name="mfree_system_set_smoothing")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), value :: h
+    end function mfree_system_set_smoothing_c
+
+    integer(c_int) function mfree_system_set_gravity_c(sys, g) &
+        bind(C, name="mfree_system_set_gravity")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: g(*)
+    end function mfree_system_set_gravity_c
+
+    integer(c_int) function mfree_system_set_lumping_c(sys, lump) &
+        bind(C, name="mfree_system_set_lumping")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int), value :: lump
+    end function mfree_system_set_lumping_c
+
+    integer(c_int) function mfree_system_set_walls_c(sys, nwall, x, normals, r0, strength) &
+        bind(C, name="mfree_system_set_walls")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: nwall
+      real(c_double), intent(in) :: x(*)
+      real(c_double), intent(in) :: normals(*)
+      real(c_double), value :: r0
+      real(c_double), value :: strength
+    end function mfree_system_set_walls_c
+
+    integer(c_int) function mfree_system_set_box_c(sys, lo, hi) &
+        bind(C, name="mfree_system_set_box")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: lo(*)
+      real(c_double), intent(in) :: hi(*)
+    end function mfree_system_set_box_c
+
+    integer(c_int) function mfree_system_get_size_c(sys, neq) &
+        bind(C, name="mfree_system_get_size")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), intent(out) :: neq
+    end function mfree_system_get_size_c
+
+    integer(c_int) function mfree_system_rhs_c(sys, t, y, ydot) &
+        bind(C, name="mfree_system_rhs")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), value :: t
+      real(c_double), intent(in) :: y(*)
+      real(c_double), intent(out) :: ydot(*)
+    end function mfree_system_rhs_c
+
+    integer(c_int) function mfree_system_assemble_mass_c(sys, y, consistent, M) &
+        bind(C, name="mfree_system_assemble_mass")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: y(*)
+      integer(c_int32_t), value :: consistent
+      type(c_ptr), intent(inout) :: M
+    end function mfree_system_assemble_mass_c
+
+    integer(c_int) function mfree_system_assemble_interpolation_c(sys, y, S) &
+        bind(C, name="mfree_system_assemble_interpolation")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: y(*)
+      type(c_ptr), intent(inout) :: S
+    end function mfree_system_assemble_interpolation_c
+
+    integer(c_int) function mfree_system_get_pressure_c(sys, y, p) &
+        bind(C, name="mfree_system_get_pressure")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: y(*)
+      real(c_double), intent(out) :: p(*)
+    end function mfree_system_get_pressure_c
+
+    integer(c_int) function mfree_system_get_velocity_c(sys, y, vhat) &
+        bind(C, name="mfree_system_get_velocity")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: y(*)
+      real(c_double), intent(out) :: vhat(*)
+    end function mfree_system_get_velocity_c
+
+    integer(c_int) function mfree_system_integrate_c(sys, scheme, y, t, t_end, cfl, dt_max, &
+                                                     progress, user, nsteps) &
+        bind(C, name="mfree_system_integrate")
+      import :: c_int, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: sys
+      integer(c_int), value :: scheme
+      real(c_double), intent(inout) :: y(*)
+      real(c_double), intent(inout) :: t
+      real(c_double), value :: t_end
+      real(c_double), value :: cfl
+      real(c_double), value :: dt_max
+      type(c_funptr), value :: progress
+      type(c_ptr), value :: user
+      type(c_ptr), value :: nsteps
+    end function mfree_system_integrate_c
+
+    integer(c_int) function mfree_system_create_elastodynamic_c(ctx, as, density, sys) &
+        bind(C, name="mfree_system_create_elastodynamic")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: ctx
+      type(c_ptr), value :: as
+      real(c_double), value :: density
+      type(c_ptr), intent(out) :: sys
+    end function mfree_system_create_elastodynamic_c
+
+    integer(c_int) function mfree_system_set_load_history_c(sys, g, user) &
+        bind(C, name="mfree_system_set_load_history")
+      import :: c_int, c_ptr, c_funptr
+      type(c_ptr), value :: sys
+      type(c_funptr), value :: g
+      type(c_ptr), value :: user
+    end function mfree_system_set_load_history_c
+
+    integer(c_int) function mfree_system_get_stress_c(sys, t, y, sigma) &
+        bind(C, name="mfree_system_get_stress")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), value :: t
+      real(c_double), intent(in) :: y(*)
+      real(c_double), intent(out) :: sigma(*)
+    end function mfree_system_get_stress_c
+
+    ! -- C library (private): length of a NUL-terminated string
+    integer(c_size_t) function strlen_c(s) bind(C, name="strlen")
+      import :: c_size_t, c_ptr
+      type(c_ptr), value :: s
+    end function strlen_c
+  end interface
+  public :: mfree_version_string_c, mfree_version_get_c, mfree_status_string_c
+  public :: mfree_context_create_c, mfree_context_destroy_c
+  public :: mfree_context_get_last_error_c, mfree_context_set_error_c
+  public :: mfree_context_set_error_handler_c, mfree_context_set_num_threads_c
+  public :: mfree_context_get_num_threads_c, mfree_kernel_eval_c
+  public :: mfree_kernel_get_support_radius_c, mfree_kernel_get_normalization_c
+  public :: mfree_particles_create_c, mfree_particles_destroy_c
+  public :: mfree_particles_set_num_ghost_c, mfree_particles_set_positions_c
+  public :: mfree_particles_set_volumes_c, mfree_particles_set_masses_c
+  public :: mfree_particles_set_densities_c, mfree_particles_set_support_c
+  public :: mfree_particles_set_search_c, mfree_particles_set_periodic_c
+  public :: mfree_particles_set_neighbors_c, mfree_particles_setup_c
+  public :: mfree_particles_update_c, mfree_particles_get_dimension_c
+  public :: mfree_particles_get_size_c, mfree_particles_get_neighbor_nnz_c
+  public :: mfree_particles_get_neighbors_c, mfree_particles_get_volumes_c
+  public :: mfree_particles_get_site_status_c, mfree_approximant_create_c
+  public :: mfree_approximant_destroy_c, mfree_approximant_set_kernel_c
+  public :: mfree_approximant_set_order_c, mfree_approximant_set_derivatives_c
+  public :: mfree_approximant_set_fallback_c, mfree_approximant_set_points_c
+  public :: mfree_approximant_setup_c, mfree_approximant_update_c
+  public :: mfree_approximant_apply_c, mfree_approximant_apply_add_c
+  public :: mfree_approximant_get_num_sites_c, mfree_approximant_get_nnz_c
+  public :: mfree_approximant_assemble_csr_c, mfree_approximant_check_reproduction_c
+  public :: mfree_approximant_get_site_status_c, mfree_approximant_get_neighbor_counts_c
+  public :: mfree_approximant_get_condition_c, mfree_approximant_get_site_order_c
+  public :: mfree_matrix_create_csr_c, mfree_matrix_destroy_c, mfree_matrix_get_size_c
+  public :: mfree_matrix_get_csr_c, mfree_matrix_get_csr_i32_c, mfree_matrix_get_csr_i64_c
+  public :: mfree_matrix_get_csc_c, mfree_matrix_get_pattern_id_c
+  public :: mfree_matrix_get_symmetric_c, mfree_matrix_apply_c, mfree_assembler_create_c
+  public :: mfree_assembler_destroy_c, mfree_assembler_set_material_c
+  public :: mfree_assembler_set_coefficient_c, mfree_assembler_set_quadrature_nodal_c
+  public :: mfree_assembler_set_quadrature_cells_c
+  public :: mfree_assembler_set_quadrature_points_c, mfree_assembler_set_body_force_c
+  public :: mfree_assembler_add_traction_c, mfree_assembler_add_traction_segments_c
+  public :: mfree_assembler_add_dirichlet_c, mfree_assembler_add_dirichlet_nodes_c
+  public :: mfree_assembler_add_traction_nodes_c, mfree_assembler_set_fe_layer_c
+  public :: mfree_assembler_set_penalty_c, mfree_assembler_setup_c
+  public :: mfree_assembler_update_c, mfree_assembler_get_size_c
+  public :: mfree_assembler_assemble_matrix_c, mfree_assembler_assemble_rhs_c
+  public :: mfree_system_create_fluid_c, mfree_system_destroy_c, mfree_system_set_fluid_c
+  public :: mfree_system_set_masses_c, mfree_system_set_smoothing_c
+  public :: mfree_system_set_gravity_c, mfree_system_set_lumping_c
+  public :: mfree_system_set_walls_c, mfree_system_set_box_c, mfree_system_get_size_c
+  public :: mfree_system_rhs_c, mfree_system_assemble_mass_c
+  public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
+  public :: mfree_system_get_velocity_c, mfree_system_integrate_c
+  public :: mfree_system_create_elastodynamic_c, mfree_system_set_load_history_c
+  public :: mfree_system_get_stress_c
+
+  ! ---- per-particle scalars and point supports: an array, or one value (stride 0) -----
+  interface mfree_particles_set_volumes
+    module procedure mfree_particles_set_volumes_array, mfree_particles_set_volumes_scalar
+  end interface mfree_particles_set_volumes
+  interface mfree_particles_set_masses
+    module procedure mfree_particles_set_masses_array, mfree_particles_set_masses_scalar
+  end interface mfree_particles_set_masses
+  interface mfree_particles_set_densities
+    module procedure mfree_particles_set_densities_array, mfree_particles_set_densities_scalar
+  end interface mfree_particles_set_densities
+  interface mfree_particles_set_support
+    module procedure mfree_particles_set_support_array, mfree_particles_set_support_scalar
+  end interface mfree_particles_set_support
+  interface mfree_approximant_set_points
+    module procedure mfree_approximant_set_points_array, mfree_approximant_set_points_scalar
+  end interface mfree_approximant_set_points
+  interface mfree_system_set_fluid
+    module procedure mfree_system_set_fluid_array, mfree_system_set_fluid_scalar
+  end interface mfree_system_set_fluid
+  interface mfree_system_set_masses
+    module procedure mfree_system_set_masses_array, mfree_system_set_masses_scalar
+  end interface mfree_system_set_masses
+
+  ! ---- typed wrappers (C names) and helpers -----------------------------------------
+  public :: mfree_version_string, mfree_version_get, mfree_status_string
+  public :: mfree_version_ge, mfree_version_check, mfree_c_string, mfree_last_error
+  public :: mfree_context_create, mfree_context_destroy, mfree_context_get_last_error
+  public :: mfree_context_set_error, mfree_context_set_error_handler
+  public :: mfree_context_set_num_threads, mfree_context_get_num_threads
+  public :: mfree_kernel_eval, mfree_kernel_get_support_radius
+  public :: mfree_kernel_get_normalization
+  public :: mfree_particles_create, mfree_particles_destroy, mfree_particles_set_num_ghost
+  public :: mfree_particles_set_positions, mfree_particles_set_volumes
+  public :: mfree_particles_set_masses, mfree_particles_set_densities
+  public :: mfree_particles_set_support, mfree_particles_set_search
+  public :: mfree_particles_set_periodic, mfree_particles_set_neighbors
+  public :: mfree_particles_setup, mfree_particles_update, mfree_particles_get_dimension
+  public :: mfree_particles_get_size, mfree_particles_get_neighbor_nnz
+  public :: mfree_particles_get_neighbors, mfree_particles_get_volumes
+  public :: mfree_particles_get_site_status
+  public :: mfree_approximant_create, mfree_approximant_destroy
+  public :: mfree_approximant_set_kernel, mfree_approximant_set_order
+  public :: mfree_approximant_set_derivatives, mfree_approximant_set_fallback
+  public :: mfree_approximant_set_points, mfree_approximant_setup, mfree_approximant_update
+  public :: mfree_approximant_apply, mfree_approximant_apply_add
+  public :: mfree_approximant_get_num_sites, mfree_approximant_get_nnz
+  public :: mfree_approximant_assemble_csr, mfree_approximant_check_reproduction
+  public :: mfree_approximant_get_site_status, mfree_approximant_get_neighbor_counts
+  public :: mfree_approximant_get_condition, mfree_approximant_get_site_order
+  public :: mfree_matrix_create_csr, mfree_matrix_destroy, mfree_matrix_get_size
+  public :: mfree_matrix_get_csr, mfree_matrix_get_csr_i32, mfree_matrix_get_csr_i64
+  public :: mfree_matrix_get_csc, mfree_matrix_get_pattern_id, mfree_matrix_get_symmetric
+  public :: mfree_matrix_apply
+  public :: mfree_assembler_create, mfree_assembler_destroy, mfree_assembler_set_material
+  public :: mfree_assembler_set_coefficient, mfree_assembler_set_quadrature_nodal
+  public :: mfree_assembler_set_quadrature_cells, mfree_assembler_set_quadrature_points
+  public :: mfree_assembler_set_body_force, mfree_assembler_add_traction
+  public :: mfree_assembler_add_traction_segments, mfree_assembler_add_dirichlet
+  public :: mfree_assembler_add_dirichlet_nodes, mfree_assembler_add_traction_nodes
+  public :: mfree_assembler_set_fe_layer, mfree_assembler_set_penalty
+  public :: mfree_assembler_setup, mfree_assembler_update, mfree_assembler_get_size
+  public :: mfree_assembler_assemble_matrix, mfree_assembler_assemble_rhs
+  public :: mfree_system_create_fluid, mfree_system_destroy, mfree_system_set_fluid
+  public :: mfree_system_set_masses, mfree_system_set_smoothing, mfree_system_set_gravity
+  public :: mfree_system_set_lumping, mfree_system_set_walls, mfree_system_set_box
+  public :: mfree_system_get_size, mfree_system_rhs, mfree_system_assemble_mass
+  public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
+  public :: mfree_system_get_velocity, mfree_system_integrate
+  public :: mfree_system_create_elastodynamic, mfree_system_set_load_history
+  public :: mfree_system_get_stress
+
+  ! Targets of zero-length matrix views (a C view of an empty array may be NULL).
+  integer(c_int64_t), target, save :: empty_i64(0)
+  integer(c_int32_t), target, save :: empty_i32(0)
+  real(c_double), target, save :: empty_dbl(0)
+
+contains
+
+  ! ==== helpers ========================================================================
+
+  !> A Fortran copy of a NUL-terminated C string ('' for NULL), e.g. the message an
+  !> error handler receives or what mfree_version_string_c returns.
+  function mfree_c_string(p) result(s)
+    type(c_ptr), intent(in) :: p
+    character(len=:), allocatable :: s
+    character(kind=c_char), pointer :: chars(:)
+    integer(c_size_t) :: n
+    integer :: i
+    if (.not. c_associated(p)) then
+      s = ''
+      return
+    end if
+    n = strlen_c(p)
+    call c_f_pointer(p, chars, [n])
+    allocate (character(len=int(n)) :: s)
+    do i = 1, int(n)
+      s(i:i) = chars(i)
+    end do
+  end function mfree_c_string
+
+  !> The characters of buf before its first NUL.
+  function from_c_chars(buf) result(s)
+    character(kind=c_char), intent(in) :: buf(:)
+    character(len=:), allocatable :: s
+    integer :: i, n
+    n = size(buf)
+    do i = 1, size(buf)
+      if (buf(i) == c_null_char) then
+        n = i - 1
+        exit
+      end if
+    end do
+    allocate (character(len=n) :: s)
+    do i = 1, n
+      s(i:i) = buf(i)
+    end do
+  end function from_c_chars
+
+  !> A NUL-terminated copy of a Fortran string (trailing blanks kept).
+  subroutine to_c_chars(s, buf)
+    character(len=*), intent(in) :: s
+    character(kind=c_char), allocatable, intent(out) :: buf(:)
+    integer :: i
+    allocate (buf(len(s) + 1))
+    do i = 1, len(s)
+      buf(i) = s(i:i)
+    end do
+    buf(len(s) + 1) = c_null_char
+  end subroutine to_c_chars
+
+  ! ==== version and status =============================================================
+
+  !> Run-time library version "MAJOR.MINOR.PATCH".
+  function mfree_version_string() result(s)
+    character(len=:), allocatable :: s
+    s = mfree_c_string(mfree_version_string_c())
+  end function mfree_version_string
+
+  !> Run-time version numbers; each output optional.
+  integer(c_int) function mfree_version_get(major, minor, patch) result(st)
+    integer(c_int32_t), intent(out), optional, target :: major, minor, patch
+    type(c_ptr) :: pmaj, pmin, ppat
+    pmaj = c_null_ptr
+    pmin = c_null_ptr
+    ppat = c_null_ptr
+    if (present(major)) pmaj = c_loc(major)
+    if (present(minor)) pmin = c_loc(minor)
+    if (present(patch)) ppat = c_loc(patch)
+    st = mfree_version_get_c(pmaj, pmin, ppat)
+  end function mfree_version_get
+
+  !> The name of a status code.
+  function mfree_status_string(status) result(s)
+    integer(c_int), intent(in) :: status
+    character(len=:), allocatable :: s
+    s = mfree_c_string(mfree_status_string_c(status))
+  end function mfree_status_string
+
+  !> MFREE_VERSION_GE of the C header: this module is at least version a.b.c.
+  logical function mfree_version_ge(a, b, c)
+    integer, intent(in) :: a, b, c
+    mfree_version_ge = MFREE_VERSION_MAJOR > a .or. &
+      (MFREE_VERSION_MAJOR == a .and. MFREE_VERSION_MINOR > b) .or. &
+      (MFREE_VERSION_MAJOR == a .and. MFREE_VERSION_MINOR == b .and. &
+       MFREE_VERSION_PATCH >= c)
+  end function mfree_version_ge
+
+  !> True when the library loaded at run time can serve this module: same major version
+  !> and a minor.patch at least the module's (an older library may lack functions).
+  logical function mfree_version_check()
+    integer(c_int32_t) :: major, minor, patch
+    mfree_version_check = .false.
+    if (mfree_version_get(major, minor, patch) /= MFREE_SUCCESS) return
+    mfree_version_check = major == MFREE_VERSION_MAJOR .and. &
+      (minor > MFREE_VERSION_MINOR .or. &
+       (minor == MFREE_VERSION_MINOR .and. patch >= MFREE_VERSION_PATCH))
+  end function mfree_version_check
+
+  ! ==== context ========================================================================
+
+  integer(c_int) function mfree_context_create(ctx) result(st)
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_context_create_c(ctx%ptr)
+  end function mfree_context_create
+
+  integer(c_int) function mfree_context_destroy(ctx) result(st)
+    type(mfree_context), intent(inout) :: ctx
+    st = mfree_context_destroy_c(ctx%ptr)
+  end function mfree_context_destroy
+
+  !> The last failure: its code and/or its message, blank-padded or truncated to
+  !> len(message) (mfree_last_error returns the whole message).
+  integer(c_int) function mfree_context_get_last_error(ctx, code, message) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int), intent(out), optional, target :: code
+    character(len=*), intent(out), optional :: message
+    character(kind=c_char), allocatable, target :: buf(:)
+    type(c_ptr) :: pcode
+    pcode = c_null_ptr
+    if (present(code)) pcode = c_loc(code)
+    if (present(message)) then
+      allocate (buf(len(message) + 1))
+      buf = c_null_char
+      st = mfree_context_get_last_error_c(ctx%ptr, pcode, c_loc(buf), &
+                                          int(size(buf), c_int64_t))
+      message = from_c_chars(buf)
+    else
+      st = mfree_context_get_last_error_c(ctx%ptr, pcode, c_null_ptr, 0_c_int64_t)
+    end if
+  end function mfree_context_get_last_error
+
+  !> The whole message of the last failure recorded on ctx ('' if none or ctx is null).
+  function mfree_last_error(ctx) result(msg)
+    type(mfree_context), intent(in) :: ctx
+    character(len=:), allocatable :: msg
+    character(kind=c_char), allocatable, target :: buf(:)
+    integer :: n, i, used
+    ! The C call truncates to the buffer and cannot report the full length: grow the
+    ! buffer until the message ends before its last byte.
+    n = 256
+    do
+      allocate (buf(n))
+      buf = c_null_char
+      if (mfree_context_get_last_error_c(ctx%ptr, c_null_ptr, c_loc(buf), &
+                                         int(n, c_int64_t)) /= MFREE_SUCCESS) then
+        msg = ''
+        return
+      end if
+      used = n
+      do i = 1, n
+        if (buf(i) == c_null_char) then
+          used = i - 1
+          exit
+        end if
+      end do
+      if (used < n - 1 .or. n >= 2**24) exit
+      deallocate (buf)
+      n = 2 * n
+    end do
+    msg = from_c_chars(buf)
+  end function mfree_last_error
+
+  !> Record a failure as mfree does (for host wrappers); returns code.
+  integer(c_int) function mfree_context_set_error(ctx, code, message) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int), intent(in) :: code
+    character(len=*), intent(in), optional :: message
+    character(kind=c_char), allocatable, target :: buf(:)
+    if (present(message)) then
+      call to_c_chars(message, buf)
+      st = mfree_context_set_error_c(ctx%ptr, code, c_loc(buf))
+    else
+      st = mfree_context_set_error_c(ctx%ptr, code, c_null_ptr)
+    end if
+  end function mfree_context_set_error
+
+  !> Install handler (absent: remove it) with an optional user pointer.
+  integer(c_int) function mfree_context_set_error_handler(ctx, handler, user) result(st)
+    type(mfree_context), intent(in) :: ctx
+    procedure(mfree_error_handler), optional :: handler
+    type(c_ptr), intent(in), optional :: user
+    type(c_funptr) :: fp
+    type(c_ptr) :: up
+    fp = c_null_funptr
+    up = c_null_ptr
+    if (present(handler)) fp = c_funloc(handler)
+    if (present(user)) up = user
+    st = mfree_context_set_error_handler_c(ctx%ptr, fp, up)
+  end function mfree_context_set_error_handler
+
+  integer(c_int) function mfree_context_set_num_threads(ctx, nthreads) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: nthreads
+    st = mfree_context_set_num_threads_c(ctx%ptr, nthreads)
+  end function mfree_context_set_num_threads
+
+  integer(c_int) function mfree_context_get_num_threads(ctx, nthreads) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(out) :: nthreads
+    st = mfree_context_get_num_threads_c(ctx%ptr, nthreads)
+  end function mfree_context_get_num_threads
+
+  ! ==== kernels ========================================================================
+
+  !> W, dW/dr, d2W/dr2 at the n distances r; request any subset of the outputs.
+  integer(c_int) function mfree_kernel_eval(ctx, kernel, dim, param, h, n, r, w, dwdr, &
+                                            d2wdr2) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int), intent(in) :: kernel
+    integer(c_int32_t), intent(in) :: dim
+    real(c_double), intent(in) :: param, h
+    integer(c_int64_t), intent(in) :: n
+    real(c_double), intent(in) :: r(*)
+    real(c_double), intent(out), optional, target :: w(*), dwdr(*), d2wdr2(*)
+    type(c_ptr) :: pw, pd, pd2
+    pw = c_null_ptr
+    pd = c_null_ptr
+    pd2 = c_null_ptr
+    if (present(w)) pw = c_loc(w)
+    if (present(dwdr)) pd = c_loc(dwdr)
+    if (present(d2wdr2)) pd2 = c_loc(d2wdr2)
+    st = mfree_kernel_eval_c(ctx%ptr, kernel, dim, param, h, n, r, pw, pd, pd2)
+  end function mfree_kernel_eval
+
+  integer(c_int) function mfree_kernel_get_support_radius(ctx, kernel, param, radius) &
+      result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int), intent(in) :: kernel
+    real(c_double), intent(in) :: param
+    real(c_double), intent(out) :: radius
+    st = mfree_kernel_get_support_radius_c(ctx%ptr, kernel, param, radius)
+  end function mfree_kernel_get_support_radius
+
+  integer(c_int) function mfree_kernel_get_normalization(ctx, kernel, dim, param, c) &
+      result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int), intent(in) :: kernel
+    integer(c_int32_t), intent(in) :: dim
+    real(c_double), intent(in) :: param
+    real(c_double), intent(out) :: c
+    st = mfree_kernel_get_normalization_c(ctx%ptr, kernel, dim, param, c)
+  end function mfree_kernel_get_normalization
+
+  ! ==== particle sets ==================================================================
+
+  integer(c_int) function mfree_particles_create(ctx, dim, n, ps) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: dim, n
+    type(mfree_particles), intent(out) :: ps
+    st = mfree_particles_create_c(ctx%ptr, dim, n, ps%ptr)
+  end function mfree_particles_create
+
+  integer(c_int) function mfree_particles_destroy(ps) result(st)
+    type(mfree_particles), intent(inout) :: ps
+    st = mfree_particles_destroy_c(ps%ptr)
+  end function mfree_particles_destroy
+
+  integer(c_int) function mfree_particles_set_num_ghost(ps, n_ghost) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int32_t), intent(in) :: n_ghost
+    st = mfree_particles_set_num_ghost_c(ps%ptr, n_ghost)
+  end function mfree_particles_set_num_ghost
+
+  !> Positions: x(3,n) -> MFREE_LAYOUT_AOS, ld = 3; x(n,3) -> MFREE_LAYOUT_SOA, ld = n.
+  !> With MFREE_BORROW, x must be a whole contiguous array with the TARGET attribute.
+  integer(c_int) function mfree_particles_set_positions(ps, x, layout, ld, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: x(*)
+    integer(c_int), intent(in) :: layout, mem
+    integer(c_int64_t), intent(in) :: ld
+    st = mfree_particles_set_positions_c(ps%ptr, x, layout, ld, mem)
+  end function mfree_particles_set_positions
+
+  integer(c_int) function mfree_particles_set_volumes_array(ps, v, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: v(*)
+    integer(c_int64_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    st = mfree_particles_set_volumes_c(ps%ptr, v, stride, mem)
+  end function mfree_particles_set_volumes_array
+
+  integer(c_int) function mfree_particles_set_volumes_scalar(ps, v, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: v
+    integer(c_int64_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    real(c_double), pointer :: p(:)
+    call c_f_pointer(c_loc(v), p, [1])
+    st = mfree_particles_set_volumes_c(ps%ptr, p, stride, mem)
+  end function mfree_particles_set_volumes_scalar
+
+  integer(c_int) function mfree_particles_set_masses_array(ps, m, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: m(*)
+    integer(c_int64_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    st = mfree_particles_set_masses_c(ps%ptr, m, stride, mem)
+  end function mfree_particles_set_masses_array
+
+  integer(c_int) function mfree_particles_set_masses_scalar(ps, m, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: m
+    integer(c_int64_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    real(c_double), pointer :: p(:)
+    call c_f_pointer(c_loc(m), p, [1])
+    st = mfree_particles_set_masses_c(ps%ptr, p, stride, mem)
+  end function mfree_particles_set_masses_scalar
+
+  integer(c_int) function mfree_particles_set_densities_array(ps, rho, stride, mem) &
+      result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: rho(*)
+    integer(c_int64_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    st = mfree_particles_set_densities_c(ps%ptr, rho, stride, mem)
+  end function mfree_particles_set_densities_array
+
+  integer(c_int) function mfree_particles_set_densities_scalar(ps, rho, stride, mem) &
+      result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: rho
+    integer(c_int64_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    real(c_double), pointer :: p(:)
+    call c_f_pointer(c_loc(rho), p, [1])
+    st = mfree_particles_set_densities_c(ps%ptr, p, stride, mem)
+  end function mfree_particles_set_densities_scalar
+
+  integer(c_int) function mfree_particles_set_support_array(ps, h, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: h(*)
+    integer(c_int64_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    st = mfree_particles_set_support_c(ps%ptr, h, stride, mem)
+  end function mfree_particles_set_support_array
+
+  integer(c_int) function mfree_particles_set_support_scalar(ps, h, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: h
+    integer(c_int64_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    real(c_double), pointer :: p(:)
+    call c_f_pointer(c_loc(h), p, [1])
+    st = mfree_particles_set_support_c(ps%ptr, p, stride, mem)
+  end function mfree_particles_set_support_scalar
+
+  integer(c_int) function mfree_particles_set_search(ps, convention, kappa) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int), intent(in) :: convention
+    real(c_double), intent(in) :: kappa
+    st = mfree_particles_set_search_c(ps%ptr, convention, kappa)
+  end function mfree_particles_set_search
+
+  integer(c_int) function mfree_particles_set_periodic(ps, lo, hi, periodic) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in) :: lo(*), hi(*)
+    integer(c_int32_t), intent(in) :: periodic(*)
+    st = mfree_particles_set_periodic_c(ps%ptr, lo, hi, periodic)
+  end function mfree_particles_set_periodic
+
+  !> Host neighbour lists as CSR; Fortran 1-based lists: index_base = 1 (rowptr(1) = 1,
+  !> row i is cols(rowptr(i) : rowptr(i+1)-1)).
+  integer(c_int) function mfree_particles_set_neighbors(ps, rowptr, cols, index_base, mem) &
+      result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(in), target :: rowptr(*)
+    integer(c_int32_t), intent(in), target :: cols(*)
+    integer(c_int32_t), intent(in) :: index_base
+    integer(c_int), intent(in) :: mem
+    st = mfree_particles_set_neighbors_c(ps%ptr, rowptr, cols, index_base, mem)
+  end function mfree_particles_set_neighbors
+
+  integer(c_int) function mfree_particles_setup(ps) result(st)
+    type(mfree_particles), intent(in) :: ps
+    st = mfree_particles_setup_c(ps%ptr)
+  end function mfree_particles_setup
+
+  integer(c_int) function mfree_particles_update(ps) result(st)
+    type(mfree_particles), intent(in) :: ps
+    st = mfree_particles_update_c(ps%ptr)
+  end function mfree_particles_update
+
+  integer(c_int) function mfree_particles_get_dimension(ps, dim) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int32_t), intent(out) :: dim
+    st = mfree_particles_get_dimension_c(ps%ptr, dim)
+  end function mfree_particles_get_dimension
+
+  integer(c_int) function mfree_particles_get_size(ps, n, n_ghost) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int32_t), intent(out), optional, target :: n, n_ghost
+    type(c_ptr) :: pn, pg
+    pn = c_null_ptr
+    pg = c_null_ptr
+    if (present(n)) pn = c_loc(n)
+    if (present(n_ghost)) pg = c_loc(n_ghost)
+    st = mfree_particles_get_size_c(ps%ptr, pn, pg)
+  end function mfree_particles_get_size
+
+  integer(c_int) function mfree_particles_get_neighbor_nnz(ps, nnz) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(out) :: nnz
+    st = mfree_particles_get_neighbor_nnz_c(ps%ptr, nnz)
+  end function mfree_particles_get_neighbor_nnz
+
+  !> 0-based CSR copy: row i (1-based) is cols(rowptr(i)+1 : rowptr(i+1)), values 0..n-1.
+  integer(c_int) function mfree_particles_get_neighbors(ps, rowptr, cols) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(out) :: rowptr(*)
+    integer(c_int32_t), intent(out) :: cols(*)
+    st = mfree_particles_get_neighbors_c(ps%ptr, rowptr, cols)
+  end function mfree_particles_get_neighbors
+
+  integer(c_int) function mfree_particles_get_volumes(ps, v) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(out) :: v(*)
+    st = mfree_particles_get_volumes_c(ps%ptr, v)
+  end function mfree_particles_get_volumes
+
+  integer(c_int) function mfree_particles_get_site_status(ps, status, nfailed) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int32_t), intent(out), optional, target :: status(*)
+    integer(c_int32_t), intent(out), optional, target :: nfailed
+    type(c_ptr) :: pstat, pf
+    pstat = c_null_ptr
+    pf = c_null_ptr
+    if (present(status)) pstat = c_loc(status)
+    if (present(nfailed)) pf = c_loc(nfailed)
+    st = mfree_particles_get_site_status_c(ps%ptr, pstat, pf)
+  end function mfree_particles_get_site_status
+
+  ! ==== approximants ===================================================================
+
+  integer(c_int) function mfree_approximant_create(ctx, ps, method, a) result(st)
+    type(mfree_context), intent(in) :: ctx
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int), intent(in) :: method
+    type(mfree_approximant), intent(out) :: a
+    st = mfree_approximant_create_c(ctx%ptr, ps%ptr, method, a%ptr)
+  end function mfree_approximant_create
+
+  integer(c_int) function mfree_approximant_destroy(a) result(st)
+    type(mfree_approximant), intent(inout) :: a
+    st = mfree_approximant_destroy_c(a%ptr)
+  end function mfree_approximant_destroy
+
+  integer(c_int) function mfree_approximant_set_kernel(a, kernel, param) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: kernel
+    real(c_double), intent(in) :: param
+    st = mfree_approximant_set_kernel_c(a%ptr, kernel, param)
+  end function mfree_approximant_set_kernel
+
+  integer(c_int) function mfree_approximant_set_order(a, order) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(in) :: order
+    st = mfree_approximant_set_order_c(a%ptr, order)
+  end function mfree_approximant_set_order
+
+  !> flags: ior of MFREE_DERIV_* values.
+  integer(c_int) function mfree_approximant_set_derivatives(a, flags) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(in) :: flags
+    st = mfree_approximant_set_derivatives_c(a%ptr, flags)
+  end function mfree_approximant_set_derivatives
+
+  integer(c_int) function mfree_approximant_set_fallback(a, policy) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: policy
+    st = mfree_approximant_set_fallback_c(a%ptr, policy)
+  end function mfree_approximant_set_fallback
+
+  integer(c_int) function mfree_approximant_set_points_array(a, npts, x, layout, ld, h, &
+                                                             h_stride, mem) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(in) :: npts
+    real(c_double), intent(in), target :: x(*), h(*)
+    integer(c_int), intent(in) :: layout, mem
+    integer(c_int64_t), intent(in) :: ld, h_stride
+    st = mfree_approximant_set_points_c(a%ptr, npts, x, layout, ld, h, h_stride, mem)
+  end function mfree_approximant_set_points_array
+
+  integer(c_int) function mfree_approximant_set_points_scalar(a, npts, x, layout, ld, h, &
+                                                              h_stride, mem) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(in) :: npts
+    real(c_double), intent(in), target :: x(*)
+    real(c_double), intent(in), target :: h
+    integer(c_int), intent(in) :: layout, mem
+    integer(c_int64_t), intent(in) :: ld, h_stride
+    real(c_double), pointer :: p(:)
+    call c_f_pointer(c_loc(h), p, [1])
+    st = mfree_approximant_set_points_c(a%ptr, npts, x, layout, ld, p, h_stride, mem)
+  end function mfree_approximant_set_points_scalar
+
+  integer(c_int) function mfree_approximant_setup(a) result(st)
+    type(mfree_approximant), intent(in) :: a
+    st = mfree_approximant_setup_c(a%ptr)
+  end function mfree_approximant_setup
+
+  integer(c_int) function mfree_approximant_update(a) result(st)
+    type(mfree_approximant), intent(in) :: a
+    st = mfree_approximant_update_c(a%ptr)
+  end function mfree_approximant_update
+
+  !> out = op(u). For u(ncomp,n) use MFREE_LAYOUT_AOS with uld = ncomp (or the leading
+  !> extent of a larger array, e.g. 3 for v(3,n) in 2D); MFREE_OP_GRADIENT writes
+  !> direction d of component c at c*dim + d, i.e. out(d, c, i) for out(dim, ncomp, n)
+  !> with old = dim*ncomp.
+  integer(c_int) function mfree_approximant_apply(a, op, ncomp, u, ulayout, uld, out, &
+                                                  olayout, old) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: op, ulayout, olayout
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(in) :: u(*)
+    integer(c_int64_t), intent(in) :: uld, old
+    real(c_double), intent(out) :: out(*)
+    st = mfree_approximant_apply_c(a%ptr, op, ncomp, u, ulayout, uld, out, olayout, old)
+  end function mfree_approximant_apply
+
+  integer(c_int) function mfree_approximant_apply_add(a, op, ncomp, u, ulayout, uld, out, &
+                                                      olayout, old) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: op, ulayout, olayout
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(in) :: u(*)
+    integer(c_int64_t), intent(in) :: uld, old
+    real(c_double), intent(inout) :: out(*)
+    st = mfree_approximant_apply_add_c(a%ptr, op, ncomp, u, ulayout, uld, out, olayout, &
+                                       old)
+  end function mfree_approximant_apply_add
+
+  integer(c_int) function mfree_approximant_get_num_sites(a, nsites) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out) :: nsites
+    st = mfree_approximant_get_num_sites_c(a%ptr, nsites)
+  end function mfree_approximant_get_num_sites
+
+  integer(c_int) function mfree_approximant_get_nnz(a, nnz) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int64_t), intent(out) :: nnz
+    st = mfree_approximant_get_nnz_c(a%ptr, nnz)
+  end function mfree_approximant_get_nnz
+
+  !> One table as 0-based CSR; any of rowptr, cols, vals may be omitted (not all).
+  integer(c_int) function mfree_approximant_assemble_csr(a, deriv, component, rowptr, cols, &
+                                                         vals) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: deriv
+    integer(c_int32_t), intent(in) :: component
+    integer(c_int64_t), intent(out), optional, target :: rowptr(*)
+    integer(c_int32_t), intent(out), optional, target :: cols(*)
+    real(c_double), intent(out), optional, target :: vals(*)
+    type(c_ptr) :: pr, pc, pv
+    pr = c_null_ptr
+    pc = c_null_ptr
+    pv = c_null_ptr
+    if (present(rowptr)) pr = c_loc(rowptr)
+    if (present(cols)) pc = c_loc(cols)
+    if (present(vals)) pv = c_loc(vals)
+    st = mfree_approximant_assemble_csr_c(a%ptr, deriv, component, pr, pc, pv)
+  end function mfree_approximant_assemble_csr
+
+  integer(c_int) function mfree_approximant_check_reproduction(a, order, fn_err, deriv_err) &
+      result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(in) :: order
+    real(c_double), intent(out) :: fn_err, deriv_err
+    st = mfree_approximant_check_reproduction_c(a%ptr, order, fn_err, deriv_err)
+  end function mfree_approximant_check_reproduction
+
+  integer(c_int) function mfree_approximant_get_site_status(a, status, nfailed) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out), optional, target :: status(*)
+    integer(c_int32_t), intent(out), optional, target :: nfailed
+    type(c_ptr) :: pstat, pf
+    pstat = c_null_ptr
+    pf = c_null_ptr
+    if (present(status)) pstat = c_loc(status)
+    if (present(nfailed)) pf = c_loc(nfailed)
+    st = mfree_approximant_get_site_status_c(a%ptr, pstat, pf)
+  end function mfree_approximant_get_site_status
+
+  integer(c_int) function mfree_approximant_get_neighbor_counts(a, counts) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out) :: counts(*)
+    st = mfree_approximant_get_neighbor_counts_c(a%ptr, counts)
+  end function mfree_approximant_get_neighbor_counts
+
+  integer(c_int) function mfree_approximant_get_condition(a, cond) result(st)
+    type(mfree_approximant), intent(in) :: a
+    real(c_double), intent(out) :: cond(*)
+    st = mfree_approximant_get_condition_c(a%ptr, cond)
+  end function mfree_approximant_get_condition
+
+  integer(c_int) function mfree_approximant_get_site_order(a, order) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out) :: order(*)
+    st = mfree_approximant_get_site_order_c(a%ptr, order)
+  end function mfree_approximant_get_site_order
+
+  ! ==== sparse matrices ================================================================
+
+  !> A matrix from 0-based CSR host arrays (copied).
+  integer(c_int) function mfree_matrix_create_csr(ctx, nrows, ncols, rowptr, cols, vals, A) &
+      result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: nrows, ncols
+    integer(c_int64_t), intent(in) :: rowptr(*)
+    integer(c_int32_t), intent(in) :: cols(*)
+    real(c_double), intent(in) :: vals(*)
+    type(mfree_matrix), intent(out) :: A
+    st = mfree_matrix_create_csr_c(ctx%ptr, nrows, ncols, rowptr, cols, vals, A%ptr)
+  end function mfree_matrix_create_csr
+
+  integer(c_int) function mfree_matrix_destroy(A) result(st)
+    type(mfree_matrix), intent(inout) :: A
+    st = mfree_matrix_destroy_c(A%ptr)
+  end function mfree_matrix_destroy
+
+  integer(c_int) function mfree_matrix_get_size(A, nrows, ncols, nnz) result(st)
+    type(mfree_matrix), intent(in) :: A
+    integer(c_int32_t), intent(out), optional, target :: nrows, ncols
+    integer(c_int64_t), intent(out), optional, target :: nnz
+    type(c_ptr) :: pr, pc, pn
+    pr = c_null_ptr
+    pc = c_null_ptr
+    pn = c_null_ptr
+    if (present(nrows)) pr = c_loc(nrows)
+    if (present(ncols)) pc = c_loc(ncols)
+    if (present(nnz)) pn = c_loc(nnz)
+    st = mfree_matrix_get_size_c(A%ptr, pr, pc, pn)
+  end function mfree_matrix_get_size
+
+  !> Sizes of the views: rows + 1 (or columns + 1 for CSC) offsets and nnz entries.
+  integer(c_int) function view_sizes(A, csc, noff, nnz) result(st)
+    type(mfree_matrix), intent(in) :: A
+    logical, intent(in) :: csc
+    integer(c_int64_t), intent(out) :: noff, nnz
+    integer(c_int32_t), target :: nrows, ncols
+    integer(c_int64_t), target :: nz
+    noff = 0
+    nnz = 0
+    st = mfree_matrix_get_size_c(A%ptr, c_loc(nrows), c_loc(ncols), c_loc(nz))
+    if (st /= MFREE_SUCCESS) return
+    if (csc) then
+      noff = int(ncols, c_int64_t) + 1
+    else
+      noff = int(nrows, c_int64_t) + 1
+    end if
+    nnz = nz
+  end function view_sizes
+
+  !> Zero-copy CSR view as Fortran pointers (read only; 0-based offsets and columns:
+  !> row i holds k = rowptr(i)+1 .. rowptr(i+1), column cols(k)+1, value vals(k)). The
+  !> pointers stay valid until A is refilled with another pattern or destroyed.
+  integer(c_int) function mfree_matrix_get_csr(A, rowptr, cols, vals) result(st)
+    type(mfree_matrix), intent(in) :: A
+    integer(c_int64_t), pointer, intent(out) :: rowptr(:)
+    integer(c_int32_t), pointer, intent(out) :: cols(:)
+    real(c_double), pointer, intent(out) :: vals(:)
+    type(c_ptr) :: pr, pc, pv
+    integer(c_int64_t) :: noff, nnz
+    nullify (rowptr, cols, vals)
+    st = view_sizes(A, .false., noff, nnz)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_matrix_get_csr_c(A%ptr, pr, pc, pv)
+    if (st /= MFREE_SUCCESS) return
+    call c_f_pointer(pr, rowptr, [noff])
+    if (nnz > 0) then
+      call c_f_pointer(pc, cols, [nnz])
+      call c_f_pointer(pv, vals, [nnz])
+    else
+      cols => empty_i32
+      vals => empty_dbl
+    end if
+  end function mfree_matrix_get_csr
+
+  !> As mfree_matrix_get_csr with 32-bit offsets (MFREE_ERR_UNSUPPORTED if nnz is too big).
+  integer(c_int) function mfree_matrix_get_csr_i32(A, rowptr, cols, vals) result(st)
+    type(mfree_matrix), intent(in) :: A
+    integer(c_int32_t), pointer, intent(out) :: rowptr(:)
+    integer(c_int32_t), pointer, intent(out) :: cols(:)
+    real(c_double), pointer, intent(out) :: vals(:)
+    type(c_ptr) :: pr, pc, pv
+    integer(c_int64_t) :: noff, nnz
+    nullify (rowptr, cols, vals)
+    st = view_sizes(A, .false., noff, nnz)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_matrix_get_csr_i32_c(A%ptr, pr, pc, pv)
+    if (st /= MFREE_SUCCESS) return
+    call c_f_pointer(pr, rowptr, [noff])
+    if (nnz > 0) then
+      call c_f_pointer(pc, cols, [nnz])
+      call c_f_pointer(pv, vals, [nnz])
+    else
+      cols => empty_i32
+      vals => empty_dbl
+    end if
+  end function mfree_matrix_get_csr_i32
+
+  !> As mfree_matrix_get_csr with 64-bit offsets and columns.
+  integer(c_int) function mfree_matrix_get_csr_i64(A, rowptr, cols, vals) result(st)
+    type(mfree_matrix), intent(in) :: A
+    integer(c_int64_t), pointer, intent(out) :: rowptr(:)
+    integer(c_int64_t), pointer, intent(out) :: cols(:)
+    real(c_double), pointer, intent(out) :: vals(:)
+    type(c_ptr) :: pr, pc, pv
+    integer(c_int64_t) :: noff, nnz
+    nullify (rowptr, cols, vals)
+    st = view_sizes(A, .false., noff, nnz)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_matrix_get_csr_i64_c(A%ptr, pr, pc, pv)
+    if (st /= MFREE_SUCCESS) return
+    call c_f_pointer(pr, rowptr, [noff])
+    if (nnz > 0) then
+      call c_f_pointer(pc, cols, [nnz])
+      call c_f_pointer(pv, vals, [nnz])
+    else
+      cols => empty_i64
+      vals => empty_dbl
+    end if
+  end function mfree_matrix_get_csr_i64
+
+  !> Zero-copy CSC view (0-based), computed on first request after a fill.
+  integer(c_int) function mfree_matrix_get_csc(A, colptr, rows, vals) result(st)
+    type(mfree_matrix), intent(in) :: A
+    integer(c_int64_t), pointer, intent(out) :: colptr(:)
+    integer(c_int32_t), pointer, intent(out) :: rows(:)
+    real(c_double), pointer, intent(out) :: vals(:)
+    type(c_ptr) :: pcp, pr, pv
+    integer(c_int64_t) :: noff, nnz
+    nullify (colptr, rows, vals)
+    st = view_sizes(A, .true., noff, nnz)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_matrix_get_csc_c(A%ptr, pcp, pr, pv)
+    if (st /= MFREE_SUCCESS) return
+    call c_f_pointer(pcp, colptr, [noff])
+    if (nnz > 0) then
+      call c_f_pointer(pr, rows, [nnz])
+      call c_f_pointer(pv, vals, [nnz])
+    else
+      rows => empty_i32
+      vals => empty_dbl
+    end if
+  end function mfree_matrix_get_csc
+
+  integer(c_int) function mfree_matrix_get_pattern_id(A, id) result(st)
+    type(mfree_matrix), intent(in) :: A
+    integer(c_int64_t), intent(out) :: id
+    st = mfree_matrix_get_pattern_id_c(A%ptr, id)
+  end function mfree_matrix_get_pattern_id
+
+  integer(c_int) function mfree_matrix_get_symmetric(A, symmetric) result(st)
+    type(mfree_matrix), intent(in) :: A
+    integer(c_int32_t), intent(out) :: symmetric
+    st = mfree_matrix_get_symmetric_c(A%ptr, symmetric)
+  end function mfree_matrix_get_symmetric
+
+  integer(c_int) function mfree_matrix_apply(A, x, y) result(st)
+    type(mfree_matrix), intent(in) :: A
+    real(c_double), intent(in) :: x(*)
+    real(c_double), intent(out) :: y(*)
+    st = mfree_matrix_apply_c(A%ptr, x, y)
+  end function mfree_matrix_apply
+
+  ! ==== assembly =======================================================================
+
+  !> Bubnov-Galerkin: pass a null test approximant, mfree_approximant().
+  integer(c_int) function mfree_assembler_create(ctx, trial, test, form, as) result(st)
+    type(mfree_context), intent(in) :: ctx
+    type(mfree_approximant), intent(in) :: trial, test
+    integer(c_int), intent(in) :: form
+    type(mfree_assembler), intent(out) :: as
+    st = mfree_assembler_create_c(ctx%ptr, trial%ptr, test%ptr, form, as%ptr)
+  end function mfree_assembler_create
+
+  integer(c_int) function mfree_assembler_destroy(as) result(st)
+    type(mfree_assembler), intent(inout) :: as
+    st = mfree_assembler_destroy_c(as%ptr)
+  end function mfree_assembler_destroy
+
+  integer(c_int) function mfree_assembler_set_material(as, young, poisson) result(st)
+    type(mfree_assembler), intent(in) :: as
+    real(c_double), intent(in) :: young, poisson
+    st = mfree_assembler_set_material_c(as%ptr, young, poisson)
+  end function mfree_assembler_set_material
+
+  integer(c_int) function mfree_assembler_set_coefficient(as, c) result(st)
+    type(mfree_assembler), intent(in) :: as
+    real(c_double), intent(in) :: c
+    st = mfree_assembler_set_coefficient_c(as%ptr, c)
+  end function mfree_assembler_set_coefficient
+
+  integer(c_int) function mfree_assembler_set_quadrature_nodal(as) result(st)
+    type(mfree_assembler), intent(in) :: as
+    st = mfree_assembler_set_quadrature_nodal_c(as%ptr)
+  end function mfree_assembler_set_quadrature_nodal
+
+  !> Background cells; inside (optional) drops the points where it returns 0.
+  integer(c_int) function mfree_assembler_set_quadrature_cells(as, lo, hi, ncells, ngauss, &
+                                                               inside, user) result(st)
+    type(mfree_assembler), intent(in) :: as
+    real(c_double), intent(in) :: lo(*), hi(*)
+    integer(c_int32_t), intent(in) :: ncells(*)
+    integer(c_int32_t), intent(in) :: ngauss
+    procedure(mfree_inside_fn), optional :: inside
+    type(c_ptr), intent(in), optional :: user
+    type(c_funptr) :: fp
+    fp = c_null_funptr
+    if (present(inside)) fp = c_funloc(inside)
+    st = mfree_assembler_set_quadrature_cells_c(as%ptr, lo, hi, ncells, ngauss, fp, &
+                                                user_ptr(user))
+  end function mfree_assembler_set_quadrature_cells
+
+  integer(c_int) function mfree_assembler_set_quadrature_points(as, npts, x, layout, ld, w) &
+      result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(in) :: npts
+    real(c_double), intent(in) :: x(*), w(*)
+    integer(c_int), intent(in) :: layout
+    integer(c_int64_t), intent(in) :: ld
+    st = mfree_assembler_set_quadrature_points_c(as%ptr, npts, x, layout, ld, w)
+  end function mfree_assembler_set_quadrature_points
+
+  !> Body force b(x); absent f removes it.
+  integer(c_int) function mfree_assembler_set_body_force(as, f, user) result(st)
+    type(mfree_assembler), intent(in) :: as
+    procedure(mfree_field_fn), optional :: f
+    type(c_ptr), intent(in), optional :: user
+    type(c_funptr) :: fp
+    fp = c_null_funptr
+    if (present(f)) fp = c_funloc(f)
+    st = mfree_assembler_set_body_force_c(as%ptr, fp, user_ptr(user))
+  end function mfree_assembler_set_body_force
+
+  integer(c_int) function mfree_assembler_add_traction(as, npts, x, layout, ld, w, t, user) &
+      result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(in) :: npts
+    real(c_double), intent(in) :: x(*), w(*)
+    integer(c_int), intent(in) :: layout
+    integer(c_int64_t), intent(in) :: ld
+    procedure(mfree_field_fn) :: t
+    type(c_ptr), intent(in), optional :: user
+    st = mfree_assembler_add_traction_c(as%ptr, npts, x, layout, ld, w, c_funloc(t), &
+                                        user_ptr(user))
+  end function mfree_assembler_add_traction
+
+  integer(c_int) function mfree_assembler_add_traction_segments(as, nseg, x, ngauss, t, &
+                                                                user) result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(in) :: nseg, ngauss
+    real(c_double), intent(in) :: x(*)
+    procedure(mfree_field_fn) :: t
+    type(c_ptr), intent(in), optional :: user
+    st = mfree_assembler_add_traction_segments_c(as%ptr, nseg, x, ngauss, c_funloc(t), &
+                                                 user_ptr(user))
+  end function mfree_assembler_add_traction_segments
+
+  !> Essential condition on boundary points; normals (dim per point) only for Nitsche.
+  integer(c_int) function mfree_assembler_add_dirichlet(as, method, npts, x, layout, ld, w, &
+                                                        normals, component_mask, g, user) &
+      result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int), intent(in) :: method, layout
+    integer(c_int32_t), intent(in) :: npts, component_mask
+    real(c_double), intent(in) :: x(*), w(*)
+    integer(c_int64_t), intent(in) :: ld
+    real(c_double), intent(in), optional, target :: normals(*)
+    procedure(mfree_field_fn) :: g
+    type(c_ptr), intent(in), optional :: user
+    type(c_ptr) :: pn
+    pn = c_null_ptr
+    if (present(normals)) pn = c_loc(normals)
+    st = mfree_assembler_add_dirichlet_c(as%ptr, method, npts, x, layout, ld, w, pn, &
+                                         component_mask, c_funloc(g), user_ptr(user))
+  end function mfree_assembler_add_dirichlet
+
+  !> Row replacement at particles; nodes are 0-based particle indices.
+  integer(c_int) function mfree_assembler_add_dirichlet_nodes(as, nnodes, nodes, &
+                                                              component_mask, g, user) &
+      result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(in) :: nnodes, component_mask
+    integer(c_int32_t), intent(in) :: nodes(*)
+    procedure(mfree_field_fn) :: g
+    type(c_ptr), intent(in), optional :: user
+    st = mfree_assembler_add_dirichlet_nodes_c(as%ptr, nnodes, nodes, component_mask, &
+                                               c_funloc(g), user_ptr(user))
+  end function mfree_assembler_add_dirichlet_nodes
+
+  !> Collocation traction rows at particles (0-based indices), normals dim per node.
+  integer(c_int) function mfree_assembler_add_traction_nodes(as, nnodes, nodes, normals, t, &
+                                                             user) result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(in) :: nnodes
+    integer(c_int32_t), intent(in) :: nodes(*)
+    real(c_double), intent(in) :: normals(*)
+    procedure(mfree_field_fn) :: t
+    type(c_ptr), intent(in), optional :: user
+    st = mfree_assembler_add_traction_nodes_c(as%ptr, nnodes, nodes, normals, c_funloc(t), &
+                                              user_ptr(user))
+  end function mfree_assembler_add_traction_nodes
+
+  !> Finite-element blending layer; connectivity and gu are 0-based particle indices.
+  integer(c_int) function mfree_assembler_set_fe_layer(as, nelem, nodes_per_element, &
+                                                       connectivity, ngu, gu, &
+                                                       component_mask, g, user) result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(in) :: nelem, nodes_per_element, ngu, component_mask
+    integer(c_int32_t), intent(in) :: connectivity(*), gu(*)
+    procedure(mfree_field_fn) :: g
+    type(c_ptr), intent(in), optional :: user
+    st = mfree_assembler_set_fe_layer_c(as%ptr, nelem, nodes_per_element, connectivity, &
+                                        ngu, gu, component_mask, c_funloc(g), user_ptr(user))
+  end function mfree_assembler_set_fe_layer
+
+  integer(c_int) function mfree_assembler_set_penalty(as, alpha) result(st)
+    type(mfree_assembler), intent(in) :: as
+    real(c_double), intent(in) :: alpha
+    st = mfree_assembler_set_penalty_c(as%ptr, alpha)
+  end function mfree_assembler_set_penalty
+
+  integer(c_int) function mfree_assembler_setup(as) result(st)
+    type(mfree_assembler), intent(in) :: as
+    st = mfree_assembler_setup_c(as%ptr)
+  end function mfree_assembler_setup
+
+  integer(c_int) function mfree_assembler_update(as) result(st)
+    type(mfree_assembler), intent(in) :: as
+    st = mfree_assembler_update_c(as%ptr)
+  end function mfree_assembler_update
+
+  integer(c_int) function mfree_assembler_get_size(as, ndofs, nquad) result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(out), optional, target :: ndofs, nquad
+    type(c_ptr) :: pd, pq
+    pd = c_null_ptr
+    pq = c_null_ptr
+    if (present(ndofs)) pd = c_loc(ndofs)
+    if (present(nquad)) pq = c_loc(nquad)
+    st = mfree_assembler_get_size_c(as%ptr, pd, pq)
+  end function mfree_assembler_get_size
+
+  !> K null: a new matrix; else refilled (same pattern kept when it did not change).
+  integer(c_int) function mfree_assembler_assemble_matrix(as, K) result(st)
+    type(mfree_assembler), intent(in) :: as
+    type(mfree_matrix), intent(inout) :: K
+    st = mfree_assembler_assemble_matrix_c(as%ptr, K%ptr)
+  end function mfree_assembler_assemble_matrix
+
+  integer(c_int) function mfree_assembler_assemble_rhs(as, f) result(st)
+    type(mfree_assembler), intent(in) :: as
+    real(c_double), intent(out) :: f(*)
+    st = mfree_assembler_assemble_rhs_c(as%ptr, f)
+  end function mfree_assembler_assemble_rhs
+
+  ! ==== semi-discrete particle systems =================================================
+
+  !> State y((2 dim + 1) n): positions y(1 : dim n) as x(dim, n), velocity parameters
+  !> as v(dim, n), then the n densities.
+  integer(c_int) function mfree_system_create_fluid(ctx, dim, n, sys) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: dim, n
+    type(mfree_system), intent(out) :: sys
+    st = mfree_system_create_fluid_c(ctx%ptr, dim, n, sys%ptr)
+  end function mfree_system_create_fluid
+
+  integer(c_int) function mfree_system_destroy(sys) result(st)
+    type(mfree_system), intent(inout) :: sys
+    st = mfree_system_destroy_c(sys%ptr)
+  end function mfree_system_destroy
+
+  !> Rest densities rho0 (array with stride, or one value with stride 0; copied).
+  integer(c_int) function mfree_system_set_fluid_array(sys, rho0, stride, kappa, gamma, mu) &
+      result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: rho0(*)
+    integer(c_int64_t), intent(in) :: stride
+    real(c_double), intent(in) :: kappa, gamma, mu
+    st = mfree_system_set_fluid_c(sys%ptr, rho0, stride, kappa, gamma, mu)
+  end function mfree_system_set_fluid_array
+
+  integer(c_int) function mfree_system_set_fluid_scalar(sys, rho0, stride, kappa, gamma, mu) &
+      result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: rho0
+    integer(c_int64_t), intent(in) :: stride
+    real(c_double), intent(in) :: kappa, gamma, mu
+    real(c_double) :: one(1)
+    one(1) = rho0  ! copied by mfree: a local array will do
+    st = mfree_system_set_fluid_c(sys%ptr, one, stride, kappa, gamma, mu)
+  end function mfree_system_set_fluid_scalar
+
+  integer(c_int) function mfree_system_set_masses_array(sys, m, stride) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: m(*)
+    integer(c_int64_t), intent(in) :: stride
+    st = mfree_system_set_masses_c(sys%ptr, m, stride)
+  end function mfree_system_set_masses_array
+
+  integer(c_int) function mfree_system_set_masses_scalar(sys, m, stride) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: m
+    integer(c_int64_t), intent(in) :: stride
+    real(c_double) :: one(1)
+    one(1) = m
+    st = mfree_system_set_masses_c(sys%ptr, one, stride)
+  end function mfree_system_set_masses_scalar
+
+  integer(c_int) function mfree_system_set_smoothing(sys, h) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: h
+    st = mfree_system_set_smoothing_c(sys%ptr, h)
+  end function mfree_system_set_smoothing
+
+  integer(c_int) function mfree_system_set_gravity(sys, g) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: g(*)
+    st = mfree_system_set_gravity_c(sys%ptr, g)
+  end function mfree_system_set_gravity
+
+  integer(c_int) function mfree_system_set_lumping(sys, lump) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int), intent(in) :: lump
+    st = mfree_system_set_lumping_c(sys%ptr, lump)
+  end function mfree_system_set_lumping
+
+  !> Wall particles x(dim, nwall) with unit normals(dim, nwall) into the fluid (copied).
+  integer(c_int) function mfree_system_set_walls(sys, nwall, x, normals, r0, strength) &
+      result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: nwall
+    real(c_double), intent(in) :: x(*), normals(*)
+    real(c_double), intent(in) :: r0, strength
+    st = mfree_system_set_walls_c(sys%ptr, nwall, x, normals, r0, strength)
+  end function mfree_system_set_walls
+
+  integer(c_int) function mfree_system_set_box(sys, lo, hi) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: lo(*), hi(*)
+    st = mfree_system_set_box_c(sys%ptr, lo, hi)
+  end function mfree_system_set_box
+
+  integer(c_int) function mfree_system_get_size(sys, neq) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(out) :: neq
+    st = mfree_system_get_size_c(sys%ptr, neq)
+  end function mfree_system_get_size
+
+  integer(c_int) function mfree_system_rhs(sys, t, y, ydot) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: t
+    real(c_double), intent(in) :: y(*)
+    real(c_double), intent(out) :: ydot(*)
+    st = mfree_system_rhs_c(sys%ptr, t, y, ydot)
+  end function mfree_system_rhs
+
+  !> consistent: 0 lumped, nonzero consistent velocity block. M null: created.
+  integer(c_int) function mfree_system_assemble_mass(sys, y, consistent, M) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: y(*)
+    integer(c_int32_t), intent(in) :: consistent
+    type(mfree_matrix), intent(inout) :: M
+    st = mfree_system_assemble_mass_c(sys%ptr, y, consistent, M%ptr)
+  end function mfree_system_assemble_mass
+
+  integer(c_int) function mfree_system_assemble_interpolation(sys, y, S) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: y(*)
+    type(mfree_matrix), intent(inout) :: S
+    st = mfree_system_assemble_interpolation_c(sys%ptr, y, S%ptr)
+  end function mfree_system_assemble_interpolation
+
+  integer(c_int) function mfree_system_get_pressure(sys, y, p) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: y(*)
+    real(c_double), intent(out) :: p(*)
+    st = mfree_system_get_pressure_c(sys%ptr, y, p)
+  end function mfree_system_get_pressure
+
+  integer(c_int) function mfree_system_get_velocity(sys, y, vhat) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: y(*)
+    real(c_double), intent(out) :: vhat(*)
+    st = mfree_system_get_velocity_c(sys%ptr, y, vhat)
+  end function mfree_system_get_velocity
+
+  !> Integrate y from t to t_end (both updated in place); progress (optional) is called
+  !> after every accepted step; nsteps (optional) receives the number of steps.
+  integer(c_int) function mfree_system_integrate(sys, scheme, y, t, t_end, cfl, dt_max, &
+                                                 progress, user, nsteps) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int), intent(in) :: scheme
+    real(c_double), intent(inout) :: y(*)
+    real(c_double), intent(inout) :: t
+    real(c_double), intent(in) :: t_end, cfl, dt_max
+    procedure(mfree_progress_fn), optional :: progress
+    type(c_ptr), intent(in), optional :: user
+    integer(c_int64_t), intent(out), optional, target :: nsteps
+    type(c_funptr) :: fp
+    type(c_ptr) :: pn
+    fp = c_null_funptr
+    pn = c_null_ptr
+    if (present(progress)) fp = c_funloc(progress)
+    if (present(nsteps)) pn = c_loc(nsteps)
+    st = mfree_system_integrate_c(sys%ptr, scheme, y, t, t_end, cfl, dt_max, fp, &
+                                  user_ptr(user), pn)
+  end function mfree_system_integrate
+
+  !> Elastodynamics by collocation on a set-up collocation assembler (kept alive).
+  integer(c_int) function mfree_system_create_elastodynamic(ctx, as, density, sys) result(st)
+    type(mfree_context), intent(in) :: ctx
+    type(mfree_assembler), intent(in) :: as
+    real(c_double), intent(in) :: density
+    type(mfree_system), intent(out) :: sys
+    st = mfree_system_create_elastodynamic_c(ctx%ptr, as%ptr, density, sys%ptr)
+  end function mfree_system_create_elastodynamic
+
+  !> Load history g(t) scaling the boundary data; absent g: back to the default 1.
+  integer(c_int) function mfree_system_set_load_history(sys, g, user) result(st)
+    type(mfree_system), intent(in) :: sys
+    procedure(mfree_history_fn), optional :: g
+    type(c_ptr), intent(in), optional :: user
+    type(c_funptr) :: fp
+    fp = c_null_funptr
+    if (present(g)) fp = c_funloc(g)
+    st = mfree_system_set_load_history_c(sys%ptr, fp, user_ptr(user))
+  end function mfree_system_set_load_history
+
+  !> Stress at the particles (1D: sigma(n); 2D: sigma(3, n) as xx, yy, xy) at time t.
+  integer(c_int) function mfree_system_get_stress(sys, t, y, sigma) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: t
+    real(c_double), intent(in) :: y(*)
+    real(c_double), intent(out) :: sigma(*)
+    st = mfree_system_get_stress_c(sys%ptr, t, y, sigma)
+  end function mfree_system_get_stress
+
+  !> The user pointer of a callback: c_null_ptr when absent.
+  type(c_ptr) function user_ptr(user)
+    type(c_ptr), intent(in), optional :: user
+    user_ptr = c_null_ptr
+    if (present(user)) user_ptr = user
+  end function user_ptr
+
+end module mfree

@@ -1,0 +1,160 @@
+!> module mfree_suitesparse: Fortran 2008 bindings of the SuiteSparse adapter
+!> (adapters/suitesparse/include/mfree_suitesparse.h, library libmfree_suitesparse).
+!> Built into libmfree_fortran_suitesparse only when the adapter is built; the core
+!> module mfree (libmfree_fortran) never depends on SuiteSparse.
+!>
+!> Same two layers as module mfree: raw bind(C) interfaces <C name>_c with the exact C
+!> types, and typed wrappers with the C names. The solver handle is type(mfree_solver)
+!> (C: mfree_suitesparse_t): a type named mfree_suitesparse would clash with this
+!> module's name in every program that uses it.
+module mfree_suitesparse
+  use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_ptr, &
+    c_null_ptr, c_loc
+  use mfree, only: mfree_context, mfree_matrix
+  implicit none
+  private
+
+  ! ---- mfree_solver_kind_t; values frozen --------------------------------------------
+  integer(c_int), parameter, public :: MFREE_SOLVER_CHOLMOD = 1
+  integer(c_int), parameter, public :: MFREE_SOLVER_UMFPACK = 2
+  integer(c_int), parameter, public :: MFREE_SOLVER_KLU = 3
+
+  !> A direct solver (C: mfree_suitesparse_t *).
+  type, public :: mfree_solver
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_solver
+
+  ! ---- raw bind(C) interfaces: one per public function of mfree_suitesparse.h -------
+  interface
+    integer(c_int) function mfree_suitesparse_create_c(ctx, kind, s) &
+        bind(C, name="mfree_suitesparse_create")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int), value :: kind
+      type(c_ptr), intent(out) :: s
+    end function mfree_suitesparse_create_c
+
+    integer(c_int) function mfree_suitesparse_destroy_c(s) &
+        bind(C, name="mfree_suitesparse_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: s
+    end function mfree_suitesparse_destroy_c
+
+    integer(c_int) function mfree_suitesparse_set_index_width_c(s, bits) &
+        bind(C, name="mfree_suitesparse_set_index_width")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: s
+      integer(c_int32_t), value :: bits
+    end function mfree_suitesparse_set_index_width_c
+
+    integer(c_int) function mfree_suitesparse_setup_c(s, A) &
+        bind(C, name="mfree_suitesparse_setup")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: s
+      type(c_ptr), value :: A
+    end function mfree_suitesparse_setup_c
+
+    integer(c_int) function mfree_suitesparse_update_c(s, A) &
+        bind(C, name="mfree_suitesparse_update")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: s
+      type(c_ptr), value :: A
+    end function mfree_suitesparse_update_c
+
+    integer(c_int) function mfree_suitesparse_solve_c(s, nrhs, b, ldb, x, ldx) &
+        bind(C, name="mfree_suitesparse_solve")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: s
+      integer(c_int32_t), value :: nrhs
+      type(c_ptr), value :: b
+      integer(c_int64_t), value :: ldb
+      real(c_double), intent(inout) :: x(*)
+      integer(c_int64_t), value :: ldx
+    end function mfree_suitesparse_solve_c
+
+    integer(c_int) function mfree_suitesparse_get_info_c(s, rcond, factor_nnz, index_width) &
+        bind(C, name="mfree_suitesparse_get_info")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: s
+      type(c_ptr), value :: rcond
+      type(c_ptr), value :: factor_nnz
+      type(c_ptr), value :: index_width
+    end function mfree_suitesparse_get_info_c
+  end interface
+  public :: mfree_suitesparse_create_c, mfree_suitesparse_destroy_c
+  public :: mfree_suitesparse_set_index_width_c, mfree_suitesparse_setup_c
+  public :: mfree_suitesparse_update_c, mfree_suitesparse_solve_c
+  public :: mfree_suitesparse_get_info_c
+
+  public :: mfree_suitesparse_create, mfree_suitesparse_destroy
+  public :: mfree_suitesparse_set_index_width, mfree_suitesparse_setup
+  public :: mfree_suitesparse_update, mfree_suitesparse_solve, mfree_suitesparse_get_info
+
+contains
+
+  integer(c_int) function mfree_suitesparse_create(ctx, kind, s) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int), intent(in) :: kind
+    type(mfree_solver), intent(out) :: s
+    st = mfree_suitesparse_create_c(ctx%ptr, kind, s%ptr)
+  end function mfree_suitesparse_create
+
+  integer(c_int) function mfree_suitesparse_destroy(s) result(st)
+    type(mfree_solver), intent(inout) :: s
+    st = mfree_suitesparse_destroy_c(s%ptr)
+  end function mfree_suitesparse_destroy
+
+  !> 0 (automatic), 32 or 64.
+  integer(c_int) function mfree_suitesparse_set_index_width(s, bits) result(st)
+    type(mfree_solver), intent(in) :: s
+    integer(c_int32_t), intent(in) :: bits
+    st = mfree_suitesparse_set_index_width_c(s%ptr, bits)
+  end function mfree_suitesparse_set_index_width
+
+  integer(c_int) function mfree_suitesparse_setup(s, A) result(st)
+    type(mfree_solver), intent(in) :: s
+    type(mfree_matrix), intent(in) :: A
+    st = mfree_suitesparse_setup_c(s%ptr, A%ptr)
+  end function mfree_suitesparse_setup
+
+  integer(c_int) function mfree_suitesparse_update(s, A) result(st)
+    type(mfree_solver), intent(in) :: s
+    type(mfree_matrix), intent(in) :: A
+    st = mfree_suitesparse_update_c(s%ptr, A%ptr)
+  end function mfree_suitesparse_update
+
+  !> Solve A X = B, column-major b(ldb, nrhs), x(ldx, nrhs). Omit b to solve in place
+  !> (x holds B on entry; ldb is then ldx): st = mfree_suitesparse_solve(s, nrhs,
+  !> ldb=n, x=x, ldx=n). Passing the same array as b and x would alias two Fortran
+  !> dummy arguments, which the standard forbids.
+  integer(c_int) function mfree_suitesparse_solve(s, nrhs, b, ldb, x, ldx) result(st)
+    type(mfree_solver), intent(in) :: s
+    integer(c_int32_t), intent(in) :: nrhs
+    real(c_double), intent(in), optional, target :: b(*)
+    integer(c_int64_t), intent(in) :: ldb, ldx
+    real(c_double), intent(inout), target :: x(*)
+    if (present(b)) then
+      st = mfree_suitesparse_solve_c(s%ptr, nrhs, c_loc(b), ldb, x, ldx)
+    else
+      st = mfree_suitesparse_solve_c(s%ptr, nrhs, c_loc(x), ldx, x, ldx)
+    end if
+  end function mfree_suitesparse_solve
+
+  !> Facts about the current factorisation; each output optional.
+  integer(c_int) function mfree_suitesparse_get_info(s, rcond, factor_nnz, index_width) &
+      result(st)
+    type(mfree_solver), intent(in) :: s
+    real(c_double), intent(out), optional, target :: rcond
+    integer(c_int64_t), intent(out), optional, target :: factor_nnz
+    integer(c_int32_t), intent(out), optional, target :: index_width
+    type(c_ptr) :: pr, pf, pw
+    pr = c_null_ptr
+    pf = c_null_ptr
+    pw = c_null_ptr
+    if (present(rcond)) pr = c_loc(rcond)
+    if (present(factor_nnz)) pf = c_loc(factor_nnz)
+    if (present(index_width)) pw = c_loc(index_width)
+    st = mfree_suitesparse_get_info_c(s%ptr, pr, pf, pw)
+  end function mfree_suitesparse_get_info
+
+end module mfree_suitesparse
