@@ -113,7 +113,7 @@ contains
       ed = max(ed, abs(divv(q) - (amat(1, 1) + amat(2, 2))))
       ejb = max(ejb, abs(gjb(1, q) - 2.5_c_double), abs(gjb(2, q) - 2.5_c_double))
     end do
-    write (*, '(a,a,3es10.2,a,es10.2)') what, ' grad u, grad v, div v errors', eu, ev, ed, &
+    write (*, '(a,a,3es10.2,a,es10.2)') trim(what), ': grad u, grad v, div v errors', eu, ev, ed, &
       '; a(x+y):', ejb
     if (claims) then
       call check(eu < tol .and. ev < tol .and. ed < tol, &
