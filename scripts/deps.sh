@@ -5,7 +5,7 @@
 # libsundials-dev, ...).
 set -euo pipefail
 
-MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran"
+MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev"
 
 if ! command -v dpkg-query >/dev/null 2>&1; then
   echo "deps.sh: dpkg-query not found: this script is for Debian/Ubuntu." >&2
