@@ -229,6 +229,37 @@ static void test_points_on_particles(void **s) {
       }
 }
 
+/* One support for all points (h_stride 0) equals the same value repeated. */
+static void test_point_support_stride_zero(void **s) {
+  (void)s;
+  static cloud_t c;
+  make_cloud(&c, 2, 12, 1.7, 0.0, 21);
+  mfree_particles_t *ps = make_set(&c, MFREE_KERNEL_CUBIC_SPLINE, MFREE_SEARCH_SYMMETRIC_MEAN, MFREE_COPY);
+  const int flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT | MFREE_DERIV_HESSIAN;
+  static double h[NMAX];
+  for (int i = 0; i < c.n; ++i) h[i] = c.h[0];
+  for (int mem = 0; mem < 2; ++mem) {
+    const mfree_mem_t mm = mem ? MFREE_BORROW : MFREE_COPY;
+    mfree_approximant_t *a1 = make_approx(ps, MFREE_METHOD_MLS, 2, MFREE_KERNEL_CUBIC_SPLINE, flags);
+    mfree_approximant_t *a0 = make_approx(ps, MFREE_METHOD_MLS, 2, MFREE_KERNEL_CUBIC_SPLINE, flags);
+    mfree_approximant_t *ap = make_approx(ps, MFREE_METHOD_MLS, 2, MFREE_KERNEL_CUBIC_SPLINE, flags);
+    assert_ok(ctx, mfree_approximant_set_points(a1, c.n, c.x, MFREE_LAYOUT_AOS, 2, h, 1, mm));
+    assert_ok(ctx, mfree_approximant_set_points(a0, c.n, c.x, MFREE_LAYOUT_AOS, 2, &c.h[0], 0, mm));
+    assert_ok(ctx, mfree_approximant_setup(a1));
+    assert_ok(ctx, mfree_approximant_setup(a0));
+    assert_ok(ctx, mfree_approximant_setup(ap)); /* the particles (uniform h) */
+    assert_no_failed_site(a0);
+    const double e = compare_all(a1, a0, 2, flags, "stride 0 vs 1");
+    if (e > 0.0) fail_msg("mem %d: h_stride 0 differs from a repeated h by %.3g", mem, e);
+    const double ep = compare_all(ap, a0, 2, flags, "stride 0 vs particles");
+    if (ep > 1e-13) fail_msg("mem %d: h_stride 0 points differ from the particles by %.3g", mem, ep);
+    assert_ok(ctx, mfree_approximant_destroy(&a1));
+    assert_ok(ctx, mfree_approximant_destroy(&a0));
+    assert_ok(ctx, mfree_approximant_destroy(&ap));
+  }
+  assert_ok(ctx, mfree_particles_destroy(&ps));
+}
+
 /* Particles-only methods refuse points (and nothing is changed: setup still works). */
 static void test_particles_only_methods(void **s) {
   (void)s;
@@ -479,6 +510,7 @@ static void test_periodic_mls(void **s) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_points_on_particles),
+      cmocka_unit_test(test_point_support_stride_zero),
       cmocka_unit_test(test_particles_only_methods),
       cmocka_unit_test(test_borrowed_points_update),
       cmocka_unit_test(test_borrowed_particles_update),

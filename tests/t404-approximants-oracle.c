@@ -1,7 +1,8 @@
 /* Approximants against an O(N^2) brute-force oracle written here: dense loops over ALL
  * particles (no neighbour lists), weights from mfree_kernel_eval, the textbook formulas
  * in long double with a small Gaussian elimination of our own:
- *  - SPH: Phi_j = W_j V_j, grad Phi_j = grad W_j V_j (000 eqs 21, 29);
+ *  - SPH: Phi_j = W_j V_j, grad Phi_j = grad W_j V_j (000 eqs 21, 29), and the Hessian
+ *    of the radial W, W'' n n^T + W'/r (I - n n^T);
  *  - Shepard: w_j / sum w and its quotient-rule derivative (000 eqs 38-39 and the
  *    [External/standard] derivative of section 4.2);
  *  - MLS order 1 and 2: shifted, h-scaled basis, M gamma = p(0), derivatives with the
@@ -143,7 +144,7 @@ static int basis_find(const basis_t *B, int i, int k) {
 
 /* Per-site data of the oracle: weights and their x-gradients for ALL particles. */
 typedef struct {
-  real d[NMAX][3], w[NMAX], gw[NMAX][3];
+  real d[NMAX][3], w[NMAX], gw[NMAX][3], hw[NMAX][6];
 } site_t;
 
 static void site_weights(const cloud_t *c, int s, site_t *st) {
@@ -156,14 +157,26 @@ static void site_weights(const cloud_t *c, int s, site_t *st) {
     }
     const double r = sqrt(r2);
     const double hp = c->conv == MFREE_SEARCH_GATHER ? c->h[s] : fmax(c->h[s], c->h[j]);
-    double w = 0.0, dw = 0.0;
-    assert_ok(ctx, mfree_kernel_eval(ctx, c->kernel, dim, 0.0, hp, 1, &r, &w, &dw, NULL));
+    double w = 0.0, dw = 0.0, d2w = 0.0;
+    assert_ok(ctx, mfree_kernel_eval(ctx, c->kernel, dim, 0.0, hp, 1, &r, &w, &dw, &d2w));
     st->w[j] = w;
     for (int a = 0; a < 3; ++a) {
       st->d[j][a] = a < dim ? dd[a] : 0.0;
       /* grad_x W(|x - x_j|) = W'(r) (x - x_j) / r = -W'(r) d / r */
       st->gw[j][a] = (a < dim && r > 0.0) ? -(real)dw * dd[a] / r : 0.0L;
     }
+    /* Hessian of a radial function: W'' n n^T + W'/r (I - n n^T), n = d / r; the limit
+     * W''(0) I at r = 0 */
+    for (int a = 0; a < dim; ++a)
+      for (int b = a; b < dim; ++b) {
+        const int e = a * dim - a * (a - 1) / 2 + (b - a);
+        if (r > 0.0) {
+          const real nn = (real)dd[a] * dd[b] / ((real)r * r);
+          st->hw[j][e] = (real)d2w * nn + (real)dw / r * ((a == b ? 1.0L : 0.0L) - nn);
+        } else {
+          st->hw[j][e] = a == b ? (real)d2w : 0.0L;
+        }
+      }
   }
 }
 
@@ -177,6 +190,7 @@ static void oracle_rows(const cloud_t *c, int s, const site_t *st, mfree_method_
       for (int j = 0; j < n; ++j) {
         val[j] = st->w[j] * c->v[j];
         for (int a = 0; a < dim; ++a) grad[a][j] = st->gw[j][a] * c->v[j];
+        for (int e = 0; e < dim * (dim + 1) / 2; ++e) hess[e][j] = st->hw[j][e] * c->v[j];
       }
       return;
     case MFREE_METHOD_SHEPARD:
@@ -344,7 +358,7 @@ typedef struct {
 } ocase_t;
 
 static const ocase_t kCases[] = {
-    {MFREE_METHOD_SPH, 0, 3, "SPH"},
+    {MFREE_METHOD_SPH, 0, 7, "SPH"},
     {MFREE_METHOD_SHEPARD, 0, 3, "Shepard"},
     {MFREE_METHOD_MLS, 1, 3, "MLS 1"},
     {MFREE_METHOD_MLS, 2, 3, "MLS 2"},
