@@ -10,7 +10,8 @@
  *  - 001 claim 12.A.4: the SSPH value table equals the RKPM value table to round-off
  *    for every kernel, support and order, at particles and at points; claim 12.A.5: the
  *    derivative tables differ; claim 12.A.13: MLS values equal SSPH values when the
- *    volumes are constant. */
+ *    volumes are constant;
+ *  - KB Method 3's derivative table is Method 1's (derived below). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -450,12 +451,58 @@ static void test_mls_equals_ssph_constant_volumes(void **s) {
     }
 }
 
+/* Derived here (not stated in paper 000): KB Method 3's derivatives are Method 1's. In
+ * Method 3 (eqs 65-66) A has rows p = (1, x_j - x) against q = (w^S, grad w^S); the row of
+ * p = 1 is (sum w^S, sum grad w^S) = (1, 0) by the Shepard partition of unity, so
+ * A = [[1, 0], [m, A1]] with A1 the Method 1 matrix (eq 61) and m the first moment, and
+ * the derivative rows of A^-T q are A1^-T grad w^S, Method 1's G (eq 56). The values
+ * differ: Method 3 corrects them to linear completeness, Method 1 keeps Shepard's. */
+static void test_kb3_gradient_is_kb1(void **s) {
+  (void)s;
+  static cloud_t c;
+  static double A[NMAX * NMAX], B[NMAX * NMAX];
+  double x[PMAX * 3], h[PMAX];
+  for (int dim = 1; dim <= 3; ++dim) {
+    const int m = dim == 1 ? 30 : (dim == 2 ? 12 : 6), npts = 20;
+    make_cloud(&c, dim, m, 1.6, 500u + (uint64_t)dim);
+    make_points(&c, 2.0, npts, 1.5 / (m - 1), 9u, x, h);
+    mfree_particles_t *ps = make_set(&c, MFREE_KERNEL_CUBIC_SPLINE, 0);
+    const cfg_t k1 = {MFREE_METHOD_KB_METHOD1, 1, MFREE_KERNEL_CUBIC_SPLINE, 3};
+    const cfg_t k3 = {MFREE_METHOD_KB_METHOD3, 1, MFREE_KERNEL_CUBIC_SPLINE, 3};
+    for (int where = 0; where < 2; ++where) {
+      const int ns = where ? npts : c.n;
+      mfree_approximant_t *a1 = make_approx(ps, &k1, dim, npts, where ? x : NULL, h);
+      mfree_approximant_t *a3 = make_approx(ps, &k3, dim, npts, where ? x : NULL, h);
+      const size_t sz = (size_t)ns * c.n;
+      for (int d = 0; d < dim; ++d) {
+        dense(a1, MFREE_DERIV_GRADIENT, d, c.n, A);
+        dense(a3, MFREE_DERIV_GRADIENT, d, c.n, B);
+        double diff = 0.0;
+        for (size_t q = 0; q < sz; ++q) diff = fmax(diff, fabs(A[q] - B[q]));
+        if (diff > 1e-12 * maxabs(A, sz))
+          fail_msg("dim %d %s: KB3 and KB1 gradients %d differ by %.3g", dim,
+                   where ? "points" : "particles", d, diff / maxabs(A, sz));
+      }
+      dense(a1, MFREE_DERIV_VALUE, 0, c.n, A);
+      dense(a3, MFREE_DERIV_VALUE, 0, c.n, B);
+      double diff = 0.0;
+      for (size_t q = 0; q < sz; ++q) diff = fmax(diff, fabs(A[q] - B[q]));
+      if (!(diff > 1e-3 * maxabs(A, sz)))
+        fail_msg("dim %d: KB3 values equal Shepard's (%.3g)", dim, diff);
+      assert_ok(ctx, mfree_approximant_destroy(&a1));
+      assert_ok(ctx, mfree_approximant_destroy(&a3));
+    }
+    assert_ok(ctx, mfree_particles_destroy(&ps));
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_true_derivatives),
       cmocka_unit_test(test_corrected_not_integrable),
       cmocka_unit_test(test_ssph_equals_rkpm_values),
       cmocka_unit_test(test_mls_equals_ssph_constant_volumes),
+      cmocka_unit_test(test_kb3_gradient_is_kb1),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
