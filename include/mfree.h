@@ -141,7 +141,9 @@ typedef MFREE_ENUM(mfree_method) {
                                            scaled basis, 000 eqs 43-46 */
   MFREE_METHOD_RKPM = 5,              /**< reproducing kernel particle method, order 0..3,
                                            001 Sect. 4 (weights W V; true derivatives) */
-  MFREE_METHOD_JOHNSON_BEISSEL = 6,   /**< 000 eqs 49, 52; particles only */
+  MFREE_METHOD_JOHNSON_BEISSEL = 6,   /**< 000 eqs 49, 52; particles only; under an
+                                           elasticity form the assembler keeps the
+                                           symmetrised SPH shear strain (eqs 48-52) */
   MFREE_METHOD_RANDLES_LIBERSKY = 7,  /**< renormalised gradient, 000 eqs 68-69;
                                            particles only */
   MFREE_METHOD_KB_METHOD1 = 8,        /**< Krongauz-Belytschko corrected derivatives,
@@ -726,7 +728,9 @@ MFREE_API mfree_status_t mfree_assembler_add_traction_nodes(mfree_assembler_t *a
  * functions of the interface nodes; at nodal quadrature points on the boundary the FE
  * functions are used, the node's volume split among its elements. The boundary nodes
  * are interpolating there, so u_c = g_c (components in component_mask) is imposed
- * directly on their unknowns.
+ * directly on their unknowns. Calls accumulate: each adds its elements to one layer and
+ * its own mask and g for its nodes (e.g. u_y = 0 on y = 0, u_x = 0 on x = 0); every call
+ * must use the same element type (MFREE_ERR_ARG otherwise).
  */
 MFREE_API mfree_status_t mfree_assembler_set_fe_layer(mfree_assembler_t *as, int32_t nelem,
                                                       int32_t nodes_per_element,

@@ -6,8 +6,10 @@
  * schemes; and with the finite-element layer (000 eqs 100-105, Fig. 2) the quadrature
  * points of the boundary nodes carry the bilinear elements' corner derivatives with the
  * node's volume split among its elements, the boundary rows being u_J = g(x_J).
- * The reference is what examples/elastostatics builds its paper-JB and FE-layer variants
- * from. Library only; dense comparisons. */
+ * Johnson-Beissel's shear strain keeps the symmetrised SPH derivatives (000 eqs 48-52:
+ * only the normal strains are corrected). A layer given in several calls (symmetry lines
+ * with different constrained components) is one layer with a mask per call.
+ * Library only; dense comparisons. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -78,12 +80,13 @@ static void plane_stress(double D[3][3]) {
 }
 
 /* Adds w B_J^T D B_K for test derivatives gt (of node J) and trial derivatives gr (of
- * node K) to the dense 2N x 2N matrix R. */
-static void add_pair(double *R, int32_t J, const double *gt, int32_t K, const double *gr, double w) {
+ * node K) to the dense 2N x 2N matrix R; the shear rows of B use gts and grs. */
+static void add_pair_s(double *R, int32_t J, const double *gt, const double *gts, int32_t K, const double *gr,
+                       const double *grs, double w) {
   double D[3][3];
   plane_stress(D);
-  const double BJ[3][2] = {{gt[0], 0}, {0, gt[1]}, {gt[1], gt[0]}};
-  const double BK[3][2] = {{gr[0], 0}, {0, gr[1]}, {gr[1], gr[0]}};
+  const double BJ[3][2] = {{gt[0], 0}, {0, gt[1]}, {gts[1], gts[0]}};
+  const double BK[3][2] = {{gr[0], 0}, {0, gr[1]}, {grs[1], grs[0]}};
   for (int c = 0; c < 2; ++c)
     for (int e = 0; e < 2; ++e) {
       double s = 0;
@@ -91,6 +94,10 @@ static void add_pair(double *R, int32_t J, const double *gt, int32_t K, const do
         for (int v = 0; v < 3; ++v) s += BJ[u][c] * D[u][v] * BK[v][e];
       R[(size_t)(2 * J + c) * 2 * N + 2 * K + e] += w * s;
     }
+}
+
+static void add_pair(double *R, int32_t J, const double *gt, int32_t K, const double *gr, double w) {
+  add_pair_s(R, J, gt, gt, K, gr, gr, w);
 }
 
 /* max |K - R| / max |R| for the assembled K (2N x 2N). */
@@ -136,8 +143,10 @@ static const scheme_t kSchemes[] = {
     {"MLS", MFREE_METHOD_MLS, 1, (mfree_method_t)0},
 };
 
-/* Builds the assembled and the reference stiffness of one scheme; with layer != 0 the
- * finite-element layer along x = 0 (the first two columns of nodes). */
+/* Builds the assembled and the reference stiffness of one scheme; with layer = 1 the
+ * finite-element layer along x = 0 (the first two columns of nodes, both components
+ * prescribed); with layer = 2 a second call adds the layer along y = 0 and the masks are
+ * u_x on x = 0, u_y on y = 0 (the corner element belongs to both calls). */
 static void check_scheme(const scheme_t *sc, int jitter, int layer) {
   mfree_particles_t *ps = cloud(jitter);
   mfree_approximant_t *trial = approx(ps, sc->trial, sc->order);
@@ -146,24 +155,48 @@ static void check_scheme(const scheme_t *sc, int jitter, int layer) {
   assert_ok(ctx, mfree_assembler_create(ctx, trial, test, MFREE_FORM_ELASTICITY_PLANE_STRESS, &as));
   assert_ok(ctx, mfree_assembler_set_material(as, E, NU));
   assert_ok(ctx, mfree_assembler_set_quadrature_nodal(as));
-  /* layer: quads (0,j), (1,j), (1,j+1), (0,j+1) in column-major node numbering */
-  int32_t conn[4 * (NY - 1)], gu[NY], nel[N] = {0};
+  /* layer on x = 0: quads (0,j), (1,j), (1,j+1), (0,j+1) in column-major node numbering;
+   * on y = 0: (i,0), (i+1,0), (i+1,1), (i,1) */
+  enum { NE1 = NY - 1, NE = NY - 1 + NX - 1 };
+  int32_t conn[4 * NE], gu[NY + NX], nel[N] = {0}, mask[N] = {0};
   for (int j = 0; j < NY - 1; ++j) {
     const int32_t q[4] = {j, NY + j, NY + j + 1, j + 1};
     memcpy(conn + 4 * j, q, sizeof q);
-    ++nel[j], ++nel[j + 1];
+  }
+  for (int i = 0; i < NX - 1; ++i) {
+    const int32_t q[4] = {i * NY, (i + 1) * NY, (i + 1) * NY + 1, i * NY + 1};
+    memcpy(conn + 4 * (NE1 + i), q, sizeof q);
   }
   for (int j = 0; j < NY; ++j) gu[j] = j;
-  if (layer) assert_ok(ctx, mfree_assembler_set_fe_layer(as, NY - 1, 4, conn, NY, gu, 3, zero_g, NULL));
+  for (int i = 0; i < NX; ++i) gu[NY + i] = i * NY;
+  const int ne = layer == 2 ? NE : NE1;
+  if (layer == 1) assert_ok(ctx, mfree_assembler_set_fe_layer(as, NE1, 4, conn, NY, gu, 3, zero_g, NULL));
+  if (layer == 2) {
+    assert_ok(ctx, mfree_assembler_set_fe_layer(as, NE1, 4, conn, NY, gu, 1, zero_g, NULL));
+    assert_ok(ctx, mfree_assembler_set_fe_layer(as, NX - 1, 4, conn + 4 * NE1, NX, gu + NY, 2, zero_g, NULL));
+  }
+  if (layer)
+    for (int j = 0; j < NY; ++j) mask[gu[j]] |= layer == 2 ? 1 : 3;
+  if (layer == 2)
+    for (int i = 0; i < NX; ++i) mask[gu[NY + i]] |= 2;
+  for (int k = 0; k < 4 * ne; ++k) nel[conn[k]] += mask[conn[k]] != 0;
   assert_ok(ctx, mfree_assembler_setup(as));
   mfree_matrix_t *K = NULL;
   assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
 
   double *Gr = gradients(trial), *Gt = test ? gradients(test) : Gr;
+  /* JB: symmetrised SPH derivatives in the shear rows (Bubnov: test = trial) */
+  double *Gs = Gr;
+  if (sc->trial == MFREE_METHOD_JOHNSON_BEISSEL) {
+    mfree_approximant_t *sph = approx(ps, MFREE_METHOD_SPH_SYMMETRIC, 0);
+    Gs = gradients(sph);
+    mfree_approximant_destroy(&sph);
+  }
+  const double *Gts = test ? Gt : Gs;
   double *R = calloc((size_t)4 * N * N, sizeof(double));
   for (int32_t I = 0; I < N; ++I) {
     if (layer && nel[I]) { /* boundary node: the elements' corner derivatives */
-      for (int e = 0; e < NY - 1; ++e)
+      for (int e = 0; e < ne; ++e)
         for (int a = 0; a < 4; ++a) {
           if (conn[4 * e + a] != I) continue;
           /* bilinear corner = the linear triangle (I, next, previous) */
@@ -179,27 +212,32 @@ static void check_scheme(const scheme_t *sc, int jitter, int layer) {
       continue;
     }
     for (int32_t J = 0; J < N; ++J) {
-      const double *gt = Gt + ((size_t)I * N + J) * 2;
-      if (gt[0] == 0.0 && gt[1] == 0.0) continue;
+      const size_t tj = ((size_t)I * N + J) * 2;
+      const double *gt = Gt + tj, *gts = Gts + tj;
+      if (gt[0] == 0.0 && gt[1] == 0.0 && gts[0] == 0.0 && gts[1] == 0.0) continue;
       for (int32_t Kn = 0; Kn < N; ++Kn) {
-        const double *gr = Gr + ((size_t)I * N + Kn) * 2;
-        if (gr[0] != 0.0 || gr[1] != 0.0) add_pair(R, J, gt, Kn, gr, V[I]);
+        const size_t rk = ((size_t)I * N + Kn) * 2;
+        const double *gr = Gr + rk, *grs = Gs + rk;
+        if (gr[0] != 0.0 || gr[1] != 0.0 || grs[0] != 0.0 || grs[1] != 0.0)
+          add_pair_s(R, J, gt, gts, Kn, gr, grs, V[I]);
       }
     }
   }
-  if (layer) /* u_J = g(x_J) on the boundary nodes */
-    for (int j = 0; j < NY; ++j)
-      for (int c = 0; c < 2; ++c) {
-        double *row = R + (size_t)(2 * gu[j] + c) * 2 * N;
-        memset(row, 0, sizeof(double) * 2 * N);
-        row[2 * gu[j] + c] = 1.0;
-      }
+  /* u_J,c = g_c(x_J) on the prescribed components of the boundary nodes */
+  for (int32_t I = 0; I < N; ++I)
+    for (int c = 0; c < 2; ++c) {
+      if (!(mask[I] & (1 << c))) continue;
+      double *row = R + (size_t)(2 * I + c) * 2 * N;
+      memset(row, 0, sizeof(double) * 2 * N);
+      row[2 * I + c] = 1.0;
+    }
   const double err = compare(K, R);
   if (!(err < 1e-12))
     fail_msg("%s (jitter %d, layer %d): assembled stiffness differs from sum_I dV_I B^T D B by %.3e", sc->name,
              jitter, layer, err);
   free(R);
   if (Gt != Gr) free(Gt);
+  if (Gs != Gr) free(Gs);
   free(Gr);
   mfree_matrix_destroy(&K);
   mfree_assembler_destroy(&as);
@@ -218,10 +256,34 @@ static void test_fe_layer_nodal(void **s) {
   for (size_t k = 0; k < sizeof kSchemes / sizeof kSchemes[0]; ++k) check_scheme(&kSchemes[k], 1, 1);
 }
 
+/* Two symmetry lines, one call each with its own component mask. */
+static void test_fe_layer_two_calls(void **s) {
+  (void)s;
+  for (size_t k = 0; k < sizeof kSchemes / sizeof kSchemes[0]; ++k) check_scheme(&kSchemes[k], 1, 2);
+}
+
+/* Every call of the layer must use the same element type. */
+static void test_fe_layer_mixed_types(void **s) {
+  (void)s;
+  mfree_particles_t *ps = cloud(0);
+  mfree_approximant_t *a = approx(ps, MFREE_METHOD_MLS, 1);
+  mfree_assembler_t *as = NULL;
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_ELASTICITY_PLANE_STRESS, &as));
+  const int32_t quad[4] = {0, NY, NY + 1, 1}, tri[3] = {NY + 1, 2 * NY + 1, NY + 2}, gu[2] = {0, 1};
+  assert_ok(ctx, mfree_assembler_set_fe_layer(as, 1, 4, quad, 2, gu, 3, zero_g, NULL));
+  assert_error(ctx, mfree_assembler_set_fe_layer(as, 1, 3, tri, 1, gu + 1, 1, zero_g, NULL), MFREE_ERR_ARG,
+               "element type");
+  mfree_assembler_destroy(&as);
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_nodal_quadrature),
       cmocka_unit_test(test_fe_layer_nodal),
+      cmocka_unit_test(test_fe_layer_two_calls),
+      cmocka_unit_test(test_fe_layer_mixed_types),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -18,10 +18,9 @@
  * quadrature; EFG: the same with 5 x 5 Gauss points per background cell.
  *
  * Essential conditions: the paper's finite-element blending layer (000 Sect. 5.6), by
- * mfree_assembler_set_fe_layer on the beam and the patch test; on the hole, which needs
- * a component mask per line, by the example's nodal-quadrature form of the same layer
- * and Nitsche for EFG (--bc selects the others mfree offers). JB keeps the symmetrised
- * SPH shear strain as 000 eqs 48-52 say (an example-side change of the stiffness; --jb).
+ * mfree_assembler_set_fe_layer, one call (component mask) per essential line (--bc selects
+ * the others mfree offers). JB keeps the symmetrised SPH shear strain as 000 eqs 48-52
+ * say (mfree's assembler does that for JB under elasticity forms).
  * Linear systems: UMFPACK through libmfree_suitesparse, else a banded LU of the example.
  *
  * Errors 000 eqs 114-119 (relative; energy with the square root), rates = least-squares
@@ -82,19 +81,16 @@ static const char kUsage[] =
     "usage: mfree_elastostatics [--json] [--problem beam|hole|patch|both|all] [--levels N]\n"
     "                           [--out DIR] [--no-plot] [--bc auto|fe-layer|fe-nodal|direct|rows|\n"
     "                           nitsche|penalty|lagrange]"
-    " [--scheme NAME] [--jb paper|mfree] [--threads N]\n"
+    " [--scheme NAME] [--threads N]\n"
     "Paper 000 Table III: convergence of SPH, JB, RL, CD1, CD2, MLS and EFG on the cantilever\n"
     "beam and the plate with a hole (plane stress), next to the paper's rates; a patch test.\n"
     "  --problem  both (default) = beam and hole; all = beam, hole and patch test\n"
     "  --levels   refinements per problem (default 5; at least 2)\n"
-    "  --bc       essential conditions for every scheme; default auto: fe-layer (mfree's\n"
-    "             finite-element blending layer, 000 Sect. 5.6) on the beam and the patch test;\n"
-    "             on the hole fe-nodal (the example's nodal-quadrature form of the same layer,\n"
-    "             which allows a mask per line) and nitsche for EFG. Others: direct = rows\n"
+    "  --bc       essential conditions for every scheme; default auto = fe-layer (mfree's\n"
+    "             finite-element blending layer, 000 Sect. 5.6, a mask per line); fe-nodal =\n"
+    "             the example's nodal-quadrature build of the same layer. Others: direct = rows\n"
     "             u_J = g(x_J) on the parameters; rows = mfree_assembler_add_dirichlet_nodes;\n"
     "             nitsche, penalty, lagrange = MFREE_BC_*\n"
-    "  --jb       paper (default): JB corrects the normal strains only (000 eqs 48-52); mfree:\n"
-    "             mfree's JB approximant for every derivative (its beta also scales the shear)\n"
     "Writes DIR/elastostatics_{beam,hole}.dat, DIR/elastostatics.gp (+ .png with gnuplot).\n";
 
 static int parse(int argc, char **argv, options_t *o) {
@@ -131,11 +127,6 @@ static int parse(int argc, char **argv, options_t *o) {
     } else if (v && strcmp(a, "--bc") == 0) {
       ++i;
       if (es_bc_parse(v, &o->bc)) return 1;
-    } else if (v && strcmp(a, "--jb") == 0) {
-      ++i;
-      if (strcmp(v, "paper") == 0) es_jb_shear_corrected = 0;
-      else if (strcmp(v, "mfree") == 0) es_jb_shear_corrected = 1;
-      else return 1;
     } else if (v && strcmp(a, "--scheme") == 0) {
       ++i;
       o->only = -2;
@@ -460,7 +451,7 @@ int main(int argc, char **argv) {
 
   if (o.json) {
     printf("{\"paper\":\"000 Table III\",\"plane\":\"stress\",\"kernel\":\"cubic spline, s = sqrt(2) dx\","
-           "\"jb\":\"%s\"", es_jb_shear_corrected ? "mfree" : "paper");
+           "\"jb\":\"paper\"");
     if (o.run[0]) printf(",\"beam\":"), json_study(&S[0]);
     if (o.run[1]) printf(",\"hole\":"), json_study(&S[1]);
     if (o.run[2]) printf(",\"patch\":"), json_patch(&P);
@@ -470,20 +461,16 @@ int main(int argc, char **argv) {
   printf("Paper 000 (Belytschko et al. 1998) Table III: rates = least-squares slopes of log(error)\n"
          "vs log(dx); 'NC' = the paper observed no convergence. Plane stress, E = 1000, nu = 0.3,\n"
          "cubic spline kernel, s = sqrt(2) dx (support 2s, 21 neighbours on a regular grid).\n"
-         "Schemes: SPH (symmetrised, eq 47), JB (%s), RL: Bubnov,\n"
+         "Schemes: SPH (symmetrised, eq 47), JB (normal strains beta-corrected, shear as SPH), RL: Bubnov,\n"
          "nodal quadrature; CD1, CD2: KB Method 1/2 trial, Shepard test (Petrov-Galerkin), nodal\n"
          "quadrature; MLS: Bubnov MLS order 1, nodal quadrature; EFG: MLS, 5x5 Gauss per cell.\n"
          "Essential conditions (BC column): fe-layer = mfree_assembler_set_fe_layer, the paper's\n"
-         "finite-element blending layer (000 Sect. 5.6) along Gamma_u; fe-nodal = the same layer\n"
-         "as nodal quadrature sees it, built by the example because mfree's layer takes one\n"
-         "component mask and the hole needs u_y = 0 on y = 0 but u_x = 0 on x = 0 (identical\n"
-         "results on the beam); nitsche = MFREE_BC_NITSCHE (EFG on the hole).\n"
+         "finite-element blending layer (000 Sect. 5.6) along Gamma_u, one component mask per\n"
+         "line (beam: u at x = 0; hole: u_y = 0 on y = 0, u_x = 0 on x = 0).\n"
          "Errors: l2 (000 eq 115) from u^h at the nodes = trial approximant values (SPH, JB, RL:\n"
          "the particle values); L2 and energy (eqs 116-119) by 5x5 Gauss per background cell with\n"
          "the trial approximant at the points (SPH, JB, RL: an MLS interpolant of the particle\n"
-         "values); 'nodal E' = the energy error summed over the nodes with the scheme's own strains.\n",
-         es_jb_shear_corrected ? "mfree's JB approximant: every derivative scaled"
-                               : "normal strains beta-corrected, shear as SPH");
+         "values); 'nodal E' = the energy error summed over the nodes with the scheme's own strains.\n");
   if (o.run[0])
     print_study("Cantilever beam (000 Sect. 6.2.1, eqs 120-125)",
                 "E = 1000, nu = 0.3, D = 1, L = 8, P = 1, plane stress; exact u at x = 0, exact tractions\n"

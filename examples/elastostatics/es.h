@@ -86,20 +86,18 @@ extern const es_scheme_t es_schemes[ES_NSCHEMES];
 
 /* Essential boundary conditions. */
 typedef enum {
-  ES_BC_AUTO = 0,     /* ES_BC_FE_LAYER where the layer has one component mask (beam,
-                         patch); else ES_BC_FE_NODAL with nodal quadrature and Nitsche for
-                         EFG (hole) */
+  ES_BC_AUTO = 0,     /* ES_BC_FE_LAYER (every problem here has essential lines) */
   ES_BC_DIRECT = 1,   /* rows u_J = g(x_J) on the nodal parameters (example-side rows) */
   ES_BC_ROWS = 2,     /* mfree_assembler_add_dirichlet_nodes: u^h(x_J) = g(x_J) */
   ES_BC_NITSCHE = 3,  /* MFREE_BC_NITSCHE on boundary Gauss points */
   ES_BC_PENALTY = 4,  /* MFREE_BC_PENALTY on boundary Gauss points */
   ES_BC_LAGRANGE = 5, /* MFREE_BC_LAGRANGE, one point multiplier per boundary node */
   ES_BC_FE_LAYER = 6, /* mfree_assembler_set_fe_layer: the finite-element blending layer
-                         of 000 Sect. 5.6 (one component mask for the whole layer) */
+                         of 000 Sect. 5.6, one call (component mask) per boundary line */
   ES_BC_FE_NODAL = 7  /* the same layer as nodal quadrature sees it, built by the example
                          (000 eq 105, Fig. 2): element derivatives at the quadrature points
                          of the nodes on Gamma_u, prescribed values on their parameters;
-                         per-line masks; nodal-quadrature schemes only */
+                         nodal-quadrature schemes only; equals fe-layer to round-off */
 } es_bc_t;
 
 const char *es_bc_name(es_bc_t bc);
@@ -117,11 +115,6 @@ typedef struct {
   es_bc_t bc;            /* the condition used */
   int warn;              /* a positive (data-dependent) status was reported */
 } es_result_t;
-
-/* How JB treats the shear strain: 0 = as 000 eqs 48-52 say (the shear rate keeps the
- * symmetrised SPH derivatives; assembled by the example), 1 = mfree's JB approximant for
- * every derivative (its beta_x also scales d/dx of u_y). */
-extern int es_jb_shear_corrected;
 
 /* One run of scheme s on level lv of problem p with condition bc; efg_ngauss Gauss
  * points per direction in EFG's background cells (0 = 5). Returns MFREE_SUCCESS or the

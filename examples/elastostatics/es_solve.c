@@ -29,8 +29,6 @@ const es_scheme_t es_schemes[ES_NSCHEMES] = {
 static const char *const kBcNames[] = {"auto",    "direct",   "rows",     "nitsche",
                                        "penalty", "lagrange", "fe-layer", "fe-nodal"};
 
-int es_jb_shear_corrected = 0;
-
 const char *es_bc_name(es_bc_t bc) {
   return (int)bc >= 0 && (int)bc <= ES_BC_FE_NODAL ? kBcNames[bc] : "?";
 }
@@ -61,16 +59,10 @@ int es_bc_parse(const char *s, es_bc_t *bc) {
  *  - nitsche: not available for SPH, JB, RL (no functions between the particles); with
  *    Shepard test functions (CD1, CD2) it leaves a rigid rotation of the clamped end.
  *  - penalty, lagrange: on boundary Gauss points / at the boundary nodes. */
-static int uniform_mask(const es_level_t *lv) {
-  for (int c = 1; c < lv->nchain; ++c)
-    if (lv->chain_mask[c] != lv->chain_mask[0]) return 0;
-  return lv->nchain > 0;
-}
-
 es_bc_t es_bc_resolve(const es_scheme_t *s, const es_level_t *lv, es_bc_t bc) {
+  (void)s;
   if (bc != ES_BC_AUTO) return bc;
-  if (uniform_mask(lv)) return ES_BC_FE_LAYER;
-  return s->efg ? ES_BC_NITSCHE : ES_BC_FE_NODAL;
+  return lv->nchain > 0 ? ES_BC_FE_LAYER : ES_BC_DIRECT;
 }
 
 double es_rate(int n, const double *dx, const double *e) {
@@ -231,35 +223,14 @@ static void plane_stress_D(const es_problem_t *p, double *D) {
   memcpy(D, d, sizeof d);
 }
 
-/* The paper's JB (000 eqs 48-52: "no modification of the shear rate"): mfree's JB
- * approximant scales every x-derivative by beta_x (and y by beta_y), so its stiffness
- * also corrects the shear strain. Each nodal-quadrature point's contribution is replaced
- * by one with beta-corrected derivatives for the normal strains and symmetrised SPH
- * derivatives (eq 47) for the shear strain, test = trial. Rows that mfree replaced
- * (skip: bit c of node J) are left alone, and so are the quadrature points where mfree's
- * FE layer uses element functions (skip_site). */
-static int jb_fix(const es_problem_t *p, const tables_t *t, int32_t n, double *v, const int64_t *rp,
-                  const int32_t *ci, const double *vol, const int32_t *skip, const int32_t *skip_site) {
-  double D[9];
-  plane_stress_D(p, D);
-  for (int32_t I = 0; I < n; ++I) {
-    if (skip_site && skip_site[I]) continue;
-    const side_t s = table_side(t, I);
-    side_t lib = s;
-    lib.sx = s.nx, lib.sy = s.ny;
-    if (add_point(v, rp, ci, D, &lib, &lib, -vol[I], skip) || add_point(v, rp, ci, D, &s, &s, vol[I], skip))
-      return 1;
-  }
-  return 0;
-}
-
 /* The layer of the finite-element blending (000 Sect. 5.6): one quadrilateral between
  * each pair of consecutive boundary nodes P_k, P_k+1 of an essential boundary line and
  * their inner partners Q_k+1, Q_k (the nodes nearest to P - dx n), counter-clockwise.
  * conn: 4 per element; returns the element count, or -1 (message in err). */
-static int32_t layer_elements(const es_level_t *lv, int32_t *conn, char *err, int errlen) {
+static int32_t layer_elements(const es_level_t *lv, int chain, int32_t *conn, char *err, int errlen) {
   int32_t ne = 0;
   for (int c = 0; c < lv->nchain; ++c) {
+    if (chain >= 0 && c != chain) continue;
     const int32_t a = lv->chain_start[c], b = lv->chain_start[c + 1];
     const double *nrm = lv->chain_nrm + 2 * c;
     for (int32_t k = a; k + 1 < b; ++k) {
@@ -312,7 +283,7 @@ static int fe_layer(const es_problem_t *p, const es_level_t *lv, const tables_t 
   int32_t *nel = calloc((size_t)n, sizeof(int32_t)), *on_gu = calloc((size_t)n, sizeof(int32_t));
   int32_t *conn = malloc(sizeof(int32_t) * 4 * (size_t)(n ? n : 1));
   int32_t ne = -1;
-  if (nel && on_gu && conn) ne = layer_elements(lv, conn, err, errlen);
+  if (nel && on_gu && conn) ne = layer_elements(lv, -1, conn, err, errlen);
   int rc = ne < 0;
   for (int32_t k = 0; k < lv->chain_start[lv->nchain] && !rc; ++k) on_gu[lv->chain_nodes[k]] = 1;
   for (int32_t k = 0; k < 4 * ne; ++k) nel[conn[k]] += on_gu[conn[k]];
@@ -688,12 +659,7 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
   }
 
   if (bc == ES_BC_FE_LAYER) {
-    if (!uniform_mask(lv)) {
-      st = MFREE_ERR_UNSUPPORTED;
-      if (err) snprintf(err, (size_t)errlen, "mfree_assembler_set_fe_layer takes one component mask for the "
-                                             "whole layer; this problem needs one per line (use fe-nodal)");
-      goto done;
-    }
+    /* one call per essential boundary line, each with its own component mask */
     conn = malloc(sizeof(int32_t) * 4 * (size_t)(n ? n : 1));
     gu = malloc(sizeof(int32_t) * (size_t)(n ? n : 1));
     on_gu = calloc((size_t)(n ? n : 1), sizeof(int32_t));
@@ -701,18 +667,21 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
       st = MFREE_ERR_ALLOC;
       goto done;
     }
-    const int32_t ne = layer_elements(lv, conn, err, errlen);
-    if (ne < 0) {
-      st = MFREE_ERR_INPUT;
-      goto done;
+    for (int c = 0; c < lv->nchain; ++c) {
+      const int32_t ne = layer_elements(lv, c, conn, err, errlen);
+      if (ne < 0) {
+        st = MFREE_ERR_INPUT;
+        goto done;
+      }
+      int32_t ngu = 0;
+      for (int32_t k = lv->chain_start[c]; k < lv->chain_start[c + 1]; ++k) {
+        const int32_t i = lv->chain_nodes[k];
+        on_gu[i] = 1;
+        gu[ngu++] = i;
+      }
+      CHECK(mfree_assembler_set_fe_layer(as, ne, 4, conn, ngu, gu, lv->chain_mask[c], g_exact, (void *)p),
+            "FE layer");
     }
-    int32_t ngu = 0;
-    for (int32_t k = 0; k < lv->chain_start[lv->nchain]; ++k) {
-      const int32_t i = lv->chain_nodes[k];
-      if (!on_gu[i]) on_gu[i] = 1, gu[ngu++] = i;
-    }
-    CHECK(mfree_assembler_set_fe_layer(as, ne, 4, conn, ngu, gu, lv->chain_mask[0], g_exact, (void *)p),
-          "FE layer");
   }
   CHECK(mfree_assembler_setup(as), "assembler setup");
   int32_t ndofs = 0, nquad = 0;
@@ -726,8 +695,7 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
   }
   CHECK(mfree_assembler_assemble_matrix(as, &K), "stiffness");
   CHECK(mfree_assembler_assemble_rhs(as, f), "load");
-  const int jb_paper = s->trial == MFREE_METHOD_JOHNSON_BEISSEL && !es_jb_shear_corrected;
-  if (jb_paper || bc == ES_BC_DIRECT || bc == ES_BC_FE_NODAL) {
+  if (bc == ES_BC_DIRECT || bc == ES_BC_FE_NODAL) {
     /* the example's changes to the assembled stiffness, on a copy of its values */
     const int64_t *rp;
     const int32_t *ci;
@@ -742,19 +710,14 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
       goto done;
     }
     memcpy(kv, va, sizeof(double) * (size_t)nnz);
-    if (jb_paper || bc == ES_BC_FE_NODAL) {
-      if (jb_paper) CHECK(mfree_approximant_create(ctx, ps, MFREE_METHOD_SPH_SYMMETRIC, &shear), "SPH shear");
+    if (bc == ES_BC_FE_NODAL) {
+      /* JB: the shear rows of the removed meshfree contributions keep symmetrised SPH */
+      if (s->trial == MFREE_METHOD_JOHNSON_BEISSEL)
+        CHECK(mfree_approximant_create(ctx, ps, MFREE_METHOD_SPH_SYMMETRIC, &shear), "SPH shear");
       CHECK(tables_get(trial, shear, n, &ttr), "trial tables");
       if (test) CHECK(tables_get(test, NULL, n, &tte), "test tables");
       const tables_t *pte = test ? &tte : &ttr;
-      const int replaced = bc == ES_BC_ROWS || bc == ES_BC_FE_LAYER;
-      if (jb_paper && jb_fix(p, &ttr, n, kv, rp, ci, lv->vol, replaced ? lv->dmask : NULL,
-                             bc == ES_BC_FE_LAYER ? on_gu : NULL)) {
-        st = MFREE_ERR_INTERNAL;
-        if (err) snprintf(err, (size_t)errlen, "JB: a coupling outside the assembled pattern");
-        goto done;
-      }
-      if (bc == ES_BC_FE_NODAL && fe_layer(p, lv, pte, &ttr, kv, rp, ci, err, errlen)) {
+      if (fe_layer(p, lv, pte, &ttr, kv, rp, ci, err, errlen)) {
         st = MFREE_ERR_INTERNAL;
         goto done;
       }
@@ -837,7 +800,7 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
     /* energy error at the nodes with the scheme's own derivatives there (JB: beta-corrected
      * normal strains, symmetrised SPH shear) */
     if (!ttr.rp) {
-      if (s->trial == MFREE_METHOD_JOHNSON_BEISSEL && !es_jb_shear_corrected)
+      if (s->trial == MFREE_METHOD_JOHNSON_BEISSEL)
         CHECK(mfree_approximant_create(ctx, ps, MFREE_METHOD_SPH_SYMMETRIC, &shear), "SPH shear");
       CHECK(tables_get(trial, shear, n, &ttr), "trial tables");
     }

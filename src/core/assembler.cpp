@@ -39,6 +39,18 @@ int strain_rows(int dim, const double *g, double B[6][3]) {
   return 6;
 }
 
+// The same with the shear rows from gradient gs (Johnson-Beissel: paper 000 eqs 48-52
+// correct the normal strains only).
+int strain_rows(int dim, const double *g, const double *gs, double B[6][3]) {
+  double Bs[6][3];
+  const int nv = strain_rows(dim, g, B);
+  if (gs == g) return nv;
+  strain_rows(dim, gs, Bs);
+  for (int v = dim; v < nv; ++v)
+    for (int a = 0; a < 3; ++a) B[v][a] = Bs[v][a];
+  return nv;
+}
+
 // Voigt index of the stress component (a, b).
 int voigt(int dim, int a, int b) {
   if (a == b) return a;
@@ -332,12 +344,19 @@ void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, in
   if (!conn || !gu) throw Error(MFREE_ERR_NULL, "connectivity or boundary nodes are NULL");
   if (!g) throw Error(MFREE_ERR_NULL, "boundary value function is NULL");
   if (mask <= 0 || mask >= (1 << ncomp_)) throw Error(MFREE_ERR_ARG, "component mask selects no valid component");
+  if (fe_.npe && fe_.npe != npe)
+    throw Error(MFREE_ERR_ARG, "the layer already has elements with " + std::to_string(fe_.npe) +
+                                   " nodes; every call must use the same element type");
   const int32_t n = ps_->num_owned();
-  FeLayer fe;
+  // Calls accumulate: elements of every call form one layer (the blending sees all of
+  // them) and each call's boundary nodes get its own component mask, so symmetry lines
+  // with different constrained components are one layer.
+  FeLayer fe = fe_;
   fe.npe = npe;
-  fe.conn.assign(conn, conn + static_cast<size_t>(nelem) * npe);
-  fe.on_gu.assign(ps_->size(), 0);
-  fe.in_layer.assign(ps_->size(), 0);
+  const size_t first = fe.conn.size();
+  fe.conn.insert(fe.conn.end(), conn, conn + static_cast<size_t>(nelem) * npe);
+  fe.on_gu.resize(ps_->size(), 0);
+  fe.in_layer.resize(ps_->size(), 0);
   for (int32_t k = 0; k < nelem * npe; ++k) {
     if (conn[k] < 0 || conn[k] >= n)
       throw Error(MFREE_ERR_INPUT, "element " + std::to_string(k / npe) + " refers to particle " +
@@ -351,14 +370,14 @@ void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, in
   }
   // orientation: positive Jacobian at every corner (counter-clockwise, not degenerate)
   for (int32_t e = 0; e < nelem; ++e) {
-    const int32_t *c = &fe.conn[static_cast<size_t>(e) * npe];
+    const int32_t *c = &fe.conn[first + static_cast<size_t>(e) * npe];
     double xmin[2] = {1e300, 1e300}, xmax[2] = {-1e300, -1e300};
     for (int a = 0; a < npe; ++a) {
       const int32_t i = c[a], j = c[(a + 1) % npe], k = c[(a + npe - 1) % npe];
       const double ax = ps_->x(j, 0) - ps_->x(i, 0), ay = ps_->x(j, 1) - ps_->x(i, 1);
       const double bx = ps_->x(k, 0) - ps_->x(i, 0), by = ps_->x(k, 1) - ps_->x(i, 1);
       if (!(ax * by - ay * bx > 0.0))
-        throw Error(MFREE_ERR_INPUT, "layer element " + std::to_string(e) +
+        throw Error(MFREE_ERR_INPUT, "layer element " + std::to_string(e) + " of this call" +
                                          " is inverted or degenerate (nodes must run counter-clockwise)");
       for (int d = 0; d < 2; ++d) {
         xmin[d] = std::min(xmin[d], ps_->x(i, d));
@@ -472,12 +491,14 @@ void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
   out.rowptr.assign(1, 0);
   double N[4], dN[8];
   std::vector<int32_t> cols;
-  std::vector<double> val, grad;
+  std::vector<double> val, grad, sgrad;
+  const bool has_s = !t.sgrad.empty();
   auto push = [&](double w) {
     out.w.push_back(w);
     out.cols.insert(out.cols.end(), cols.begin(), cols.end());
     out.val.insert(out.val.end(), val.begin(), val.end());
     out.grad.insert(out.grad.end(), grad.begin(), grad.end());
+    if (has_s) out.sgrad.insert(out.sgrad.end(), sgrad.begin(), sgrad.end());
     out.rowptr.push_back(static_cast<int64_t>(out.cols.size()));
   };
   for (int32_t q = 0; q < t.size(); ++q) {
@@ -485,6 +506,7 @@ void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
     cols.assign(t.cols.begin() + k0, t.cols.begin() + k1);
     val.assign(t.val.begin() + k0, t.val.begin() + k1);
     grad.assign(t.grad.begin() + 2 * k0, t.grad.begin() + 2 * k1);
+    if (has_s) sgrad.assign(t.sgrad.begin() + 2 * k0, t.sgrad.begin() + 2 * k1);
     if (!pts) {
       if (!fe_.on_gu[q]) {
         push(t.w[q]);
@@ -506,6 +528,7 @@ void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
           grad.push_back(dN[2 * a]);
           grad.push_back(dN[2 * a + 1]);
         }
+        if (has_s) sgrad = grad;
         push(t.w[q] / static_cast<double>(elems.size()));
       }
       continue;
@@ -531,6 +554,8 @@ void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
     for (size_t k = 0; k < cols.size(); ++k) {  // r Phi
       const double phi = val[k];
       for (int d = 0; d < 2; ++d) grad[2 * k + d] = gr[d] * phi + r * grad[2 * k + d];
+      if (has_s)
+        for (int d = 0; d < 2; ++d) sgrad[2 * k + d] = gr[d] * phi + r * sgrad[2 * k + d];
       val[k] = r * phi;
     }
     for (int a = 0; a < npe; ++a) {  // + (1 - r) N
@@ -541,9 +566,12 @@ void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
         val.push_back(0.0);
         grad.push_back(0.0);
         grad.push_back(0.0);
+        if (has_s) sgrad.push_back(0.0), sgrad.push_back(0.0);
       }
       val[k] += (1 - r) * N[a];
       for (int d = 0; d < 2; ++d) grad[2 * k + d] += -gr[d] * N[a] + (1 - r) * dN[2 * a + d];
+      if (has_s)
+        for (int d = 0; d < 2; ++d) sgrad[2 * k + d] += -gr[d] * N[a] + (1 - r) * dN[2 * a + d];
     }
     push(t.w[q]);
   }
@@ -556,6 +584,14 @@ void Assembler::build_qtables() {
   fill_qtable(*trial_q_, qtrial_, nodal ? nullptr : &qw_);
   if (test_q_) fill_qtable(*test_q_, qtest_, nodal ? nullptr : &qw_);
   else qtest_ = QTable();
+  auto shear = [&](const Approximant *a, QTable &t) {
+    if (!a) return;
+    if (a->rowptr() != t.rowptr || a->cols() != t.cols)
+      throw Error(MFREE_ERR_INTERNAL, "symmetrised SPH and Johnson-Beissel tables differ in their neighbours");
+    t.sgrad = a->gradients();
+  };
+  shear(trial_shear_.get(), qtrial_);
+  if (test_q_) shear(test_shear_.get(), qtest_);
   if (fe_.npe) {
     blend_qtable(qtrial_, nodal ? nullptr : &qx_);
     if (test_q_) blend_qtable(qtest_, nodal ? nullptr : &qx_);
@@ -660,6 +696,20 @@ Report Assembler::build_tables() {
     } else {
       test_q_.reset();
     }
+    // Johnson-Beissel (paper 000 eqs 48-52) corrects the normal strains; the shear strain
+    // keeps the symmetrised SPH derivatives of eq 47.
+    auto shear = [&](const ApproxConfig &c, std::unique_ptr<Approximant> &out, const char *where) {
+      out.reset();
+      if (!elasticity() || c.method != MFREE_METHOD_JOHNSON_BEISSEL) return;
+      ApproxConfig sh = c;
+      sh.method = MFREE_METHOD_SPH_SYMMETRIC;
+      sh.flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
+      out = make(sh, nullptr);
+      merge(out->setup(), where);
+    };
+    shear(tc, trial_shear_, "symmetrised SPH shear derivatives of the trial functions");
+    if (!bubnov_) shear(sc, test_shear_, "symmetrised SPH shear derivatives of the test functions");
+    else test_shear_.reset();
     load_q_.reset();
     if (body_ && !m) {
       load_q_ = make(values_config(test_cfg_), nodal ? nullptr : &qx_);
@@ -761,6 +811,8 @@ void Assembler::build_pattern() {
     for (int32_t d : mcols[m]) dof_mult[d].push_back(nbase + m);
   rowptr_.assign(static_cast<size_t>(ndofs_) + 1, 0);
   cols_.clear();
+  node_deg_.assign(n, 0);
+  for (int32_t J = 0; J < n; ++J) node_deg_[J] = static_cast<int32_t>(rows[J].size());
   for (int32_t J = 0; J < n; ++J)
     for (int a = 0; a < nc; ++a) {
       const int32_t dof = J * nc + a;
@@ -831,12 +883,28 @@ Report Assembler::update() {
   upd(test_q_.get());
   upd(load_q_.get());
   upd(trial_nodes_.get());
+  upd(trial_shear_.get());
+  upd(test_shear_.get());
   for (auto &s : psets_) {
     upd(s->test.get());
     upd(s->trial.get());
   }
   build_qtables();
   return rep;
+}
+
+int64_t Assembler::node_offset(int32_t J, int32_t K) const {
+  const int nc = ncomp_;
+  const int64_t base = rowptr_[static_cast<size_t>(J) * nc];
+  int32_t lo = 0, hi = node_deg_[J] - 1;
+  while (lo <= hi) {
+    const int32_t mid = lo + (hi - lo) / 2;
+    const int32_t c = cols_[base + static_cast<int64_t>(mid) * nc] / nc;
+    if (c == K) return static_cast<int64_t>(mid) * nc;
+    if (c < K) lo = mid + 1;
+    else hi = mid - 1;
+  }
+  return -1;
 }
 
 void Assembler::assemble_matrix(SparseMatrix &K) const {
@@ -898,6 +966,12 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
   } else {
     const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
     const auto &Pg = qa.grad, &Tg = qb.grad;
+    const auto &Ps = qa.sgrad.empty() ? qa.grad : qa.sgrad, &Ts = qb.sgrad.empty() ? qb.grad : qb.sgrad;
+    auto offset = [&](int32_t J, int32_t K2) {
+      const int64_t o = node_offset(J, K2);
+      if (o < 0) throw Error(MFREE_ERR_INTERNAL, "assembly entry outside the pattern");
+      return o;
+    };
     std::vector<double> DB;  // per trial neighbour: nv x nc
     for (int32_t q = 0; q < qa.size(); ++q) {
       const double w = qa.w[q];
@@ -908,14 +982,14 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
             double dot = 0.0;
             for (int d = 0; d < dim; ++d) dot += Tg[a * dim + d] * Pg[b * dim + d];
             const int32_t J = qb.cols[a];
-            if (row_kind_[J] == 0) at(J, qa.cols[b]) += w * coef_ * dot;
+            if (row_kind_[J] == 0) v[rowptr_[J] + offset(J, qa.cols[b])] += w * coef_ * dot;
           }
         continue;
       }
       DB.assign(static_cast<size_t>(b1 - b0) * nv * nc, 0.0);
       for (int64_t b = b0; b < b1; ++b) {
         double B[6][3];
-        strain_rows(dim, &Pg[b * dim], B);
+        strain_rows(dim, &Pg[b * dim], &Ps[b * dim], B);
         double *db = &DB[static_cast<size_t>(b - b0) * nv * nc];
         for (int u = 0; u < nv; ++u)
           for (int e = 0; e < nc; ++e) {
@@ -926,17 +1000,18 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
       }
       for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a) {
         double BJ[6][3];
-        strain_rows(dim, &Tg[a * dim], BJ);
+        strain_rows(dim, &Tg[a * dim], &Ts[a * dim], BJ);
         const int32_t J = qb.cols[a];
         for (int64_t b = b0; b < b1; ++b) {
           const double *db = &DB[static_cast<size_t>(b - b0) * nv * nc];
-          const int32_t K2 = qa.cols[b];
+          const int64_t o = offset(J, qa.cols[b]);
           for (int c = 0; c < nc; ++c) {
             if (row_kind_[J * nc + c] != 0) continue;
+            double *row = &v[rowptr_[J * nc + c] + o];
             for (int e = 0; e < nc; ++e) {
               double s = 0.0;
               for (int u = 0; u < nv; ++u) s += BJ[u][c] * db[u * nc + e];
-              at(J * nc + c, K2 * nc + e) += w * s;
+              row[e] += w * s;
             }
           }
         }

@@ -87,6 +87,9 @@ class Assembler {
     std::vector<int64_t> rowptr{0};
     std::vector<int32_t> cols;
     std::vector<double> val, grad;
+    // Derivatives for the shear strains when they differ from grad (Johnson-Beissel,
+    // paper 000 eqs 48-52: the shear keeps the symmetrised SPH derivatives); empty: grad.
+    std::vector<double> sgrad;
     int32_t size() const { return static_cast<int32_t>(w.size()); }
   };
   // Read-only view with the accessor names of Approximant, so loops read alike.
@@ -111,6 +114,10 @@ class Assembler {
   // Blend rows at points pts (NULL: the particles, nodal quadrature) with the FE layer.
   void blend_qtable(QTable &t, const std::vector<double> *pts) const;
   // FE shape functions of layer element e at x (N[npe], dN[npe*2]); false if x is outside.
+  // Offset of node K's first column within each row of node J (every component row of J
+  // holds the same node columns, ncomp per node, sorted), or -1: one search per node pair
+  // instead of one per matrix entry.
+  int64_t node_offset(int32_t J, int32_t K) const;
   bool fe_shape(int32_t e, const double *x, double *N, double *dN) const;
 
   bool collocation() const { return form_ >= MFREE_FORM_COLLOCATION_LAPLACE; }
@@ -146,9 +153,13 @@ class Assembler {
   bool setup_done_ = false;
   int32_t ndofs_ = 0, nmult_ = 0;
   std::unique_ptr<Approximant> trial_q_, test_q_, load_q_, trial_nodes_;
+  // Johnson-Beissel under an elasticity form: symmetrised SPH derivatives at the particles
+  // for the shear strains of the trial and test sides (paper 000 eqs 48-52)
+  std::unique_ptr<Approximant> trial_shear_, test_shear_;
   // dof pattern
   std::vector<int64_t> rowptr_;
   std::vector<int32_t> cols_;
+  std::vector<int32_t> node_deg_;  // per node: node columns in each of its rows
   std::vector<int32_t> row_kind_;  // per dof: 0 form, 1 Dirichlet row, 2 traction row
   std::vector<int32_t> row_set_, row_node_;  // which node set / position replaces the row
   FeLayer fe_;
