@@ -2,10 +2,11 @@
 # Install the Debian 12 packages that building and testing mfree needs, only those that
 # are missing (apt-get update runs only then). Works as root or through sudo.
 # Later capabilities add their packages here (gfortran, libsuitesparse-dev,
-# libsundials-dev, ...).
+# libsundials-dev, ...). abigail-tools: the abidiff check against abi/*.abi (ABI.md);
+# clang: the libFuzzer harness (fuzz/); valgrind: the memory-check label.
 set -euo pipefail
 
-MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev"
+MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev abigail-tools clang valgrind"
 
 if ! command -v dpkg-query >/dev/null 2>&1; then
   echo "deps.sh: dpkg-query not found: this script is for Debian/Ubuntu." >&2
