@@ -755,11 +755,28 @@ void Assembler::build_pattern() {
     for (int32_t s = 0; s < trial.num_sites(); ++s)
       for (int64_t b = trial.rowptr()[s]; b < trial.rowptr()[s + 1]; ++b) rows[s].push_back(trial.cols()[b]);
   } else {
+    // Row J = the trial neighbours of every quadrature point that J's test function
+    // sees: through the transpose of the test table, with a marker per node, so that
+    // each row is collected without duplicates (background quadrature has many points
+    // per node pair).
     const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
-    for (int32_t q = 0; q < qa.size(); ++q)
-      for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a) {
-        auto &row = rows[qb.cols[a]];
-        for (int64_t b = qa.rowptr[q]; b < qa.rowptr[q + 1]; ++b) row.push_back(qa.cols[b]);
+    std::vector<int64_t> tp(static_cast<size_t>(n) + 1, 0);
+    for (int32_t J : qb.cols) ++tp[static_cast<size_t>(J) + 1];
+    for (int32_t J = 0; J < n; ++J) tp[J + 1] += tp[J];
+    std::vector<int32_t> tq(qb.cols.size());
+    {
+      std::vector<int64_t> next(tp.begin(), tp.end() - 1);
+      for (int32_t q = 0; q < qb.size(); ++q)
+        for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a) tq[next[qb.cols[a]]++] = q;
+    }
+    std::vector<int32_t> mark(n, -1);
+    for (int32_t J = 0; J < n; ++J)
+      for (int64_t t = tp[J]; t < tp[J + 1]; ++t) {
+        const int32_t q = tq[t];
+        for (int64_t b = qa.rowptr[q]; b < qa.rowptr[q + 1]; ++b) {
+          const int32_t K = qa.cols[b];
+          if (mark[K] != J) mark[K] = J, rows[J].push_back(K);
+        }
       }
     for (size_t si = 0; si < psets_.size(); ++si)
       if (psets_[si]->kind == 2 || psets_[si]->kind == 4) {
@@ -893,20 +910,6 @@ Report Assembler::update() {
   return rep;
 }
 
-int64_t Assembler::node_offset(int32_t J, int32_t K) const {
-  const int nc = ncomp_;
-  const int64_t base = rowptr_[static_cast<size_t>(J) * nc];
-  int32_t lo = 0, hi = node_deg_[J] - 1;
-  while (lo <= hi) {
-    const int32_t mid = lo + (hi - lo) / 2;
-    const int32_t c = cols_[base + static_cast<int64_t>(mid) * nc] / nc;
-    if (c == K) return static_cast<int64_t>(mid) * nc;
-    if (c < K) lo = mid + 1;
-    else hi = mid - 1;
-  }
-  return -1;
-}
-
 void Assembler::assemble_matrix(SparseMatrix &K) const {
   if (!setup_done_) throw Error(MFREE_ERR_STATE, "the assembler is not set up");
   if (K.rows() != ndofs_ || K.rowptr() != rowptr_ || K.colidx() != cols_)
@@ -964,58 +967,72 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
         }
     }
   } else {
+    // Row by row (gather): for each test node J, the quadrature points its test
+    // function sees (the transpose of the test table), with the positions of J's
+    // columns in a scatter array, so that no entry is searched for.
     const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
     const auto &Pg = qa.grad, &Tg = qb.grad;
     const auto &Ps = qa.sgrad.empty() ? qa.grad : qa.sgrad, &Ts = qb.sgrad.empty() ? qb.grad : qb.sgrad;
-    auto offset = [&](int32_t J, int32_t K2) {
-      const int64_t o = node_offset(J, K2);
-      if (o < 0) throw Error(MFREE_ERR_INTERNAL, "assembly entry outside the pattern");
-      return o;
+    const int32_t nn = ps_->size();
+    std::vector<int64_t> tp(static_cast<size_t>(nn) + 1, 0), ta(qb.cols.size());
+    std::vector<int32_t> tq(qb.cols.size());
+    for (int32_t J : qb.cols) ++tp[static_cast<size_t>(J) + 1];
+    for (int32_t J = 0; J < nn; ++J) tp[J + 1] += tp[J];
+    {
+      std::vector<int64_t> next(tp.begin(), tp.end() - 1);
+      for (int32_t q = 0; q < qb.size(); ++q)
+        for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a) {
+          const int64_t k = next[qb.cols[a]]++;
+          tq[k] = q;
+          ta[k] = a;
+        }
+    }
+    std::vector<int64_t> pos(nn, -1);
+    auto offset = [&](int32_t K2) {
+      if (pos[K2] < 0) throw Error(MFREE_ERR_INTERNAL, "assembly entry outside the pattern");
+      return pos[K2];
     };
-    std::vector<double> DB;  // per trial neighbour: nv x nc
-    for (int32_t q = 0; q < qa.size(); ++q) {
-      const double w = qa.w[q];
-      const int64_t b0 = qa.rowptr[q], b1 = qa.rowptr[q + 1];
-      if (form_ == MFREE_FORM_LAPLACE) {
-        for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a)
+    for (int32_t J = 0; J < nn; ++J) {
+      if (tp[J] == tp[J + 1]) continue;
+      const int64_t base = rowptr_[static_cast<size_t>(J) * nc];
+      for (int32_t i = 0; i < node_deg_[J]; ++i) pos[cols_[base + static_cast<int64_t>(i) * nc] / nc] = int64_t{i} * nc;
+      for (int64_t t = tp[J]; t < tp[J + 1]; ++t) {
+        const int32_t q = tq[t];
+        const int64_t a = ta[t], b0 = qa.rowptr[q], b1 = qa.rowptr[q + 1];
+        const double w = qa.w[q];
+        if (form_ == MFREE_FORM_LAPLACE) {
+          if (row_kind_[J] != 0) continue;
           for (int64_t b = b0; b < b1; ++b) {
             double dot = 0.0;
             for (int d = 0; d < dim; ++d) dot += Tg[a * dim + d] * Pg[b * dim + d];
-            const int32_t J = qb.cols[a];
-            if (row_kind_[J] == 0) v[rowptr_[J] + offset(J, qa.cols[b])] += w * coef_ * dot;
+            v[base + offset(qa.cols[b])] += w * coef_ * dot;
           }
-        continue;
-      }
-      DB.assign(static_cast<size_t>(b1 - b0) * nv * nc, 0.0);
-      for (int64_t b = b0; b < b1; ++b) {
-        double B[6][3];
-        strain_rows(dim, &Pg[b * dim], &Ps[b * dim], B);
-        double *db = &DB[static_cast<size_t>(b - b0) * nv * nc];
-        for (int u = 0; u < nv; ++u)
-          for (int e = 0; e < nc; ++e) {
-            double s = 0.0;
-            for (int t = 0; t < nv; ++t) s += D[u * dstride + t] * B[t][e];
-            db[u * nc + e] = s;
-          }
-      }
-      for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a) {
-        double BJ[6][3];
+          continue;
+        }
+        double BJ[6][3], BJD[3][6];  // BJD = B_J^T D
         strain_rows(dim, &Tg[a * dim], &Ts[a * dim], BJ);
-        const int32_t J = qb.cols[a];
+        for (int c = 0; c < nc; ++c)
+          for (int t2 = 0; t2 < nv; ++t2) {
+            double s = 0.0;
+            for (int u = 0; u < nv; ++u) s += BJ[u][c] * D[u * dstride + t2];
+            BJD[c][t2] = s;
+          }
         for (int64_t b = b0; b < b1; ++b) {
-          const double *db = &DB[static_cast<size_t>(b - b0) * nv * nc];
-          const int64_t o = offset(J, qa.cols[b]);
+          double BK[6][3];
+          strain_rows(dim, &Pg[b * dim], &Ps[b * dim], BK);
+          const int64_t o = offset(qa.cols[b]);
           for (int c = 0; c < nc; ++c) {
             if (row_kind_[J * nc + c] != 0) continue;
             double *row = &v[rowptr_[J * nc + c] + o];
             for (int e = 0; e < nc; ++e) {
               double s = 0.0;
-              for (int u = 0; u < nv; ++u) s += BJ[u][c] * db[u * nc + e];
+              for (int t2 = 0; t2 < nv; ++t2) s += BJD[c][t2] * BK[t2][e];
               row[e] += w * s;
             }
           }
         }
       }
+      for (int32_t i = 0; i < node_deg_[J]; ++i) pos[cols_[base + static_cast<int64_t>(i) * nc] / nc] = -1;
     }
     // penalty, Nitsche and Lagrange terms
     for (size_t si = 0; si < psets_.size(); ++si) {

@@ -114,10 +114,6 @@ class Assembler {
   // Blend rows at points pts (NULL: the particles, nodal quadrature) with the FE layer.
   void blend_qtable(QTable &t, const std::vector<double> *pts) const;
   // FE shape functions of layer element e at x (N[npe], dN[npe*2]); false if x is outside.
-  // Offset of node K's first column within each row of node J (every component row of J
-  // holds the same node columns, ncomp per node, sorted), or -1: one search per node pair
-  // instead of one per matrix entry.
-  int64_t node_offset(int32_t J, int32_t K) const;
   bool fe_shape(int32_t e, const double *x, double *N, double *dN) const;
 
   bool collocation() const { return form_ >= MFREE_FORM_COLLOCATION_LAPLACE; }
@@ -159,7 +155,9 @@ class Assembler {
   // dof pattern
   std::vector<int64_t> rowptr_;
   std::vector<int32_t> cols_;
-  std::vector<int32_t> node_deg_;  // per node: node columns in each of its rows
+  std::vector<int32_t> node_deg_;  // per node: node columns in each of its rows (every
+                                   // component row of a node holds the same node columns,
+                                   // ncomp per node, sorted, multipliers after them)
   std::vector<int32_t> row_kind_;  // per dof: 0 form, 1 Dirichlet row, 2 traction row
   std::vector<int32_t> row_set_, row_node_;  // which node set / position replaces the row
   FeLayer fe_;
