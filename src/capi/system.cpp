@@ -5,7 +5,8 @@
 struct mfree_system {
   std::atomic<int> refs{1};
   mfree_context_t *ctx = nullptr;
-  mfree_assembler_t *as = nullptr;  // retained by elastodynamic systems
+  mfree_assembler_t *as = nullptr;       // retained by elastodynamic systems
+  mfree_assembler_t *mass_as = nullptr;  // retained by Galerkin elastodynamic systems
   std::unique_ptr<mfree::System> sys;
   mfree::System &core() { return *sys; }
   const mfree::System &core() const { return *sys; }
@@ -81,9 +82,10 @@ mfree_status_t mfree_system_destroy(mfree_system_t **sys) {
   mfree_system_t *s = *sys;
   if (s->refs.fetch_sub(1, std::memory_order_acq_rel) == 1) {
     mfree_context_t *c = s->ctx;
-    mfree_assembler_t *a = s->as;
+    mfree_assembler_t *a = s->as, *ma = s->mass_as;
     delete s;
     mfree::release(a);
+    mfree::release(ma);
     mfree::release(c);
   }
   *sys = nullptr;
@@ -201,6 +203,27 @@ mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx, mfree_ass
   });
 }
 
+mfree_status_t mfree_system_create_elastodynamic_galerkin(mfree_context_t *ctx, mfree_assembler_t *stiffness,
+                                                        mfree_assembler_t *mass, mfree_system_t **sys) {
+  if (!ctx) return MFREE_ERR_NULL;
+  return mfree::guard(ctx, "mfree_system_create_elastodynamic_galerkin", [&]() {
+    MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
+    *sys = nullptr;
+    MFREE_REQUIRE(stiffness && mass, MFREE_ERR_NULL, "stiffness or mass assembler is NULL");
+    auto impl = std::make_unique<mfree::ElasticSystem>(&stiffness->as, &mass->as);
+    auto *s = new mfree_system_t();
+    s->ctx = ctx;
+    s->as = stiffness;
+    s->mass_as = mass;
+    s->sys = std::move(impl);
+    mfree::retain(ctx);
+    stiffness->refs.fetch_add(1, std::memory_order_relaxed);
+    mass->refs.fetch_add(1, std::memory_order_relaxed);
+    *sys = s;
+    return MFREE_SUCCESS;
+  });
+}
+
 mfree_status_t mfree_system_set_load_history(mfree_system_t *sys, mfree_history_fn g, void *user) {
   return mfree::with_handle(sys, "mfree_system_set_load_history", [&](mfree::System &base) {
     kind<mfree::ElasticSystem>(base, "load history (not elastodynamic)").set_load_history(g, user);
@@ -211,6 +234,9 @@ mfree_status_t mfree_system_set_load_history(mfree_system_t *sys, mfree_history_
 mfree_status_t mfree_system_get_stress(mfree_system_t *sys, double t, const double *y, double *sigma) {
   return mfree::with_handle(sys, "mfree_system_get_stress", [&](mfree::System &base) {
     const auto &e = kind<mfree::ElasticSystem>(base, "stress output (not elastodynamic)");
+    MFREE_REQUIRE(!e.galerkin(), MFREE_ERR_UNSUPPORTED,
+                  "no stress output for Galerkin systems: apply the trial approximant's gradient "
+                  "(mfree_approximant_apply, MFREE_OP_GRADIENT) to the displacements");
     MFREE_REQUIRE(y && sigma, MFREE_ERR_NULL, "y or sigma is NULL");
     e.stress(t, y, sigma);
     return MFREE_SUCCESS;

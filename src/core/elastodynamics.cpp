@@ -14,8 +14,49 @@ ElasticSystem::ElasticSystem(const Assembler *as, double density) : as_(as), rho
   if (form != MFREE_FORM_COLLOCATION_LAPLACE && form != MFREE_FORM_COLLOCATION_PLANE_STRESS &&
       form != MFREE_FORM_COLLOCATION_PLANE_STRAIN)
     throw Error(MFREE_ERR_UNSUPPORTED, "elastodynamics needs a collocation assembler (Laplace form for the 1D bar "
-                                       "rho u'' = E u'', or a plane collocation form)");
+                                       "rho u'' = E u'', or a plane collocation form); Galerkin assemblers go to "
+                                       "mfree_system_create_elastodynamic_galerkin");
   if (!(std::isfinite(density) && density > 0.0)) throw Error(MFREE_ERR_ARG, "density must be finite and > 0");
+  init_common();
+  // the smallest particle spacing for the CFL limit
+  const ParticleSet &ps = as->particles();
+  dx_min_ = INFINITY;
+  const Approximant *tab = as->collocation_tables();
+  for (int32_t i = 0; i < ps.size(); ++i)
+    for (int64_t k = tab->rowptr()[i]; k < tab->rowptr()[i + 1]; ++k) {
+      const int32_t j = tab->cols()[k];
+      if (j == i) continue;
+      double d[3] = {0, 0, 0}, r2 = 0.0;
+      ps.displacement(i, j, d);
+      for (int c = 0; c < dim_; ++c) r2 += d[c] * d[c];
+      if (r2 > 0.0) dx_min_ = std::min(dx_min_, std::sqrt(r2));
+    }
+  limit_ = dx_min_ / c_;
+}
+
+ElasticSystem::ElasticSystem(const Assembler *stiffness, const Assembler *mass) : as_(stiffness), rho_(0.0) {
+  if (!stiffness->is_setup() || !mass->is_setup()) throw Error(MFREE_ERR_STATE, "an assembler is not set up");
+  const int form = stiffness->form();
+  if (form != MFREE_FORM_LAPLACE && form != MFREE_FORM_ELASTICITY_PLANE_STRESS &&
+      form != MFREE_FORM_ELASTICITY_PLANE_STRAIN && form != MFREE_FORM_ELASTICITY_3D)
+    throw Error(MFREE_ERR_UNSUPPORTED, "the stiffness assembler needs a Galerkin Laplace or elasticity form");
+  if (mass->form() != MFREE_FORM_MASS && mass->form() != MFREE_FORM_MASS_LUMPED)
+    throw Error(MFREE_ERR_UNSUPPORTED, "the mass assembler needs MFREE_FORM_MASS or MFREE_FORM_MASS_LUMPED");
+  if (&mass->particles() != &stiffness->particles())
+    throw Error(MFREE_ERR_MISMATCH, "the mass and stiffness assemblers are built on different particle sets");
+  if (stiffness->ndofs() != stiffness->particles().size() * stiffness->ncomp())
+    throw Error(MFREE_ERR_UNSUPPORTED, "Lagrange multipliers are not supported in elastodynamics: impose essential "
+                                       "conditions by penalty, Nitsche or node rows");
+  if (mass->ndofs() != mass->particles().size())
+    throw Error(MFREE_ERR_UNSUPPORTED, "the mass assembler has extra unknowns (multipliers)");
+  galerkin_ = true;
+  rho_ = mass->coefficient();
+  init_common();
+  init_galerkin_mass(mass);
+}
+
+void ElasticSystem::init_common() {
+  const Assembler *as = as_;
   const ParticleSet &ps = as->particles();
   dim_ = ps.dim();
   nc_ = as->ncomp();
@@ -49,28 +90,101 @@ ElasticSystem::ElasticSystem(const Assembler *as, double density) : as_(as), rho
     if (lu_->info() != Eigen::Success)
       throw Error(MFREE_ERR_INPUT, "the boundary rows do not determine the boundary unknowns (singular block)");
   }
-  // wave speed and the smallest particle spacing for the CFL limit
-  const double E = as->young(), nu = as->poisson();
-  if (form == MFREE_FORM_COLLOCATION_LAPLACE) {
+  // wave speed: bar (Laplace, c = coefficient = E) or P wave
+  const int form = as->form();
+  if (form == MFREE_FORM_COLLOCATION_LAPLACE || form == MFREE_FORM_LAPLACE) {
     c_ = std::sqrt(as->coefficient() / rho_);
   } else {
+    const double E = as->young(), nu = as->poisson();
     const double lam = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
-    const double lam_eff = form == MFREE_FORM_COLLOCATION_PLANE_STRESS ? 2 * lam * mu / (lam + 2 * mu) : lam;
+    const bool pstress = form == MFREE_FORM_COLLOCATION_PLANE_STRESS || form == MFREE_FORM_ELASTICITY_PLANE_STRESS;
+    const double lam_eff = pstress ? 2 * lam * mu / (lam + 2 * mu) : lam;
     c_ = std::sqrt((lam_eff + 2 * mu) / rho_);
   }
-  dx_min_ = INFINITY;
-  const Approximant *tab = as->collocation_tables();
-  for (int32_t i = 0; i < ps.size(); ++i)
-    for (int64_t k = tab->rowptr()[i]; k < tab->rowptr()[i + 1]; ++k) {
-      const int32_t j = tab->cols()[k];
-      if (j == i) continue;
-      double d[3] = {0, 0, 0}, r2 = 0.0;
-      ps.displacement(i, j, d);
-      for (int c = 0; c < dim_; ++c) r2 += d[c] * d[c];
-      if (r2 > 0.0) dx_min_ = std::min(dx_min_, std::sqrt(r2));
-    }
   rb_.resize(nb);
   work_.resize(nd_);
+}
+
+void ElasticSystem::init_galerkin_mass(const Assembler *mass) {
+  SparseMatrix Ms;
+  mass->assemble_matrix(Ms);
+  fpos_.assign(nd_, -1);
+  for (int32_t d = 0; d < nd_; ++d)
+    if (bpos_[d] < 0) {
+      fpos_[d] = static_cast<int32_t>(fdofs_.size());
+      fdofs_.push_back(d);
+    }
+  const int32_t nf = static_cast<int32_t>(fdofs_.size());
+  // M_ff: the scalar mass m_JK on every component, couplings to constrained unknowns
+  // dropped (exact when the constrained values do not accelerate, or the mass is lumped)
+  std::vector<Eigen::Triplet<double>> trip;
+  lumped_ = mass->form() == MFREE_FORM_MASS_LUMPED;
+  const int32_t n = as_->particles().size();
+  for (int32_t J = 0; J < n; ++J)
+    for (int64_t k = Ms.rowptr()[J]; k < Ms.rowptr()[J + 1]; ++k) {
+      const int32_t K = Ms.colidx()[k];
+      const double m = Ms.values()[k];
+      if (m == 0.0) continue;
+      if (K != J) lumped_ = false;
+      for (int a = 0; a < nc_; ++a) {
+        const int32_t p = fpos_[J * nc_ + a], q = fpos_[K * nc_ + a];
+        if (p >= 0 && q >= 0) trip.emplace_back(p, q, m);
+      }
+    }
+  Mff_.resize(nf, nf);
+  Mff_.setFromTriplets(trip.begin(), trip.end());
+  const Eigen::SparseMatrix<double> asym = Mff_ - Eigen::SparseMatrix<double>(Mff_.transpose());
+  if (asym.norm() > 1e-12 * Mff_.norm())
+    throw Error(MFREE_ERR_UNSUPPORTED, "the mass matrix is not symmetric (Petrov-Galerkin): use a Bubnov mass");
+  if (lumped_) {
+    minv_.assign(nf, 0.0);
+    for (int32_t p = 0; p < nf; ++p) {
+      const double m = Mff_.coeff(p, p);
+      if (!(m > 0.0)) throw Error(MFREE_ERR_INPUT, "the lumped mass of unknown " + std::to_string(fdofs_[p]) +
+                                                       " is " + std::to_string(m) + ", not positive");
+      minv_[p] = 1.0 / m;
+    }
+  } else {
+    mfac_ = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>();
+    mfac_->compute(Mff_);
+    bool spd = mfac_->info() == Eigen::Success;
+    if (spd)
+      for (int32_t p = 0; p < nf; ++p) spd = spd && mfac_->vectorD()(p) > 0.0;
+    if (!spd) throw Error(MFREE_ERR_INPUT, "the consistent mass is not positive definite");
+  }
+  // Step limit of central differences, 2 / omega_max, omega^2 the eigenvalues of
+  // M^-1 K on the free unknowns. Lumped: Gershgorin's bound max_p sum_q |K_pq| / m_p
+  // (rigorous). Consistent: power iteration, 200 steps from a fixed start, plus 5 %.
+  double w2 = 0.0;
+  if (lumped_) {
+    for (int32_t p = 0; p < nf; ++p) {
+      const int32_t d = fdofs_[p];
+      double s = 0.0;
+      for (int64_t k = K_.rowptr()[d]; k < K_.rowptr()[d + 1]; ++k) s += std::fabs(K_.values()[k]);
+      w2 = std::max(w2, s * minv_[p]);
+    }
+  } else {
+    Eigen::VectorXd x(nf), Kx(nf);
+    for (int32_t p = 0; p < nf; ++p) x(p) = 1.0 + 0.37 * std::sin(1.0 + 7.3 * p);  // not an eigenvector
+    std::vector<double> u(nd_), a(nd_);
+    for (int it = 0; it < 200 && nf > 0; ++it) {
+      x /= x.norm();
+      std::fill(u.begin(), u.end(), 0.0);
+      for (int32_t p = 0; p < nf; ++p) u[fdofs_[p]] = x(p);
+      for (int32_t p = 0; p < nf; ++p) {
+        const int32_t d = fdofs_[p];
+        double s = 0.0;
+        for (int64_t k = K_.rowptr()[d]; k < K_.rowptr()[d + 1]; ++k) s += K_.values()[k] * u[K_.colidx()[k]];
+        Kx(p) = s;
+      }
+      const Eigen::VectorXd y = mfac_->solve(Kx);
+      w2 = std::max(w2, x.dot(Mff_ * y) / x.dot(Mff_ * x));  // Rayleigh quotient in the M inner product
+      x = y;
+    }
+    w2 *= 1.05 * 1.05;
+  }
+  limit_ = w2 > 0.0 ? 2.0 / std::sqrt(w2) : INFINITY;
+  dx_min_ = limit_ * c_;
 }
 
 void ElasticSystem::set_load_history(double (*fn)(void *, double), void *user) {
@@ -96,7 +210,26 @@ void ElasticSystem::enforce_boundary(double t, double *u) const {
   for (int32_t q = 0; q < nb; ++q) u[bdofs_[q]] = ub(q);
 }
 
-void ElasticSystem::accel(const double *u, double *a) const {
+void ElasticSystem::accel(double t, const double *u, double *a) const {
+  if (galerkin_) {
+    // M_ff a_f = g(t) f_f - K_f u: the history scales the whole load vector
+    const int32_t nf = static_cast<int32_t>(fdofs_.size());
+    const double g = history(t);
+    Eigen::VectorXd r(nf);
+    for (int32_t p = 0; p < nf; ++p) {
+      const int32_t d = fdofs_[p];
+      double s = g * f0_[d];
+      for (int64_t k = K_.rowptr()[d]; k < K_.rowptr()[d + 1]; ++k) s -= K_.values()[k] * u[K_.colidx()[k]];
+      r(p) = s;
+    }
+    if (lumped_) {
+      for (int32_t p = 0; p < nf; ++p) r(p) *= minv_[p];
+    } else if (nf > 0) {
+      r = mfac_->solve(r).eval();
+    }
+    for (int32_t d = 0; d < nd_; ++d) a[d] = fpos_[d] >= 0 ? r(fpos_[d]) : 0.0;
+    return;
+  }
   for (int32_t d = 0; d < nd_; ++d) {
     if (bpos_[d] >= 0) {
       a[d] = 0.0;
@@ -127,21 +260,40 @@ Report ElasticSystem::rhs(double t, const double *y, double *ydot) {
   enforce_boundary(t, work_.data());
   // boundary unknowns follow the constraints: their entries of y are not used
   for (int32_t d = 0; d < nd_; ++d) ydot[d] = bpos_[d] >= 0 ? 0.0 : y[nd_ + d];
-  accel(work_.data(), ydot + nd_);
+  accel(t, work_.data(), ydot + nd_);
   return rep;
 }
 
 Report ElasticSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   (void)y;
   (void)consistent;
-  std::vector<int64_t> rp(static_cast<size_t>(neq()) + 1);
-  std::vector<int32_t> ci(static_cast<size_t>(neq()));
+  // y' = f is explicit for collocation: the identity. Galerkin: the velocity block holds
+  // the mass the right-hand side divides by (lumped or consistent, as assembled) on the
+  // free unknowns, the identity on the constrained ones.
+  std::vector<int64_t> rp(static_cast<size_t>(neq()) + 1, 0);
+  std::vector<int32_t> ci;
+  std::vector<double> vals;
   for (int32_t q = 0; q < neq(); ++q) {
-    rp[q + 1] = q + 1;
-    ci[q] = q;
+    const int32_t d = q - nd_;
+    if (galerkin_ && d >= 0 && fpos_[d] >= 0) {
+      const int32_t p = fpos_[d];
+      std::vector<std::pair<int32_t, double>> row;
+      // Mff_ is column-major and symmetric: column p is row p
+      for (Eigen::SparseMatrix<double>::InnerIterator it(Mff_, p); it; ++it)
+        row.push_back({nd_ + fdofs_[it.row()], it.value()});
+      std::sort(row.begin(), row.end());
+      for (auto &e : row) {
+        ci.push_back(e.first);
+        vals.push_back(e.second);
+      }
+    } else {
+      ci.push_back(q);
+      vals.push_back(1.0);
+    }
+    rp[q + 1] = static_cast<int64_t>(ci.size());
   }
   M.set_pattern(neq(), neq(), std::move(rp), std::move(ci));
-  std::fill(M.values_mut().begin(), M.values_mut().end(), 1.0);  // y' = f is already explicit
+  std::copy(vals.begin(), vals.end(), M.values_mut().begin());
   return Report();
 }
 
@@ -185,19 +337,19 @@ Report ElasticSystem::integrate(int scheme, double *y, double &t, double t_end, 
   nsteps = 0;
   Report rep = check(y, "initial state: ");
   if (!rep.ok()) return rep;
-  const double limit = dx_min_ / c_;
+  const double limit = limit_;
   double dt = cfl > 0.0 ? cfl * limit : dt_max;
   if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
   if (dt > limit * (1.0 + 1e-12)) {
     std::ostringstream s;
-    s << "dt = " << dt << " exceeds the CFL limit dx/c = " << limit;
+    s << "dt = " << dt << " exceeds the CFL limit " << (galerkin_ ? "2/omega_max = " : "dx/c = ") << limit;
     rep.fail(MFREE_FAIL_CFL, s.str());
     return rep;
   }
   std::vector<double> yn(y, y + 2 * static_cast<size_t>(nd_)), a(nd_), u(nd_);
   double *un = yn.data(), *vn = yn.data() + nd_;
   enforce_boundary(t, un);
-  accel(un, a.data());
+  accel(t, un, a.data());
   while (t < t_end) {
     const double h = std::min(dt, t_end - t);
     // velocity Verlet = central difference for the displacements
@@ -207,7 +359,7 @@ Report ElasticSystem::integrate(int scheme, double *y, double &t, double t_end, 
     }
     const double tn = (t_end - t <= h) ? t_end : t + h;
     enforce_boundary(tn, un);
-    accel(un, a.data());
+    accel(tn, un, a.data());
     for (int32_t d = 0; d < nd_; ++d) vn[d] += 0.5 * h * a[d];
     Report bad = check(yn.data(), "step " + std::to_string(nsteps + 1) + ": ");
     if (!bad.ok()) return bad;

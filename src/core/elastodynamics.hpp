@@ -1,8 +1,10 @@
-// Linear elastodynamics by strong-form collocation (paper 001 Sect. 6.4): rho u'' =
+// Linear elastodynamics (paper 001 Sect. 6.4) by strong-form collocation: rho u'' =
 // Navier(u) + b at interior particles, boundary rows (tractions, displacements) kept as
-// algebraic constraints, solved for the boundary unknowns at every evaluation.
+// algebraic constraints, solved for the boundary unknowns at every evaluation; or by
+// Galerkin: M u'' = g(t) f - K u with K and M from two assemblers (any approximant).
 #pragma once
 
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <cstdint>
 #include <memory>
@@ -18,6 +20,10 @@ class ElasticSystem : public System {
   // as: a set-up collocation assembler (its matrix and right-hand side define the
   // operator and the boundary data); the caller keeps it alive.
   ElasticSystem(const Assembler *as, double density);
+  // Galerkin: K from a set-up Galerkin assembler (Laplace form with c = E for the 1D bar,
+  // or an elasticity form), M from a set-up mass assembler (MFREE_FORM_MASS or
+  // MFREE_FORM_MASS_LUMPED, coefficient = density) on the same particles.
+  ElasticSystem(const Assembler *stiffness, const Assembler *mass);
 
   void set_load_history(double (*fn)(void *, double), void *user);
 
@@ -28,15 +34,22 @@ class ElasticSystem : public System {
                    mfree_progress_fn progress, void *user, int64_t &nsteps) override;
 
   int stress_components() const { return dim_ == 1 ? 1 : (dim_ == 2 ? 3 : 6); }
-  // Stress at the particles from the displacements of y (boundary unknowns enforced).
+  // Stress at the particles from the displacements of y (boundary unknowns enforced);
+  // collocation systems only (the Galerkin trial tables live in the assembler).
   void stress(double t, const double *y, double *sigma) const;
+  bool galerkin() const { return galerkin_; }
   double wave_speed() const { return c_; }
   double min_spacing() const { return dx_min_; }
+  // The step limit of central differences: dx_min / c (collocation), 2 / omega_max of
+  // M^-1 K (Galerkin).
+  double step_limit() const { return limit_; }
 
  private:
   double history(double t) const { return hist_ ? hist_(hist_user_, t) : 1.0; }
+  void init_common();
+  void init_galerkin_mass(const Assembler *mass);
   void enforce_boundary(double t, double *u) const;
-  void accel(const double *u, double *a) const;
+  void accel(double t, const double *u, double *a) const;
   Report check(const double *y, const std::string &when) const;
 
   const Assembler *as_;
@@ -49,7 +62,14 @@ class ElasticSystem : public System {
   std::unique_ptr<Eigen::SparseLU<Eigen::SparseMatrix<double>>> lu_;
   double (*hist_)(void *, double) = nullptr;
   void *hist_user_ = nullptr;
-  double c_ = 0.0, dx_min_ = 0.0;
+  double c_ = 0.0, dx_min_ = 0.0, limit_ = 0.0;
+  // Galerkin: mass on the free (non-constrained) dofs, lumped (inverse diagonal) or
+  // factorised; fpos_ = position of each dof among the free ones (-1: constrained)
+  bool galerkin_ = false, lumped_ = false;
+  std::vector<int32_t> fdofs_, fpos_;
+  std::vector<double> minv_;
+  Eigen::SparseMatrix<double> Mff_;
+  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> mfac_;
   mutable std::vector<double> rb_, work_;
 };
 
