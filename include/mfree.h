@@ -860,6 +860,27 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx,
                                                            mfree_assembler_t *as,
                                                            double density,
                                                            mfree_system_t **sys);
+/**
+ * Linear elastodynamics by Galerkin with any approximant: M u'' = g(t) f - K u, K and f
+ * from a set-up Galerkin assembler (MFREE_FORM_LAPLACE with c = E for the 1D bar
+ * rho u'' = E u'', or an MFREE_FORM_ELASTICITY_* form; tractions, body forces, penalty or
+ * Nitsche terms as assembled; the load history g(t) scales the whole load vector), M
+ * from a set-up mass assembler on the same particles (MFREE_FORM_MASS, consistent, or
+ * MFREE_FORM_MASS_LUMPED; coefficient = density; Bubnov). Unknowns whose rows a node
+ * condition replaced (mfree_assembler_add_dirichlet_nodes, FE layer) are constraints as
+ * in the collocation system; their mass couplings are dropped (exact for a lumped mass
+ * or constant boundary data). Lagrange multipliers are MFREE_ERR_UNSUPPORTED. State
+ * y: displacements then velocities (ncomp per particle each). Central differences
+ * (MFREE_INTEGRATOR_LEAPFROG) with the step limit 2 / omega_max of M^-1 K (lumped:
+ * Gershgorin's bound; consistent: power iteration plus 5 %); mfree_system_assemble_mass
+ * gives the identity and, in the velocity block, the mass the right-hand side divides
+ * by. The system keeps both assemblers alive. mfree_system_get_stress is
+ * MFREE_ERR_UNSUPPORTED: apply the trial approximant's gradient to the displacements.
+ */
+MFREE_API mfree_status_t mfree_system_create_elastodynamic_galerkin(mfree_context_t *ctx,
+                                                                    mfree_assembler_t *stiffness,
+                                                                    mfree_assembler_t *mass,
+                                                                    mfree_system_t **sys);
 MFREE_API mfree_status_t mfree_system_set_load_history(mfree_system_t *sys,
                                                        mfree_history_fn g, void *user);
 /** Stress at the particles (1D: sigma = E u'; 2D: xx, yy, xy), boundary constraints

@@ -2327,6 +2327,14 @@ contains
     st = mfree_system_create_elastodynamic_c(ctx%ptr, as%ptr, density, sys%ptr)
   end function mfree_system_create_elastodynamic
 
+  !> Galerkin elastodynamics M u'' = g(t) f - K u from a stiffness and a mass assembler.
+  integer(c_int) function mfree_system_create_elastodynamic_galerkin(ctx, stiffness, mass, sys) result(st)
+    type(mfree_context), intent(in) :: ctx
+    type(mfree_assembler), intent(in) :: stiffness, mass
+    type(mfree_system), intent(out) :: sys
+    st = mfree_system_create_elastodynamic_galerkin_c(ctx%ptr, stiffness%ptr, mass%ptr, sys%ptr)
+  end function mfree_system_create_elastodynamic_galerkin
+
   !> Load history g(t) scaling the boundary data; absent g: back to the default 1.
   integer(c_int) function mfree_system_set_load_history(sys, g, user) result(st)
     type(mfree_system), intent(in) :: sys
