@@ -1054,6 +1054,15 @@ module mfree
       type(c_ptr), intent(out) :: sys
     end function mfree_system_create_elastodynamic_c
 
+    integer(c_int) function mfree_system_create_elastodynamic_galerkin_c(ctx, stiffness, mass, sys) &
+        bind(C, name="mfree_system_create_elastodynamic_galerkin")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ctx
+      type(c_ptr), value :: stiffness
+      type(c_ptr), value :: mass
+      type(c_ptr), intent(out) :: sys
+    end function mfree_system_create_elastodynamic_galerkin_c
+
     integer(c_int) function mfree_system_set_load_history_c(sys, g, user) &
         bind(C, name="mfree_system_set_load_history")
       import :: c_int, c_ptr, c_funptr
@@ -1124,6 +1133,7 @@ module mfree
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
   public :: mfree_system_create_elastodynamic_c, mfree_system_set_load_history_c
+  public :: mfree_system_create_elastodynamic_galerkin_c
   public :: mfree_system_get_stress_c
 
   ! ---- per-particle scalars and point supports: an array, or one value (stride 0) -----
@@ -1195,6 +1205,7 @@ module mfree
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
   public :: mfree_system_create_elastodynamic, mfree_system_set_load_history
+  public :: mfree_system_create_elastodynamic_galerkin
   public :: mfree_system_get_stress
 
   ! Targets of zero-length matrix views (a C view of an empty array may be NULL).
