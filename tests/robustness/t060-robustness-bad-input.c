@@ -529,7 +529,13 @@ static void rows_approximant(void) {
   ROW(MFREE_ERR_ARG, mfree_approximant_set_fallback(F.a_new, (mfree_fallback_t)3));
 #if MFREE_T060_MESH
   ROW0(MFREE_ERR_NULL, mfree_approximant_set_mesh(NULL, F.mesh));
-  ROW(MFREE_ERR_UNSUPPORTED, mfree_approximant_set_mesh(F.a_new, F.mesh));
+  {
+    mfree_approximant_t *mls = NULL; /* not MPFEM, on the mesh's particles */
+    assert_ok(F.ctx, mfree_approximant_create(F.ctx, F.psm, MFREE_METHOD_MLS, &mls));
+    ROW(MFREE_ERR_UNSUPPORTED, mfree_approximant_set_mesh(mls, F.mesh));
+    mfree_approximant_destroy(&mls);
+  }
+  ROW(MFREE_ERR_MISMATCH, mfree_approximant_set_mesh(F.a_new, F.mesh)); /* other particles */
   ROW(MFREE_ERR_NULL, mfree_approximant_set_mesh(F.am, NULL));
   {
     mfree_approximant_t *m3 = NULL;
