@@ -94,6 +94,10 @@ typedef enum {
   ES_BC_LAGRANGE = 5, /* MFREE_BC_LAGRANGE, one point multiplier per boundary node */
   ES_BC_FE_LAYER = 6, /* mfree_assembler_set_fe_layer: the finite-element blending layer
                          of 000 Sect. 5.6, one call (component mask) per boundary line */
+  ES_BC_FE_GAUSS = 8, /* the same layer, its elements integrated by 2 x 2 Gauss points with
+                         the blended functions and the other nodes by nodal quadrature (the
+                         interface nodes' volumes less their share of the layer): not the
+                         paper's; shows what the layer's nodal quadrature costs */
   ES_BC_FE_NODAL = 7  /* the same layer as nodal quadrature sees it, built by the example
                          (000 eq 105, Fig. 2): element derivatives at the quadrature points
                          of the nodes on Gamma_u, prescribed values on their parameters;

@@ -26,15 +26,15 @@ const es_scheme_t es_schemes[ES_NSCHEMES] = {
     {"EFG", MFREE_METHOD_MLS, 1, (mfree_method_t)0, 1, 0},
 };
 
-static const char *const kBcNames[] = {"auto",    "direct",   "rows",     "nitsche",
-                                       "penalty", "lagrange", "fe-layer", "fe-nodal"};
+static const char *const kBcNames[] = {"auto",     "direct",   "rows",     "nitsche", "penalty",
+                                       "lagrange", "fe-layer", "fe-nodal", "fe-gauss"};
 
 const char *es_bc_name(es_bc_t bc) {
-  return (int)bc >= 0 && (int)bc <= ES_BC_FE_NODAL ? kBcNames[bc] : "?";
+  return (int)bc >= 0 && (int)bc <= ES_BC_FE_GAUSS ? kBcNames[bc] : "?";
 }
 
 int es_bc_parse(const char *s, es_bc_t *bc) {
-  for (int k = 0; k <= ES_BC_FE_NODAL; ++k)
+  for (int k = 0; k <= ES_BC_FE_GAUSS; ++k)
     if (strcmp(s, kBcNames[k]) == 0) {
       *bc = (es_bc_t)k;
       return 0;
@@ -309,6 +309,66 @@ static int fe_layer(const es_problem_t *p, const es_level_t *lv, const tables_t 
   return rc;
 }
 
+/* ES_BC_FE_GAUSS: quadrature points = the nodes off Gamma_u with their volumes, those of
+ * the layer's interface nodes less a quarter of each adjacent element's area (the part of
+ * their cells inside the layer), plus 2 x 2 Gauss points in every layer element (bilinear
+ * map), where mfree blends the element and meshfree functions (000 eqs 100-104). */
+static int fe_gauss_points(const es_level_t *lv, double **px, double **pw, int32_t *np, char *err, int errlen) {
+  const int32_t n = lv->n;
+  int32_t *conn = malloc(sizeof(int32_t) * 4 * (size_t)(n ? n : 1));
+  char *gu = calloc((size_t)(n ? n : 1), 1);
+  double *vol = malloc(sizeof(double) * (size_t)(n ? n : 1));
+  int32_t ne = conn && gu && vol ? layer_elements(lv, -1, conn, err, errlen) : -1;
+  double *x = ne >= 0 ? malloc(sizeof(double) * 2 * (size_t)(n + 4 * ne)) : NULL;
+  double *w = ne >= 0 ? malloc(sizeof(double) * (size_t)(n + 4 * ne)) : NULL;
+  int rc = !x || !w;
+  if (!rc) {
+    memcpy(vol, lv->vol, sizeof(double) * (size_t)n);
+    for (int32_t k = 0; k < lv->chain_start[lv->nchain]; ++k) gu[lv->chain_nodes[k]] = 1;
+    const double g = 1.0 / sqrt(3.0);
+    int32_t m = 0;
+    for (int32_t e = 0; e < ne; ++e) {
+      const int32_t *q = conn + 4 * e;
+      double X[4][2];
+      for (int a = 0; a < 4; ++a) X[a][0] = lv->x[2 * q[a]], X[a][1] = lv->x[2 * q[a] + 1];
+      double area = 0.0;
+      for (int a = 0; a < 4; ++a) area += 0.5 * (X[a][0] * X[(a + 1) % 4][1] - X[(a + 1) % 4][0] * X[a][1]);
+      for (int a = 0; a < 4; ++a)
+        if (!gu[q[a]]) vol[q[a]] -= 0.25 * area;
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j, ++m) {
+          const double u = i ? g : -g, v = j ? g : -g;
+          const double N[4] = {0.25 * (1 - u) * (1 - v), 0.25 * (1 + u) * (1 - v), 0.25 * (1 + u) * (1 + v),
+                               0.25 * (1 - u) * (1 + v)};
+          double J[2][2] = {{0, 0}, {0, 0}};
+          const double du[4] = {-0.25 * (1 - v), 0.25 * (1 - v), 0.25 * (1 + v), -0.25 * (1 + v)};
+          const double dv[4] = {-0.25 * (1 - u), -0.25 * (1 + u), 0.25 * (1 + u), 0.25 * (1 - u)};
+          x[2 * m] = x[2 * m + 1] = 0.0;
+          for (int a = 0; a < 4; ++a)
+            for (int d = 0; d < 2; ++d) {
+              x[2 * m + d] += N[a] * X[a][d];
+              J[d][0] += du[a] * X[a][d];
+              J[d][1] += dv[a] * X[a][d];
+            }
+          w[m] = fabs(J[0][0] * J[1][1] - J[0][1] * J[1][0]);
+        }
+    }
+    for (int32_t i = 0; i < n; ++i) {
+      if (gu[i]) continue;
+      x[2 * m] = lv->x[2 * i], x[2 * m + 1] = lv->x[2 * i + 1];
+      w[m++] = vol[i];
+    }
+    *np = m;
+  }
+  free(conn), free(gu), free(vol);
+  if (rc) {
+    free(x), free(w);
+    return 1;
+  }
+  *px = x, *pw = w;
+  return 0;
+}
+
 /* Rows u_J = g_c(x_J) on the nodal parameters (ES_BC_DIRECT): the pattern of the
  * assembled matrix always holds the diagonal (every particle is its own neighbour). The
  * rows are scaled by E, the size of the stiffness rows. */
@@ -533,13 +593,20 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
   mfree_assembler_t *as = NULL;
   mfree_matrix_t *K = NULL;
   double *f = NULL, *u = NULL, *bx = NULL, *bw = NULL, *bn = NULL, *uq = NULL, *gq = NULL;
-  double *un = NULL;
+  double *un = NULL, *gx = NULL, *gw = NULL;
+  int32_t ngp = 0;
   int32_t *nodes = NULL, *conn = NULL, *gu = NULL, *on_gu = NULL;
   traction_t *tu = NULL;
   const int32_t n = lv->n;
 
   bc = es_bc_resolve(s, lv, bc);
   r->bc = bc;
+  if ((s->efg || s->particles_only) && bc == ES_BC_FE_GAUSS) {
+    st = MFREE_ERR_UNSUPPORTED;
+    if (err) snprintf(err, (size_t)errlen, "%s: fe-gauss is for nodal quadrature of functions defined between "
+                                           "the particles", s->name);
+    goto done;
+  }
   if (s->efg && bc == ES_BC_FE_NODAL) {
     st = MFREE_ERR_UNSUPPORTED;
     if (err) snprintf(err, (size_t)errlen, "%s: the FE-layer emulation is for nodal quadrature", s->name);
@@ -570,6 +637,12 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
     else
       CHECK(mfree_assembler_set_quadrature_points(as, lv->nq, lv->xq, MFREE_LAYOUT_AOS, 2, lv->wq),
             "background points");
+  } else if (bc == ES_BC_FE_GAUSS) {
+    if (fe_gauss_points(lv, &gx, &gw, &ngp, err, errlen)) {
+      st = MFREE_ERR_INPUT;
+      goto done;
+    }
+    CHECK(mfree_assembler_set_quadrature_points(as, ngp, gx, MFREE_LAYOUT_AOS, 2, gw), "layer Gauss points");
   } else {
     CHECK(mfree_assembler_set_quadrature_nodal(as), "nodal quadrature");
   }
@@ -658,7 +731,7 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
     }
   }
 
-  if (bc == ES_BC_FE_LAYER) {
+  if (bc == ES_BC_FE_LAYER || bc == ES_BC_FE_GAUSS) {
     /* one call per essential boundary line, each with its own component mask */
     conn = malloc(sizeof(int32_t) * 4 * (size_t)(n ? n : 1));
     gu = malloc(sizeof(int32_t) * (size_t)(n ? n : 1));
@@ -836,7 +909,7 @@ done:
   mfree_approximant_destroy(&trial);
   mfree_particles_destroy(&ps);
   free(f), free(u), free(bx), free(bw), free(bn), free(uq), free(gq), free(un), free(nodes), free(tu);
-  free(conn), free(gu), free(on_gu);
+  free(conn), free(gu), free(on_gu), free(gx), free(gw);
   r->seconds = now() - t0;
   return st;
 }
