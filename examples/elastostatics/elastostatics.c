@@ -79,8 +79,8 @@ typedef struct {
 
 static const char kUsage[] =
     "usage: mfree_elastostatics [--json] [--problem beam|hole|patch|both|all] [--levels N]\n"
-    "                           [--out DIR] [--no-plot] [--bc auto|fe-layer|fe-nodal|direct|rows|\n"
-    "                           nitsche|penalty|lagrange]"
+    "                           [--out DIR] [--no-plot] [--bc auto|fe-layer|fe-nodal|fe-gauss|\n"
+    "                           direct|rows|nitsche|penalty|lagrange]"
     " [--scheme NAME] [--threads N]\n"
     "Paper 000 Table III: convergence of SPH, JB, RL, CD1, CD2, MLS and EFG on the cantilever\n"
     "beam and the plate with a hole (plane stress), next to the paper's rates; a patch test.\n"
@@ -88,7 +88,9 @@ static const char kUsage[] =
     "  --levels   refinements per problem (default 5; at least 2)\n"
     "  --bc       essential conditions for every scheme; default auto = fe-layer (mfree's\n"
     "             finite-element blending layer, 000 Sect. 5.6, a mask per line); fe-nodal =\n"
-    "             the example's nodal-quadrature build of the same layer. Others: direct = rows\n"
+    "             the example's nodal-quadrature build of the same layer; fe-gauss = the layer's\n"
+    "             elements by 2x2 Gauss points, the rest nodal (not the paper's; CD1, CD2, MLS).\n"
+    "             Others: direct = rows\n"
     "             u_J = g(x_J) on the parameters; rows = mfree_assembler_add_dirichlet_nodes;\n"
     "             nitsche, penalty, lagrange = MFREE_BC_*\n"
     "Writes DIR/elastostatics_{beam,hole}.dat, DIR/elastostatics.gp (+ .png with gnuplot).\n";
