@@ -90,8 +90,8 @@ static const char kUsage[] =
     "             finite-element blending layer, 000 Sect. 5.6, a mask per line); fe-nodal =\n"
     "             the example's nodal-quadrature build of the same layer; fe-gauss = the layer's\n"
     "             elements by 2x2 Gauss points, the rest nodal (not the paper's; CD1, CD2, MLS).\n"
-    "             Others: direct = rows\n"
-    "             u_J = g(x_J) on the parameters; rows = mfree_assembler_add_dirichlet_nodes;\n"
+    "             Others: direct = rows u_J = g(x_J) on the parameters; rows =\n"
+    "             mfree_assembler_add_dirichlet_nodes;\n"
     "             nitsche, penalty, lagrange = MFREE_BC_*\n"
     "Writes DIR/elastostatics_{beam,hole}.dat, DIR/elastostatics.gp (+ .png with gnuplot).\n";
 
