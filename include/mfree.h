@@ -238,6 +238,12 @@ typedef int32_t (*mfree_inside_fn)(void *user, const double *x);
 
 /** Called on every failure recorded on a context (from the failing call's thread). */
 typedef void (*mfree_error_handler_t)(void *user, mfree_status_t code, const char *message);
+/** Allocation hook (mfree_context_set_allocator): return bytes bytes aligned as malloc's
+ * are, or NULL on failure (the call then returns MFREE_ERR_ALLOC). May be called from
+ * any of the call's OpenMP threads at once. */
+typedef void *(*mfree_alloc_fn)(void *user, int64_t bytes);
+/** Release a block of the matching mfree_alloc_fn; bytes is the size it was asked for. */
+typedef void (*mfree_free_fn)(void *user, void *ptr, int64_t bytes);
 
 /* ------------------------------------------------------------------------------------ */
 /* Version and status                                                                     */
@@ -292,6 +298,21 @@ MFREE_API mfree_status_t mfree_context_set_num_threads(mfree_context_t *ctx,
                                                        int32_t nthreads);
 MFREE_API mfree_status_t mfree_context_get_num_threads(const mfree_context_t *ctx,
                                                        int32_t *nthreads);
+
+/**
+ * Install an allocator for the large arrays mfree allocates while it runs a call on an
+ * object of this context: neighbour lists, shape-function tables and their per-site
+ * scratch (small bookkeeping such as messages uses the C++ runtime). Every block goes
+ * back to the free function of the allocator that made it, even after the allocator is
+ * changed, so alloc, release and user must stay valid until the objects that used them
+ * are destroyed. After the first setup, mfree_approximant_update and _apply allocate
+ * nothing. Both NULL restores malloc (the default).
+ * @param[in] alloc    allocation function, or NULL
+ * @param[in] release  matching free function, or NULL (both NULL or neither)
+ * @param[in] user     passed to both; not dereferenced by mfree
+ */
+MFREE_API mfree_status_t mfree_context_set_allocator(mfree_context_t *ctx, mfree_alloc_fn alloc,
+                                                     mfree_free_fn release, void *user);
 
 /* ------------------------------------------------------------------------------------ */
 /* Kernels                                                                                */
@@ -860,27 +881,6 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx,
                                                            mfree_assembler_t *as,
                                                            double density,
                                                            mfree_system_t **sys);
-/**
- * Linear elastodynamics by Galerkin with any approximant: M u'' = g(t) f - K u, K and f
- * from a set-up Galerkin assembler (MFREE_FORM_LAPLACE with c = E for the 1D bar
- * rho u'' = E u'', or an MFREE_FORM_ELASTICITY_* form; tractions, body forces, penalty or
- * Nitsche terms as assembled; the load history g(t) scales the whole load vector), M
- * from a set-up mass assembler on the same particles (MFREE_FORM_MASS, consistent, or
- * MFREE_FORM_MASS_LUMPED; coefficient = density; Bubnov). Unknowns whose rows a node
- * condition replaced (mfree_assembler_add_dirichlet_nodes, FE layer) are constraints as
- * in the collocation system; their mass couplings are dropped (exact for a lumped mass
- * or constant boundary data). Lagrange multipliers are MFREE_ERR_UNSUPPORTED. State
- * y: displacements then velocities (ncomp per particle each). Central differences
- * (MFREE_INTEGRATOR_LEAPFROG) with the step limit 2 / omega_max of M^-1 K (lumped:
- * Gershgorin's bound; consistent: power iteration plus 5 %); mfree_system_assemble_mass
- * gives the identity and, in the velocity block, the mass the right-hand side divides
- * by. The system keeps both assemblers alive. mfree_system_get_stress is
- * MFREE_ERR_UNSUPPORTED: apply the trial approximant's gradient to the displacements.
- */
-MFREE_API mfree_status_t mfree_system_create_elastodynamic_galerkin(mfree_context_t *ctx,
-                                                                    mfree_assembler_t *stiffness,
-                                                                    mfree_assembler_t *mass,
-                                                                    mfree_system_t **sys);
 MFREE_API mfree_status_t mfree_system_set_load_history(mfree_system_t *sys,
                                                        mfree_history_fn g, void *user);
 /** Stress at the particles (1D: sigma = E u'; 2D: xx, yy, xy), boundary constraints

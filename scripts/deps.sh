@@ -6,7 +6,7 @@
 # clang: the libFuzzer harness (fuzz/); valgrind: the memory-check label.
 set -euo pipefail
 
-MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev abigail-tools clang valgrind"
+MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev abigail-tools clang valgrind libnanoflann-dev"
 
 if ! command -v dpkg-query >/dev/null 2>&1; then
   echo "deps.sh: dpkg-query not found: this script is for Debian/Ubuntu." >&2

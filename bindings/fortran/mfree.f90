@@ -267,6 +267,17 @@ module mfree
       integer(c_int32_t), intent(out) :: nthreads
     end function mfree_context_get_num_threads_c
 
+    ! alloc: type(c_funptr) to a bind(C) function returning type(c_ptr) with arguments
+    ! (type(c_ptr), value :: user; integer(c_int64_t), value :: bytes); release: a
+    ! bind(C) subroutine (user, ptr, bytes); both c_null_funptr restores malloc.
+    integer(c_int) function mfree_context_set_allocator_c(ctx, alloc, release, user) &
+        bind(C, name="mfree_context_set_allocator")
+      import :: c_int, c_ptr, c_funptr
+      type(c_ptr), value :: ctx
+      type(c_funptr), value :: alloc, release
+      type(c_ptr), value :: user
+    end function mfree_context_set_allocator_c
+
     ! -- kernels
     integer(c_int) function mfree_kernel_eval_c(ctx, kernel, dim, param, h, n, r, w, dwdr, &
                                                 d2wdr2) &
@@ -1054,15 +1065,6 @@ module mfree
       type(c_ptr), intent(out) :: sys
     end function mfree_system_create_elastodynamic_c
 
-    integer(c_int) function mfree_system_create_elastodynamic_galerkin_c(ctx, stiffness, mass, sys) &
-        bind(C, name="mfree_system_create_elastodynamic_galerkin")
-      import :: c_int, c_ptr
-      type(c_ptr), value :: ctx
-      type(c_ptr), value :: stiffness
-      type(c_ptr), value :: mass
-      type(c_ptr), intent(out) :: sys
-    end function mfree_system_create_elastodynamic_galerkin_c
-
     integer(c_int) function mfree_system_set_load_history_c(sys, g, user) &
         bind(C, name="mfree_system_set_load_history")
       import :: c_int, c_ptr, c_funptr
@@ -1091,6 +1093,7 @@ module mfree
   public :: mfree_context_get_last_error_c, mfree_context_set_error_c
   public :: mfree_context_set_error_handler_c, mfree_context_set_num_threads_c
   public :: mfree_context_get_num_threads_c, mfree_kernel_eval_c
+  public :: mfree_context_set_allocator_c
   public :: mfree_kernel_get_support_radius_c, mfree_kernel_get_normalization_c
   public :: mfree_particles_create_c, mfree_particles_destroy_c
   public :: mfree_particles_set_num_ghost_c, mfree_particles_set_positions_c
@@ -1133,7 +1136,6 @@ module mfree
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
   public :: mfree_system_create_elastodynamic_c, mfree_system_set_load_history_c
-  public :: mfree_system_create_elastodynamic_galerkin_c
   public :: mfree_system_get_stress_c
 
   ! ---- per-particle scalars and point supports: an array, or one value (stride 0) -----
@@ -1205,7 +1207,6 @@ module mfree
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
   public :: mfree_system_create_elastodynamic, mfree_system_set_load_history
-  public :: mfree_system_create_elastodynamic_galerkin
   public :: mfree_system_get_stress
 
   ! Targets of zero-length matrix views (a C view of an empty array may be NULL).
@@ -2337,14 +2338,6 @@ contains
     type(mfree_system), intent(out) :: sys
     st = mfree_system_create_elastodynamic_c(ctx%ptr, as%ptr, density, sys%ptr)
   end function mfree_system_create_elastodynamic
-
-  !> Galerkin elastodynamics M u'' = g(t) f - K u from a stiffness and a mass assembler.
-  integer(c_int) function mfree_system_create_elastodynamic_galerkin(ctx, stiffness, mass, sys) result(st)
-    type(mfree_context), intent(in) :: ctx
-    type(mfree_assembler), intent(in) :: stiffness, mass
-    type(mfree_system), intent(out) :: sys
-    st = mfree_system_create_elastodynamic_galerkin_c(ctx%ptr, stiffness%ptr, mass%ptr, sys%ptr)
-  end function mfree_system_create_elastodynamic_galerkin
 
   !> Load history g(t) scaling the boundary data; absent g: back to the default 1.
   integer(c_int) function mfree_system_set_load_history(sys, g, user) result(st)

@@ -25,7 +25,7 @@ void check_layout(int layout, int64_t ld, int64_t need_aos, int64_t need_soa, co
 }
 
 template <class T>
-void copy_site_vector(const mfree::Approximant &ap, const std::vector<T> &v, T *dst) {
+void copy_site_vector(const mfree::Approximant &ap, const mfree::HVec<T> &v, T *dst) {
   if (!ap.is_setup()) throw mfree::Error(MFREE_ERR_STATE, "the approximant is not set up");
   if (!dst && !v.empty()) throw mfree::Error(MFREE_ERR_NULL, "output pointer is NULL");
   std::copy(v.begin(), v.end(), dst);

@@ -91,4 +91,16 @@ mfree_status_t mfree_context_get_num_threads(const mfree_context_t *ctx, int32_t
   return MFREE_SUCCESS;
 }
 
+mfree_status_t mfree_context_set_allocator(mfree_context_t *ctx, mfree_alloc_fn alloc,
+                                           mfree_free_fn release, void *user) {
+  if (!ctx) return MFREE_ERR_NULL;
+  if ((alloc == nullptr) != (release == nullptr))
+    return mfree::record(ctx, MFREE_ERR_ARG, "mfree_context_set_allocator",
+                         "give both an allocation and a free function, or neither");
+  ctx->alloc.alloc = alloc;
+  ctx->alloc.release = release;
+  ctx->alloc.user = alloc ? user : nullptr;
+  return MFREE_SUCCESS;
+}
+
 }  // extern "C"

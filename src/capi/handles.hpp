@@ -6,9 +6,11 @@
 #include <new>
 #include <string>
 
+#include "core/alloc.hpp"
 #include "core/approximant.hpp"
 #include "core/assembler.hpp"
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "core/matrix.hpp"
 #include "core/particles.hpp"
 #include "mfree.h"
@@ -20,6 +22,7 @@ struct mfree_context {
   mfree_error_handler_t handler = nullptr;
   void *handler_user = nullptr;
   int32_t nthreads = 1;
+  mfree::AllocHook alloc;  // empty: malloc
 };
 
 struct mfree_particles {
@@ -79,6 +82,9 @@ mfree_status_t record(mfree_context_t *ctx, mfree_status_t status, const char *f
 // Run body() and turn every exception into a status and a message on ctx.
 template <class Body>
 mfree_status_t guard(mfree_context_t *ctx, const char *fn, Body &&body) noexcept {
+  // the context's allocator and thread count hold for everything the call runs
+  const AllocScope alloc_scope(ctx ? &ctx->alloc : nullptr);
+  const ThreadScope thread_scope(ctx ? ctx->nthreads : 1);
   try {
     return body();
   } catch (const Error &e) {

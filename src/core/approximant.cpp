@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "basis.hpp"
+#include "parallel.hpp"
 
 namespace mfree {
 
@@ -280,6 +281,7 @@ Report Approximant::compute(const char *what) {
   const size_t nnz = cols_.size();
   const bool fv = flags_ & MFREE_DERIV_VALUE, fg = flags_ & MFREE_DERIV_GRADIENT,
              fh = flags_ & MFREE_DERIV_HESSIAN;
+  // same sizes on update: assign reuses the storage, nothing is allocated
   val_.assign(fv ? nnz : 0, 0.0);
   grad_.assign(fg ? nnz * dim : 0, 0.0);
   hess_.assign(fh ? nnz * nh : 0, 0.0);
@@ -288,83 +290,99 @@ Report Approximant::compute(const char *what) {
   order_used_.assign(nsites_, -1);
   const bool have_vol = ps_->has_volumes();
 
-  LocalConfig cfg;
-  cfg.method = method_;
-  cfg.dim = dim;
-  cfg.order = order_;
-  cfg.want_value = fv;
-  cfg.want_grad = fg;
-  cfg.want_hess = fh;
-  cfg.kernel = kernel_.get();
+  LocalConfig base;
+  base.method = method_;
+  base.dim = dim;
+  base.order = order_;
+  base.want_value = fv;
+  base.want_grad = fg;
+  base.want_hess = fh;
+  base.kernel = kernel_.get();
+
+  // Per-thread scratch sized for the longest row before the threads start, so that no
+  // site allocates; sites are split statically and are independent, so the tables do
+  // not depend on the thread count.
+  const int nt = num_threads(nsites_);
+  if (scratch_.size() < static_cast<size_t>(nt)) scratch_.resize(nt);
+  int maxrow = 0;
+  for (int32_t s = 0; s < nsites_; ++s) maxrow = std::max<int>(maxrow, static_cast<int>(rowptr_[s + 1] - rowptr_[s]));
+  const int maxL = basis_size(dim, std::max(has_order(method_) ? order_ : 1, 1));
+  for (int t = 0; t < nt; ++t) {
+    SiteScratch &w = scratch_[t];
+    const size_t need = static_cast<size_t>(maxrow);
+    if (w.d.size() < 3 * need) w.d.resize(3 * need);
+    if (w.v.size() < need) w.v.resize(need);
+    if (w.h.size() < need) w.h.resize(need);
+    w.work.reserve(maxrow, dim, maxL);
+  }
+  const auto &pst = ps_->site_status();
+  parallel_blocks(nsites_, nt, [&](int t, int64_t b, int64_t e) {
+    SiteScratch &w = scratch_[t];
+    LocalConfig cfg = base;
+    for (int32_t s = static_cast<int32_t>(b); s < e; ++s) {
+      const int32_t me = site_particle(s);
+      if (me >= 0 && pst[me] != 0) {
+        status_[s] = pst[me];
+        continue;
+      }
+      const int64_t k0 = rowptr_[s];
+      const int n = static_cast<int>(rowptr_[s + 1] - k0);
+      for (int q = 0; q < n; ++q) {
+        const int32_t j = cols_[k0 + q];
+        double *d = &w.d[3 * static_cast<size_t>(q)];
+        d[0] = d[1] = d[2] = 0.0;
+        site_displacement(s, j, d);
+        w.v[q] = have_vol ? ps_->volume(j) : 1.0;
+        w.h[q] = pair_h(s, j);
+      }
+      LocalInput in;
+      in.n = n;
+      in.self = self_[s];
+      in.hs = site_h(s);
+      in.d = w.d.data();
+      in.vol = w.v.data();
+      in.h = w.h.data();
+      LocalOutput out;
+      out.phi = fv ? &val_[k0] : nullptr;
+      out.grad = fg ? &grad_[k0 * dim] : nullptr;
+      out.hess = fh ? &hess_[k0 * nh] : nullptr;
+      cfg.method = method_;
+      cfg.order = order_;
+      compute_site(cfg, in, w.work, out);
+      if (out.status && fallback_ == MFREE_FALLBACK_LOWER_ORDER) {
+        const int first_status = out.status;
+        const double first_cond = out.cond;
+        if (has_order(method_))
+          for (int o = order_ - 1; o >= min_order(method_) && out.status; --o) {
+            cfg.order = o;
+            if (fh && !provides_hessian(method_, o)) break;
+            compute_site(cfg, in, w.work, out);
+          }
+        if (out.status) {  // last resort: Shepard functions (constant complete)
+          cfg.method = MFREE_METHOD_SHEPARD;
+          cfg.order = 0;
+          compute_site(cfg, in, w.work, out);
+        }
+        if (out.status) {
+          out.status = first_status;
+          out.cond = first_cond;
+        }
+      }
+      status_[s] = out.status;
+      support_[s] = out.support;
+      cond_[s] = out.cond;
+      order_used_[s] = out.order_used;
+    }
+  });
 
   Report rep;
   int64_t nfailed = 0;
   int32_t first_bad = -1;
-  for (int32_t s = 0; s < nsites_; ++s) {
-    const int32_t me = site_particle(s);
-    if (me >= 0 && ps_->site_status()[me] != 0) {
-      status_[s] = ps_->site_status()[me];
-      ++nfailed;
-      if (first_bad < 0) first_bad = s;
-      continue;
-    }
-    const int64_t k0 = rowptr_[s];
-    const int n = static_cast<int>(rowptr_[s + 1] - k0);
-    if (dbuf_.size() < 3 * static_cast<size_t>(n)) {
-      dbuf_.resize(3 * static_cast<size_t>(n));
-      vbuf_.resize(n);
-      hbuf_.resize(n);
-    }
-    for (int q = 0; q < n; ++q) {
-      const int32_t j = cols_[k0 + q];
-      double *d = &dbuf_[3 * static_cast<size_t>(q)];
-      d[0] = d[1] = d[2] = 0.0;
-      site_displacement(s, j, d);
-      vbuf_[q] = have_vol ? ps_->volume(j) : 1.0;
-      hbuf_[q] = pair_h(s, j);
-    }
-    LocalInput in;
-    in.n = n;
-    in.self = self_[s];
-    in.hs = site_h(s);
-    in.d = dbuf_.data();
-    in.vol = vbuf_.data();
-    in.h = hbuf_.data();
-    LocalOutput out;
-    out.phi = fv ? &val_[k0] : nullptr;
-    out.grad = fg ? &grad_[k0 * dim] : nullptr;
-    out.hess = fh ? &hess_[k0 * nh] : nullptr;
-    cfg.method = method_;
-    cfg.order = order_;
-    compute_site(cfg, in, work_, out);
-    if (out.status && fallback_ == MFREE_FALLBACK_LOWER_ORDER) {
-      const int first_status = out.status;
-      const double first_cond = out.cond;
-      if (has_order(method_))
-        for (int o = order_ - 1; o >= min_order(method_) && out.status; --o) {
-          cfg.order = o;
-          if (fh && !provides_hessian(method_, o)) break;
-          compute_site(cfg, in, work_, out);
-        }
-      if (out.status) {  // last resort: Shepard functions (constant complete)
-        cfg.method = MFREE_METHOD_SHEPARD;
-        cfg.order = 0;
-        compute_site(cfg, in, work_, out);
-      }
-      if (out.status) {
-        out.status = first_status;
-        out.cond = first_cond;
-      }
-    }
-    status_[s] = out.status;
-    support_[s] = out.support;
-    cond_[s] = out.cond;
-    order_used_[s] = out.order_used;
-    if (out.status) {
+  for (int32_t s = 0; s < nsites_; ++s)
+    if (status_[s]) {
       ++nfailed;
       if (first_bad < 0) first_bad = s;
     }
-  }
   if (nfailed) {
     const int32_t s = first_bad;
     std::ostringstream msg;
@@ -416,54 +434,112 @@ int Approximant::op_components(int op, int ncomp) const {
   }
 }
 
+namespace {
+
+// Up to kBlock outputs of one site are accumulated together in one pass over its row;
+// each output is still the sum over the row in row order, as a one-output loop would
+// give, so the result does not depend on the blocking or on the thread count.
+constexpr int kBlock = 24;
+
+// out rows [b, e) of the gradient of ncomp fields (D compile-time: the inner loops
+// unroll).
+template <int D>
+void gradient_rows(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
+                   int ncomp, const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co,
+                   bool add) {
+  for (int64_t s = b; s < e; ++s) {
+    for (int c0 = 0; c0 < ncomp; c0 += kBlock / D) {
+      const int nc = std::min(kBlock / D, ncomp - c0);
+      double acc[kBlock] = {0};
+      for (int64_t k = rowptr[s]; k < rowptr[s + 1]; ++k) {
+        const double *g = grad + k * D;
+        const double *uj = u + cols[k] * ju + c0 * cu;
+        for (int c = 0; c < nc; ++c) {
+          const double v = uj[c * cu];
+          for (int d = 0; d < D; ++d) acc[c * D + d] += g[d] * v;
+        }
+      }
+      double *o = out + s * so + static_cast<int64_t>(c0) * D * co;
+      for (int q = 0; q < nc * D; ++q) {
+        if (add) o[q * co] += acc[q];
+        else o[q * co] = acc[q];
+      }
+    }
+  }
+}
+
+}  // namespace
+
 void Approximant::apply(int op, int ncomp, const double *u, int ulayout, int64_t uld, double *out,
                         int olayout, int64_t old, bool add) const {
   const int dim = ps_->dim(), nh = hessian_size(dim);
   const int ocomp = op_components(op, ncomp);
-  auto U = [&](int32_t j, int c) { return ulayout == MFREE_LAYOUT_AOS ? u[j * uld + c] : u[c * uld + j]; };
-  auto O = [&](int32_t s, int c) -> double & {
-    return olayout == MFREE_LAYOUT_AOS ? out[s * old + c] : out[c * old + s];
-  };
-  for (int32_t s = 0; s < nsites_; ++s) {
-    const int64_t k0 = rowptr_[s], k1 = rowptr_[s + 1];
-    for (int oc = 0; oc < ocomp; ++oc) {
-      double acc = 0.0;
-      switch (op) {
-        case MFREE_OP_VALUE:
-          for (int64_t k = k0; k < k1; ++k) acc += val_[k] * U(cols_[k], oc);
-          break;
-        case MFREE_OP_GRADIENT: {
-          const int c = oc / dim, d = oc % dim;
-          for (int64_t k = k0; k < k1; ++k) acc += grad_[k * dim + d] * U(cols_[k], c);
-          break;
+  // strides of a site / particle index and of a component in the two layouts
+  const int64_t ju = ulayout == MFREE_LAYOUT_AOS ? uld : 1, cu = ulayout == MFREE_LAYOUT_AOS ? 1 : uld;
+  const int64_t so = olayout == MFREE_LAYOUT_AOS ? old : 1, co = olayout == MFREE_LAYOUT_AOS ? 1 : old;
+  const int64_t *rp = rowptr_.data();
+  const int32_t *cl = cols_.data();
+  const int nt = num_threads(static_cast<int64_t>(cols_.size()) / 8);
+  parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
+    if (op == MFREE_OP_GRADIENT) {
+      if (dim == 1) gradient_rows<1>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
+      else if (dim == 2) gradient_rows<2>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
+      else gradient_rows<3>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
+      return;
+    }
+    double acc[kBlock];
+    for (int64_t s = b; s < e; ++s) {
+      const int64_t k0 = rp[s], k1 = rp[s + 1];
+      for (int oc0 = 0; oc0 < ocomp; oc0 += kBlock) {
+        const int nb = std::min(kBlock, ocomp - oc0);
+        for (int q = 0; q < nb; ++q) acc[q] = 0.0;
+        switch (op) {
+          case MFREE_OP_VALUE:
+            for (int64_t k = k0; k < k1; ++k) {
+              const double v = val_[k], *uj = u + cl[k] * ju;
+              for (int q = 0; q < nb; ++q) acc[q] += v * uj[(oc0 + q) * cu];
+            }
+            break;
+          case MFREE_OP_DIVERGENCE:
+            for (int64_t k = k0; k < k1; ++k) {
+              const double *uj = u + cl[k] * ju;
+              for (int d = 0; d < dim; ++d) acc[0] += grad_[k * dim + d] * uj[d * cu];
+            }
+            break;
+          case MFREE_OP_LAPLACIAN:
+            for (int64_t k = k0; k < k1; ++k) {
+              double tr = 0.0;
+              for (int d = 0; d < dim; ++d) tr += hess_[k * nh + hessian_index(dim, d, d)];
+              const double *uj = u + cl[k] * ju;
+              for (int q = 0; q < nb; ++q) acc[q] += tr * uj[(oc0 + q) * cu];
+            }
+            break;
+          case MFREE_OP_HESSIAN:
+            for (int64_t k = k0; k < k1; ++k) {
+              const double *H = &hess_[k * nh], *uj = u + cl[k] * ju;
+              for (int q = 0; q < nb; ++q) {
+                const int oc = oc0 + q;
+                acc[q] += H[oc % nh] * uj[(oc / nh) * cu];
+              }
+            }
+            break;
+          default:
+            break;
         }
-        case MFREE_OP_DIVERGENCE:
-          for (int64_t k = k0; k < k1; ++k)
-            for (int d = 0; d < dim; ++d) acc += grad_[k * dim + d] * U(cols_[k], d);
-          break;
-        case MFREE_OP_LAPLACIAN:
-          for (int64_t k = k0; k < k1; ++k) {
-            double tr = 0.0;
-            for (int d = 0; d < dim; ++d) tr += hess_[k * nh + hessian_index(dim, d, d)];
-            acc += tr * U(cols_[k], oc);
-          }
-          break;
-        case MFREE_OP_HESSIAN: {
-          const int c = oc / nh, e = oc % nh;
-          for (int64_t k = k0; k < k1; ++k) acc += hess_[k * nh + e] * U(cols_[k], c);
-          break;
+        for (int q = 0; q < nb; ++q) {
+          double &o = out[s * so + (oc0 + q) * co];
+          if (add) o += acc[q];
+          else o = acc[q];
         }
       }
-      if (add) O(s, oc) += acc;
-      else O(s, oc) = acc;
     }
-  }
+  });
 }
 
 void Approximant::export_csr(int deriv, int component, int64_t *rowptr, int32_t *cols,
                              double *vals) const {
   const int dim = ps_->dim(), nh = hessian_size(dim);
-  const std::vector<double> *tab = nullptr;
+  const HVec<double> *tab = nullptr;
   int stride = 1;
   if (deriv == MFREE_DERIV_VALUE) {
     tab = &val_;

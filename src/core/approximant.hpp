@@ -31,11 +31,11 @@ class Approximant {
   Approximant(const ParticleSet *ps, const ApproxConfig &cfg);
   ApproxConfig config() const;
   const ParticleSet &particles() const { return *ps_; }
-  const std::vector<int64_t> &rowptr() const { return rowptr_; }
-  const std::vector<int32_t> &cols() const { return cols_; }
-  const std::vector<double> &values() const { return val_; }
-  const std::vector<double> &gradients() const { return grad_; }
-  const std::vector<double> &hessians() const { return hess_; }
+  const HVec<int64_t> &rowptr() const { return rowptr_; }
+  const HVec<int32_t> &cols() const { return cols_; }
+  const HVec<double> &values() const { return val_; }
+  const HVec<double> &gradients() const { return grad_; }
+  const HVec<double> &hessians() const { return hess_; }
 
   void set_kernel(int kernel, double param);
   void set_order(int order);
@@ -65,10 +65,10 @@ class Approximant {
   void export_csr(int deriv, int component, int64_t *rowptr, int32_t *cols, double *vals) const;
   void check_reproduction(int order, double &fn_err, double &deriv_err) const;
 
-  const std::vector<int32_t> &site_status() const { return status_; }
-  const std::vector<int32_t> &site_support() const { return support_; }
-  const std::vector<double> &site_cond() const { return cond_; }
-  const std::vector<int32_t> &site_order() const { return order_used_; }
+  const HVec<int32_t> &site_status() const { return status_; }
+  const HVec<int32_t> &site_support() const { return support_; }
+  const HVec<double> &site_cond() const { return cond_; }
+  const HVec<int32_t> &site_order() const { return order_used_; }
 
  private:
   void validate_config() const;
@@ -98,14 +98,20 @@ class Approximant {
 
   bool setup_done_ = false;
   int32_t nsites_ = 0;
-  std::vector<int64_t> rowptr_{0};
-  std::vector<int32_t> cols_;
-  std::vector<int32_t> self_;  // position of the site itself in its row, or -1
-  std::vector<double> val_, grad_, hess_;
-  std::vector<int32_t> status_, support_, order_used_;
-  std::vector<double> cond_;
-  std::vector<double> dbuf_, vbuf_, hbuf_;  // per-row scratch, reused
-  LocalWork work_;
+  // tables and per-site data come from the context's allocator hook (alloc.hpp)
+  HVec<int64_t> rowptr_ = HVec<int64_t>(1, 0);
+  HVec<int32_t> cols_;
+  HVec<int32_t> self_;  // position of the site itself in its row, or -1
+  HVec<double> val_, grad_, hess_;
+  HVec<int32_t> status_, support_, order_used_;
+  HVec<double> cond_;
+  // per-thread row scratch (displacements, volumes, pair supports) and local work,
+  // reused by every update
+  struct SiteScratch {
+    HVec<double> d, v, h;
+    LocalWork work;
+  };
+  HVec<SiteScratch> scratch_;
 };
 
 // Neighbours among the particles of ps for each host point (site support hp, the set's

@@ -129,8 +129,10 @@ double pivot_ratio(const V &piv) {
   const double big = piv.cwiseAbs().maxCoeff(), small = piv.cwiseAbs().minCoeff();
   return big > 0.0 ? small / big : 0.0;
 }
-double pivots(const Eigen::LDLT<Mat> &f) { return pivot_ratio(f.vectorD()); }
-double pivots(const Eigen::PartialPivLU<Mat> &f) { return pivot_ratio(f.matrixLU().diagonal()); }
+template <class M>
+double pivots(const Eigen::LDLT<M> &f) { return pivot_ratio(f.vectorD()); }
+template <class M>
+double pivots(const Eigen::PartialPivLU<M> &f) { return pivot_ratio(f.matrixLU().diagonal()); }
 
 // Eigen's rcond() estimate is blind to an exactly zero pivot (it reports 1 for
 // [[1,0],[0,0]]), so the smaller of it and the pivot ratio decides.
@@ -146,71 +148,83 @@ bool check_rcond(Site &s, const Solver &solver) {
 // Moving least squares (MLS, weights w) and RKPM (weights w V), order k, with true
 // derivatives: Phi_j = omega_j gamma . p_j, M gamma = p(0), differentiated with the
 // shift point frozen at the site (spec 000 section 4.3).
-int mls(Site &s, int order, bool rkpm) {
-  const Basis B(s.dim, order);
-  const int L = B.size(), dim = s.dim, n = s.n;
-  if (s.out.support < L) return MFREE_FAIL_NEIGHBORS;
+//
+// L (basis size) is a template parameter, so that the moment matrices are fixed-size
+// and live in registers and on the stack; M and its first derivatives M_,i (symmetric,
+// like M) are accumulated in one pass over the neighbours from the lower triangle of
+// p p^T, computed once per neighbour.
+template <int L>
+int mls_fixed(Site &s, const Basis &B, bool rkpm) {
+  using MatL = Eigen::Matrix<double, L, L>;
+  using VecL = Eigen::Matrix<double, L, 1>;
+  const int dim = s.dim, n = s.n;
   const double ih = 1.0 / s.in.hs;
+  const bool deriv = s.cfg.want_grad || s.cfg.want_hess;
   double *P = s.w.p.data();
-  for (int j = 0; j < n; ++j) {
-    double sj[3] = {0, 0, 0};
-    for (int c = 0; c < dim; ++c) sj[c] = s.d(j)[c] * ih;
-    B.eval(sj, P + j * L);
-  }
   auto omega = [&](int j) { return rkpm ? s.w.w[j] * s.in.vol[j] : s.w.w[j]; };
   auto domega = [&](int j, int c) { return rkpm ? s.gw(j)[c] * s.in.vol[j] : s.gw(j)[c]; };
   auto ddomega = [&](int j, int e) { return rkpm ? s.hw(j)[e] * s.in.vol[j] : s.hw(j)[e]; };
 
-  Mat M = Mat::Zero(L, L);
+  MatL M = MatL::Zero(), Mi[3] = {MatL::Zero(), MatL::Zero(), MatL::Zero()};
   for (int j = 0; j < n; ++j) {
+    double sj[3] = {0, 0, 0};
+    for (int c = 0; c < dim; ++c) sj[c] = s.d(j)[c] * ih;
+    double *p = P + j * L;
+    B.eval(sj, p);
     const double o = omega(j);
-    if (o == 0.0) continue;
-    const double *p = P + j * L;
+    double od[3] = {0, 0, 0};
+    bool any = o != 0.0;
+    if (deriv)
+      for (int c = 0; c < dim; ++c) {
+        od[c] = domega(j, c);
+        any = any || od[c] != 0.0;
+      }
+    if (!any) continue;
     for (int a = 0; a < L; ++a)
-      for (int b = 0; b <= a; ++b) M(a, b) += o * p[a] * p[b];
+      for (int b = 0; b <= a; ++b) {
+        const double t = p[a] * p[b];
+        M(a, b) += o * t;
+        if (deriv)
+          for (int c = 0; c < dim; ++c) Mi[c](a, b) += od[c] * t;
+      }
   }
-  M.triangularView<Eigen::StrictlyUpper>() = M.transpose().triangularView<Eigen::StrictlyUpper>();
-  Eigen::LDLT<Mat> ldlt(M);
+  M.template triangularView<Eigen::StrictlyUpper>() = M.transpose();
+  Eigen::LDLT<MatL> ldlt(M);
   if (ldlt.info() != Eigen::Success || !check_rcond(s, ldlt)) return MFREE_FAIL_SINGULAR;
 
-  Vec e = Vec::Zero(L);
+  VecL e = VecL::Zero();
   e(0) = 1.0;
-  const Vec g = ldlt.solve(e);
-  auto dot = [&](const Vec &v, int j) {
-    double t = 0.0;
+  const VecL g = ldlt.solve(e);
+  auto dot = [&](const VecL &v, int j) {
     const double *p = P + j * L;
+    double t = 0.0;
     for (int a = 0; a < L; ++a) t += v(a) * p[a];
     return t;
   };
-  if (s.cfg.want_value)
-    for (int j = 0; j < n; ++j) s.out.phi[j] = omega(j) * dot(g, j);
-  if (!s.cfg.want_grad && !s.cfg.want_hess) return 0;
-
-  Mat Mi[3];
-  Vec gi[3];
+  if (!deriv) {
+    if (s.cfg.want_value)
+      for (int j = 0; j < n; ++j) s.out.phi[j] = omega(j) * dot(g, j);
+    return 0;
+  }
+  VecL gi[3];
   for (int i = 0; i < dim; ++i) {
-    Mi[i] = Mat::Zero(L, L);
-    for (int j = 0; j < n; ++j) {
-      const double o = domega(j, i);
-      if (o == 0.0) continue;
-      const double *p = P + j * L;
-      for (int a = 0; a < L; ++a)
-        for (int b = 0; b < L; ++b) Mi[i](a, b) += o * p[a] * p[b];
-    }
-    Vec rhs = -(Mi[i] * g);
-    if (B.linear(i) >= 0) rhs(B.linear(i)) += ih;
+    Mi[i].template triangularView<Eigen::StrictlyUpper>() = Mi[i].transpose();
+    VecL rhs = -(Mi[i] * g);
+    const int li = B.linear(i);
+    if (li >= 0 && li < L) rhs(li) += ih;
     gi[i] = ldlt.solve(rhs);
   }
-  if (s.cfg.want_grad)
-    for (int j = 0; j < n; ++j) {
-      const double gp = dot(g, j);
-      for (int i = 0; i < dim; ++i) s.out.grad[j * dim + i] = omega(j) * dot(gi[i], j) + domega(j, i) * gp;
-    }
+  for (int j = 0; j < n; ++j) {
+    const double gp = dot(g, j), o = omega(j);
+    if (s.cfg.want_value) s.out.phi[j] = o * gp;
+    if (s.cfg.want_grad)
+      for (int i = 0; i < dim; ++i) s.out.grad[j * dim + i] = o * dot(gi[i], j) + domega(j, i) * gp;
+  }
   if (!s.cfg.want_hess) return 0;
   for (int i = 0; i < dim; ++i)
     for (int k = i; k < dim; ++k) {
       const int e2 = hessian_index(dim, i, k);
-      Mat Mik = Mat::Zero(L, L);
+      MatL Mik = MatL::Zero();
       for (int j = 0; j < n; ++j) {
         const double o = ddomega(j, e2);
         if (o == 0.0) continue;
@@ -218,15 +232,30 @@ int mls(Site &s, int order, bool rkpm) {
         for (int a = 0; a < L; ++a)
           for (int b = 0; b < L; ++b) Mik(a, b) += o * p[a] * p[b];
       }
-      Vec rhs = -(Mi[i] * gi[k]) - Mi[k] * gi[i] - Mik * g;
+      VecL rhs = -(Mi[i] * gi[k]) - Mi[k] * gi[i] - Mik * g;
       const int qd = B.quadratic(i, k);
-      if (qd >= 0) rhs(qd) += (i == k ? 2.0 : 1.0) * ih * ih;
-      const Vec gik = ldlt.solve(rhs);
+      if (qd >= 0 && qd < L) rhs(qd) += (i == k ? 2.0 : 1.0) * ih * ih;
+      const VecL gik = ldlt.solve(rhs);
       for (int j = 0; j < n; ++j)
         s.out.hess[j * s.nh + e2] = omega(j) * dot(gik, j) + domega(j, k) * dot(gi[i], j) +
                                     domega(j, i) * dot(gi[k], j) + ddomega(j, e2) * dot(g, j);
     }
   return 0;
+}
+
+int mls(Site &s, int order, bool rkpm) {
+  const Basis B(s.dim, order);
+  if (s.out.support < B.size()) return MFREE_FAIL_NEIGHBORS;
+  switch (B.size()) {  // basis_size(dim, order) for dim 1..3, order 0..3
+    case 1: return mls_fixed<1>(s, B, rkpm);
+    case 2: return mls_fixed<2>(s, B, rkpm);
+    case 3: return mls_fixed<3>(s, B, rkpm);
+    case 4: return mls_fixed<4>(s, B, rkpm);
+    case 6: return mls_fixed<6>(s, B, rkpm);
+    case 10: return mls_fixed<10>(s, B, rkpm);
+    case 20: return mls_fixed<20>(s, B, rkpm);
+    default: return MFREE_FAIL_SINGULAR;
+  }
 }
 
 // Methods that estimate Taylor coefficients Q_alpha (SSPH, KB Method 2, MSPH) read the

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "alloc.hpp"
 #include "basis.hpp"
 #include "kernel.hpp"
 #include "mfree.h"
@@ -42,7 +43,7 @@ struct LocalOutput {
 
 // Scratch space reused between sites (no allocation once large enough).
 struct LocalWork {
-  std::vector<double> r, w, gw, hw, p, q, sh;
+  HVec<double> r, w, gw, hw, p, q, sh;
   void reserve(int n, int dim, int L);
 };
 

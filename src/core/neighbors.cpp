@@ -1,49 +1,79 @@
 // Cell-list neighbour search with variable support, three conventions, periodic axes.
 //
-// Cells have edge c >= the mean search radius; a query with radius R scans the cells
+// Cells have edge >= half the mean search radius; a query with radius R scans the cells
 // within R (gather: kappa h_i; symmetric-max: kappa max_j h_j, filtered by
 // max(h_i, h_j); symmetric-mean: kappa (h_i + max h)/2, filtered by the mean), so
-// uniform supports cost a 3^dim stencil and strongly variable ones stay correct. The
+// uniform supports cost a 5^dim stencil and strongly variable ones stay correct. The
 // same grid answers queries from the particles themselves and from host points.
+//
+// Speed: the particles are counting-sorted by cell (row-major cell order, x fastest) and
+// their coordinates and radii copied in that order (SoA), so that the cells of one
+// stencil row are one contiguous range scanned by a branch-light loop. Queries run in
+// cell order too (neighbouring queries share cache lines), in static blocks over the
+// context's threads, each into its own buffer; the rows are then placed by host index.
+// The permutation never leaves this file: rows hold host indices, sorted ascending.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "approximant.hpp"
 #include "kernel.hpp"
+#include "parallel.hpp"
 #include "particles.hpp"
 
 namespace mfree {
 
 namespace {
 
+// Query radius and pair limit of a site with search radius ri under the convention.
+struct Rule {
+  int conv;
+  double rmax;
+  double query(double ri) const {
+    return conv == MFREE_SEARCH_GATHER ? ri : conv == MFREE_SEARCH_SYMMETRIC_MAX ? rmax : 0.5 * (ri + rmax);
+  }
+  double limit(double ri, double rj) const {
+    return conv == MFREE_SEARCH_GATHER ? ri : conv == MFREE_SEARCH_SYMMETRIC_MAX ? std::max(ri, rj) : 0.5 * (ri + rj);
+  }
+};
+
 class CellGrid {
  public:
   CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status);
 
-  bool empty() const { return valid_.empty(); }
+  bool empty() const { return nvalid_ == 0; }
   double rmax() const { return rmax_; }
   double radius(int32_t j) const { return rad_[j]; }
+  int64_t num_cells() const { return static_cast<int64_t>(start_.size()) - 1; }
 
   // Wrap a coordinate into the periodic box along periodic axes.
   double wrap(double x, int c) const {
     if (!periodic_[c]) return x;
     return x - L_[c] * std::floor((x - lo_[c]) / L_[c]);
   }
+  int64_t cell_of(const double *x) const {
+    int64_t k[3] = {0, 0, 0};
+    for (int c = 0; c < dim_; ++c) k[c] = coord(x[c], c);
+    return index(k);
+  }
+  // Host indices of the valid particles in cell order.
+  const std::vector<int32_t> &members() const { return id_; }
 
-  // Append to row every valid particle j with squared distance to xq (wrapped) below
-  // lim(j)^2 among those within R of xq.
-  template <class Limit>
-  void query(const double *xq, double R, Limit &&lim, std::vector<int32_t> &row) const;
+  // Write to row[cnt...] every valid particle j with squared distance to xq (wrapped)
+  // within the rule's limit for a site of radius ri, growing row as needed; cnt is
+  // advanced past them (row may hold junk beyond cnt).
+  void query(const double *xq, double ri, const Rule &rule, std::vector<int32_t> &row, size_t &cnt) const;
 
  private:
   int64_t coord(double x, int c) const {
-    int64_t k = static_cast<int64_t>(std::floor((x - lo_[c]) / cell_[c]));
+    const double f = std::floor((x - lo_[c]) / cell_[c]);
+    int64_t k;
     if (periodic_[c]) {
-      k %= nc_[c];
+      k = static_cast<int64_t>(f) % nc_[c];
       if (k < 0) k += nc_[c];
     } else {
-      k = std::min<int64_t>(std::max<int64_t>(k, 0), nc_[c] - 1);
+      // clamp in double first: far-away host points must not overflow the cast
+      k = f <= 0.0 ? 0 : (f >= static_cast<double>(nc_[c] - 1) ? nc_[c] - 1 : static_cast<int64_t>(f));
     }
     return k;
   }
@@ -52,15 +82,34 @@ class CellGrid {
     for (int c = dim_ - 1; c >= 0; --c) id = id * nc_[c] + k[c];
     return id;
   }
+  void scan_range(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
+                  std::vector<int32_t> &row, size_t &cnt) const {
+    const bool g = rule.conv == MFREE_SEARCH_GATHER;
+    switch (dim_ * 4 + (any_periodic_ ? 2 : 0) + (g ? 1 : 0)) {
+#define MFREE_SCAN(D, P, G) \
+  case D * 4 + (P ? 2 : 0) + (G ? 1 : 0): scan<D, P, G>(xq, ri, rule, p0, p1, row, cnt); break;
+      MFREE_SCAN(1, false, false) MFREE_SCAN(1, false, true) MFREE_SCAN(1, true, false) MFREE_SCAN(1, true, true)
+      MFREE_SCAN(2, false, false) MFREE_SCAN(2, false, true) MFREE_SCAN(2, true, false) MFREE_SCAN(2, true, true)
+      MFREE_SCAN(3, false, false) MFREE_SCAN(3, false, true) MFREE_SCAN(3, true, false) MFREE_SCAN(3, true, true)
+#undef MFREE_SCAN
+      default: break;
+    }
+  }
+  template <int D, bool Periodic, bool Gather>
+  void scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
+            std::vector<int32_t> &row, size_t &cnt) const;
 
   int dim_;
   double lo_[3] = {0, 0, 0}, cell_[3] = {1, 1, 1}, L_[3] = {0, 0, 0};
   int64_t nc_[3] = {1, 1, 1};
   bool periodic_[3] = {false, false, false};
+  bool any_periodic_ = false;
   double rmax_ = 0.0;
-  std::vector<double> xs_, rad_;
-  std::vector<int32_t> valid_, members_;
-  std::vector<int64_t> start_;
+  int32_t nvalid_ = 0;
+  std::vector<double> rad_;                 // by host index
+  std::vector<double> sx_[3], srad_;        // by cell order
+  std::vector<int32_t> id_;                 // host index by cell order
+  std::vector<int64_t> start_;              // cell c holds [start_[c], start_[c+1])
 };
 
 CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : dim_(ps.dim()) {
@@ -68,14 +117,13 @@ CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : 
   const double kappa = ps.kappa();
   for (int c = 0; c < dim_; ++c) {
     periodic_[c] = ps.periodic(c);
+    any_periodic_ = any_periodic_ || periodic_[c];
     if (periodic_[c]) {
       lo_[c] = ps.box_lo(c);
       L_[c] = ps.box_hi(c) - ps.box_lo(c);
     }
   }
-  xs_.assign(static_cast<size_t>(n) * 3, 0.0);
   rad_.assign(n, 0.0);
-  valid_.reserve(n);
   double rsum = 0.0, bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};
   for (int32_t i = 0; i < n; ++i) {
     if (status[i] != 0) continue;
@@ -84,13 +132,12 @@ CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : 
     rsum += rad_[i];
     for (int c = 0; c < dim_; ++c) {
       const double x = wrap(ps.x(i, c), c);
-      xs_[static_cast<size_t>(i) * 3 + c] = x;
-      if (valid_.empty() || x < bmin[c]) bmin[c] = x;
-      if (valid_.empty() || x > bmax[c]) bmax[c] = x;
+      if (nvalid_ == 0 || x < bmin[c]) bmin[c] = x;
+      if (nvalid_ == 0 || x > bmax[c]) bmax[c] = x;
     }
-    valid_.push_back(i);
+    ++nvalid_;
   }
-  if (valid_.empty()) return;
+  if (nvalid_ == 0) return;
 
   for (int c = 0; c < dim_; ++c)
     if (periodic_[c] && 2.0 * rmax_ >= L_[c]) {
@@ -100,13 +147,13 @@ CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : 
       throw Error(MFREE_ERR_INPUT, s.str());
     }
 
-  // Cell edge: the mean radius, enlarged so that the grid has at most ~4 cells per
+  // Cell edge: half the mean radius, enlarged so that the grid has at most ~2 cells per
   // particle (clustered or far-flung particles would otherwise make it huge). Enlarge
   // until the grid fits (one particle at 1e15 needs more than 64 steps); an extent whose
   // cell count is not a finite double gets one cell, which is always correct because
   // coordinates are clamped into the grid, and never reaches an out-of-range cast.
-  double edge = rsum / static_cast<double>(valid_.size());
-  const double max_cells = 4.0 * static_cast<double>(valid_.size()) + 64.0;
+  double edge = 0.5 * rsum / static_cast<double>(nvalid_);
+  const double max_cells = 2.0 * static_cast<double>(nvalid_) + 64.0;
   auto span = [&edge](double ext) {
     const double k = std::floor(ext / edge);
     return std::isfinite(k) ? k : 0.0;
@@ -134,115 +181,218 @@ CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : 
   for (int c = 0; c < dim_; ++c) ncells *= nc_[c];
 
   // Counting sort of the valid particles by cell (stable: ascending index in a cell).
-  std::vector<int64_t> cell_of(n, -1);
+  std::vector<int64_t> cell(n, -1);
   start_.assign(static_cast<size_t>(ncells) + 1, 0);
-  for (int32_t i : valid_) {
-    int64_t k[3] = {0, 0, 0};
-    for (int c = 0; c < dim_; ++c) k[c] = coord(xs_[static_cast<size_t>(i) * 3 + c], c);
-    cell_of[i] = index(k);
-    ++start_[cell_of[i] + 1];
+  for (int32_t i = 0; i < n; ++i) {
+    if (status[i] != 0) continue;
+    double x[3] = {0, 0, 0};
+    for (int c = 0; c < dim_; ++c) x[c] = wrap(ps.x(i, c), c);
+    cell[i] = cell_of(x);
+    ++start_[cell[i] + 1];
   }
   for (int64_t c = 0; c < ncells; ++c) start_[c + 1] += start_[c];
-  members_.resize(valid_.size());
+  id_.resize(nvalid_);
+  srad_.resize(nvalid_);
+  for (int c = 0; c < dim_; ++c) sx_[c].resize(nvalid_);
   std::vector<int64_t> fill(start_.begin(), start_.end() - 1);
-  for (int32_t i : valid_) members_[fill[cell_of[i]]++] = i;
+  for (int32_t i = 0; i < n; ++i) {
+    if (cell[i] < 0) continue;
+    const int64_t p = fill[cell[i]]++;
+    id_[p] = i;
+    srad_[p] = rad_[i];
+    for (int c = 0; c < dim_; ++c) sx_[c][p] = wrap(ps.x(i, c), c);
+  }
 }
 
-template <class Limit>
-void CellGrid::query(const double *xq, double R, Limit &&lim, std::vector<int32_t> &row) const {
-  if (valid_.empty()) return;
-  // Cell ranges per axis: [k - m, k + m], clamped, or all cells once on a periodic axis
-  // where the stencil would wrap onto itself.
+template <int D, bool Periodic, bool Gather>
+void CellGrid::scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
+                    std::vector<int32_t> &row, size_t &cnt) const {
+  if (row.size() < cnt + static_cast<size_t>(p1 - p0)) row.resize(2 * (cnt + static_cast<size_t>(p1 - p0)));
+  int32_t *out = row.data();
+  size_t k = cnt;
+  const double lim2 = ri * ri * (1.0 + kEdgeTol2);
+  const double *x0 = sx_[0].data(), *x1 = sx_[1].data(), *x2 = sx_[2].data();
+  const int32_t *id = id_.data();
+  // every candidate is written, the count advances only for a hit (no branch)
+  for (int64_t p = p0; p < p1; ++p) {
+    double d[3] = {xq[0] - x0[p], D > 1 ? xq[1] - x1[p] : 0.0, D > 2 ? xq[2] - x2[p] : 0.0};
+    if (Periodic)
+      for (int c = 0; c < D; ++c)
+        if (periodic_[c]) d[c] -= L_[c] * std::nearbyint(d[c] / L_[c]);
+    const double d2 = d[0] * d[0] + (D > 1 ? d[1] * d[1] : 0.0) + (D > 2 ? d[2] * d[2] : 0.0);
+    out[k] = id[p];
+    if (Gather) {
+      k += d2 <= lim2;
+    } else {
+      const double l = rule.limit(ri, srad_[p]);
+      k += d2 <= l * l * (1.0 + kEdgeTol2);
+    }
+  }
+  cnt = k;
+}
+
+void CellGrid::query(const double *xq, double ri, const Rule &rule, std::vector<int32_t> &row,
+                     size_t &cnt) const {
+  if (nvalid_ == 0) return;
+  const double R = rule.query(ri) * (1.0 + 1e-12);  // closed supports (kEdgeTol)
+  // Cell ranges per axis: [k(x - R), k(x + R)] clamped, [k - m, k + m] on a periodic
+  // axis, or all cells once where that stencil would wrap onto itself.
   int64_t kmin[3] = {0, 0, 0}, kmax[3] = {0, 0, 0};
   for (int c = 0; c < dim_; ++c) {
-    const int64_t kc = coord(xq[c], c);
-    const int64_t m = static_cast<int64_t>(std::ceil(R / cell_[c]));
-    if (periodic_[c] && 2 * m + 1 >= nc_[c]) {
-      kmin[c] = 0;
-      kmax[c] = nc_[c] - 1;
-    } else if (periodic_[c]) {
-      kmin[c] = kc - m;
-      kmax[c] = kc + m;
+    if (periodic_[c]) {
+      const int64_t kc = coord(xq[c], c);
+      const int64_t m = static_cast<int64_t>(std::ceil(R / cell_[c]));
+      if (2 * m + 1 >= nc_[c]) {
+        kmin[c] = 0;
+        kmax[c] = nc_[c] - 1;
+      } else {
+        kmin[c] = kc - m;
+        kmax[c] = kc + m;
+      }
     } else {
-      kmin[c] = std::max<int64_t>(0, kc - m);
-      kmax[c] = std::min<int64_t>(nc_[c] - 1, kc + m);
+      kmin[c] = coord(xq[c] - R, c);
+      kmax[c] = coord(xq[c] + R, c);
+    }
+  }
+  // Along axis 0 the cells [kmin, kmax] are one member range, or two where a periodic
+  // range wraps.
+  int64_t seg[2][2] = {{kmin[0], kmax[0]}, {0, -1}};
+  if (periodic_[0]) {
+    if (kmin[0] < 0) {
+      seg[0][0] = 0;
+      seg[1][0] = kmin[0] + nc_[0];
+      seg[1][1] = nc_[0] - 1;
+    } else if (kmax[0] >= nc_[0]) {
+      seg[0][1] = nc_[0] - 1;
+      seg[1][0] = 0;
+      seg[1][1] = kmax[0] - nc_[0];
     }
   }
   int64_t k[3];
   for (k[2] = kmin[2]; k[2] <= kmax[2]; ++k[2])
-    for (k[1] = kmin[1]; k[1] <= kmax[1]; ++k[1])
-      for (k[0] = kmin[0]; k[0] <= kmax[0]; ++k[0]) {
-        int64_t kw[3] = {k[0], k[1], k[2]};
-        for (int c = 0; c < dim_; ++c)
-          if (periodic_[c]) kw[c] = ((kw[c] % nc_[c]) + nc_[c]) % nc_[c];
-        const int64_t cell = index(kw);
-        for (int64_t p = start_[cell]; p < start_[cell + 1]; ++p) {
-          const int32_t j = members_[p];
-          const double *xj = &xs_[static_cast<size_t>(j) * 3];
-          double d2 = 0.0;
-          for (int c = 0; c < dim_; ++c) {
-            double d = xq[c] - xj[c];
-            if (periodic_[c]) d -= L_[c] * std::nearbyint(d / L_[c]);
-            d2 += d * d;
-          }
-          const double l = lim(j);
-          if (d2 <= l * l * (1.0 + kEdgeTol2)) row.push_back(j);
-        }
+    for (k[1] = kmin[1]; k[1] <= kmax[1]; ++k[1]) {
+      int64_t kw[3] = {0, k[1], k[2]};
+      for (int c = 1; c < dim_; ++c)
+        if (periodic_[c]) kw[c] = ((kw[c] % nc_[c]) + nc_[c]) % nc_[c];
+      for (int s = 0; s < 2; ++s) {
+        if (seg[s][1] < seg[s][0]) continue;
+        kw[0] = seg[s][0];
+        const int64_t c0 = index(kw);
+        kw[0] = seg[s][1];
+        const int64_t c1 = index(kw);
+        const int64_t p0 = start_[c0], p1 = start_[c1 + 1];
+        scan_range(xq, ri, rule, p0, p1, row, cnt);
       }
+    }
 }
 
-// Query radius and pair limit of a site with search radius ri under the convention.
-struct Rule {
-  int conv;
-  double rmax;
-  double query(double ri) const {
-    return conv == MFREE_SEARCH_GATHER ? ri : conv == MFREE_SEARCH_SYMMETRIC_MAX ? rmax : 0.5 * (ri + rmax);
+// Rows are short (tens) and, for particles stored in lattice or cell order, nearly
+// sorted already: insertion sort beats std::sort's set-up there.
+void sort_row(int32_t *b, int32_t *e) {
+  for (int32_t *p = b + 1; p < e; ++p) {
+    const int32_t v = *p;
+    int32_t *q = p;
+    while (q > b && q[-1] > v) {
+      *q = q[-1];
+      --q;
+    }
+    *q = v;
   }
-  double limit(double ri, double rj) const {
-    return conv == MFREE_SEARCH_GATHER ? ri : conv == MFREE_SEARCH_SYMMETRIC_MAX ? std::max(ri, rj) : 0.5 * (ri + rj);
+}
+
+// Rows for nsites sites visited in `order`: site(s, x) writes the wrapped position of
+// site s and returns its search radius, or a negative value for a site without a row.
+// Each thread searches a static block of `order` into its own buffer; the rows are
+// then placed by site index, so the result does not depend on the thread count.
+template <class Site>
+void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const std::vector<int32_t> &order,
+                 Site &&site, Csr &out) {
+  out.rowptr.assign(static_cast<size_t>(nsites) + 1, 0);
+  out.cols.clear();
+  if (grid.empty() || order.empty()) return;
+  const int64_t nq = static_cast<int64_t>(order.size());
+  const int nt = num_threads(nq);
+  std::vector<std::vector<int32_t>> buf(nt);
+  std::vector<int64_t> first(static_cast<size_t>(nq) + 1, 0);  // offsets into the buffers
+  parallel_blocks(nq, nt, [&](int t, int64_t b, int64_t e) {
+    std::vector<int32_t> &cols = buf[t];
+    cols.resize(static_cast<size_t>((e - b) * 32 + 64));
+    size_t cnt = 0;
+    for (int64_t q = b; q < e; ++q) {
+      const int32_t s = order[q];
+      double x[3] = {0, 0, 0};
+      const double r = site(s, x);
+      first[q] = static_cast<int64_t>(cnt);
+      if (r < 0.0) continue;
+      const size_t r0 = cnt;
+      grid.query(x, r, rule, cols, cnt);
+      sort_row(cols.data() + r0, cols.data() + cnt);
+    }
+    cols.resize(cnt);
+  });
+  // row lengths by site, then prefix sums; each block knows its own buffer's end
+  for (int t = 0; t < nt; ++t) {
+    int64_t b, e;
+    thread_block(nq, t, nt, b, e);
+    for (int64_t q = b; q < e; ++q) {
+      const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(buf[t].size());
+      out.rowptr[order[q] + 1] = end - first[q];
+    }
   }
-};
+  for (int32_t s = 0; s < nsites; ++s) out.rowptr[s + 1] += out.rowptr[s];
+  out.cols.resize(static_cast<size_t>(out.rowptr[nsites]));
+  parallel_blocks(nq, nt, [&](int t, int64_t b, int64_t e) {
+    for (int64_t q = b; q < e; ++q) {
+      const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(buf[t].size());
+      std::copy(buf[t].begin() + first[q], buf[t].begin() + end, out.cols.begin() + out.rowptr[order[q]]);
+    }
+  });
+}
 
 }  // namespace
 
 void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, Csr &out) {
   const int32_t rows = ps.num_owned();
-  out.rowptr.assign(static_cast<size_t>(rows) + 1, 0);
-  out.cols.clear();
   const CellGrid grid(ps, status);
   const Rule rule{ps.search_convention(), grid.rmax()};
-  std::vector<int32_t> row;
-  for (int32_t i = 0; i < rows; ++i) {
-    if (status[i] == 0 && !grid.empty()) {
-      double xi[3] = {0, 0, 0};
-      for (int c = 0; c < ps.dim(); ++c) xi[c] = grid.wrap(ps.x(i, c), c);
-      const double ri = grid.radius(i);
-      row.clear();
-      grid.query(xi, rule.query(ri), [&](int32_t j) { return rule.limit(ri, grid.radius(j)); }, row);
-      std::sort(row.begin(), row.end());
-      out.cols.insert(out.cols.end(), row.begin(), row.end());
-    }
-    out.rowptr[i + 1] = static_cast<int64_t>(out.cols.size());
-  }
+  // owned valid particles in cell order
+  std::vector<int32_t> order;
+  order.reserve(rows);
+  for (int32_t i : grid.members())
+    if (i < rows) order.push_back(i);
+  const int dim = ps.dim();
+  run_queries(grid, rule, rows, order,
+              [&](int32_t i, double *x) {
+                for (int c = 0; c < dim; ++c) x[c] = grid.wrap(ps.x(i, c), c);
+                return grid.radius(i);
+              },
+              out);
 }
 
 void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, int32_t npts,
                           const VectorArray &x, const ScalarArray &h, Csr &out) {
-  out.rowptr.assign(static_cast<size_t>(npts) + 1, 0);
-  out.cols.clear();
   const CellGrid grid(ps, status);
   const Rule rule{ps.search_convention(), grid.rmax()};
-  std::vector<int32_t> row;
-  for (int32_t s = 0; s < npts; ++s) {
-    double xs[3] = {0, 0, 0};
-    for (int c = 0; c < ps.dim(); ++c) xs[c] = grid.wrap(x(s, c), c);
-    const double rs = ps.kappa() * h(s);
-    row.clear();
-    grid.query(xs, rule.query(rs), [&](int32_t j) { return rule.limit(rs, grid.radius(j)); }, row);
-    std::sort(row.begin(), row.end());
-    out.cols.insert(out.cols.end(), row.begin(), row.end());
-    out.rowptr[s + 1] = static_cast<int64_t>(out.cols.size());
+  const int dim = ps.dim();
+  auto site = [&](int32_t s, double *xs) {
+    for (int c = 0; c < dim; ++c) xs[c] = grid.wrap(x(s, c), c);
+    return ps.kappa() * h(s);
+  };
+  // points in cell order (counting sort by the cell they fall in)
+  std::vector<int32_t> order(npts);
+  if (!grid.empty() && npts > 0) {
+    const int64_t ncells = grid.num_cells();
+    std::vector<int64_t> start(static_cast<size_t>(ncells) + 1, 0), cell(npts);
+    for (int32_t s = 0; s < npts; ++s) {
+      double xs[3] = {0, 0, 0};
+      site(s, xs);
+      cell[s] = grid.cell_of(xs);
+      ++start[cell[s] + 1];
+    }
+    for (int64_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
+    for (int32_t s = 0; s < npts; ++s) order[start[cell[s]]++] = s;
   }
+  run_queries(grid, rule, npts, order, site, out);
 }
 
 }  // namespace mfree

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "alloc.hpp"
 #include "error.hpp"
 #include "mfree.h"
 
@@ -34,8 +35,8 @@ struct VectorArray {
 
 // CSR adjacency, 0-based, one row per owned particle.
 struct Csr {
-  std::vector<int64_t> rowptr{0};
-  std::vector<int32_t> cols;
+  HVec<int64_t> rowptr = HVec<int64_t>(1, 0);
+  HVec<int32_t> cols;
   int64_t nnz() const { return rowptr.empty() ? 0 : rowptr.back(); }
 };
 

@@ -1,0 +1,147 @@
+// Neighbour search: mfree's cell list (mfree_particles_setup) on jittered lattices in 2D
+// and 3D with ~21 / ~57 neighbours, serial and on all cores, against nanoflann's k-d
+// tree (build + radius search of every point, when nanoflann was found at configure
+// time) and, at 10^4 points, against the O(N^2) oracle (row-by-row identical sets).
+// Usage: bench_neighbors [n ...]   sizes (default 10000 100000; add 1000000 by hand).
+// Prints particles per second and the ratio to each reference. Never run by the tests.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "bench_util.h"
+#include <mfree.h>
+
+#ifdef MFREE_BENCH_HAVE_NANOFLANN
+#include <nanoflann.hpp>
+
+namespace {
+struct Cloud {
+  const double *x;
+  size_t n;
+  int dim;
+  size_t kdtree_get_point_count() const { return n; }
+  double kdtree_get_pt(size_t i, size_t c) const { return x[i * dim + c]; }
+  template <class B>
+  bool kdtree_get_bbox(B &) const { return false; }
+};
+
+template <int D>
+double nanoflann_time(const double *x, int n, double r, long long *pairs) {
+  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, D, unsigned>;
+  Cloud cloud{x, static_cast<size_t>(n), D};
+  const double t0 = bench_now();
+  Tree tree(D, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  tree.buildIndex();
+  std::vector<std::pair<unsigned, double>> hits;
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  long long total = 0;
+  for (int i = 0; i < n; ++i) {
+    hits.clear();
+    total += static_cast<long long>(tree.radiusSearch(x + static_cast<size_t>(i) * D, r * r, hits, params));
+  }
+  *pairs = total;
+  return bench_now() - t0;
+}
+}  // namespace
+#endif
+
+namespace {
+
+// All pairs within r, row by row; returns the number of rows that differ from mfree's.
+long long oracle_diff(int dim, int n, const double *x, double r, const int64_t *rowptr,
+                      const int32_t *cols, double *seconds) {
+  const double t0 = bench_now();
+  long long bad = 0;
+  std::vector<int32_t> row;
+  for (int i = 0; i < n; ++i) {
+    row.clear();
+    for (int j = 0; j < n; ++j) {
+      double d2 = 0;
+      for (int c = 0; c < dim; ++c) {
+        const double d = x[dim * i + c] - x[dim * j + c];
+        d2 += d * d;
+      }
+      if (d2 <= r * r) row.push_back(j);
+    }
+    if (!std::equal(row.begin(), row.end(), cols + rowptr[i], cols + rowptr[i + 1])) ++bad;
+  }
+  *seconds = bench_now() - t0;
+  return bad;
+}
+
+double time_mfree(int dim, int n, const double *x, double h, int threads, int reps, int64_t *nnz,
+                  mfree_particles_t **keep) {
+  mfree_context_t *ctx = nullptr;
+  mfree_particles_t *ps = nullptr;
+  mfree_context_create(&ctx);
+  mfree_context_set_num_threads(ctx, threads);
+  mfree_particles_create(ctx, dim, n, &ps);
+  mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
+  mfree_particles_set_support(ps, &h, 0, MFREE_COPY);
+  double best = 1e300;
+  for (int k = 0; k < reps; ++k) {
+    const double t0 = bench_now();
+    if (mfree_particles_setup(ps) != MFREE_SUCCESS) {
+      std::fprintf(stderr, "mfree_particles_setup failed\n");
+      std::exit(1);
+    }
+    best = std::min(best, bench_now() - t0);
+  }
+  mfree_particles_get_neighbor_nnz(ps, nnz);
+  if (keep) *keep = ps;
+  else mfree_particles_destroy(&ps);
+  mfree_context_destroy(&ctx);
+  return best;
+}
+
+void run(int dim, double n_target) {
+  int n = 0;
+  const int m = bench_side(dim, n_target);
+  double *x = bench_lattice(dim, m, 0.3, &n);
+  const double r = bench_radius(dim), h = 0.5 * r;  // cubic spline: support 2h
+  const int reps = n <= 200000 ? 5 : 2;
+  int64_t nnz = 0, nnz_t = 0;
+  mfree_particles_t *ps = nullptr;
+  const double t1 = time_mfree(dim, n, x, h, 1, reps, &nnz, n <= 20000 ? &ps : nullptr);
+  const double tn = time_mfree(dim, n, x, h, bench_threads(), reps, &nnz_t, nullptr);
+  std::printf("%dD n=%8d  neighbours %5.1f  mfree 1 thread %8.4f s %9.3g p/s | all threads %8.4f s"
+              " %9.3g p/s (x%.2f)%s\n",
+              dim, n, static_cast<double>(nnz) / n, t1, n / t1, tn, n / tn, t1 / tn,
+              nnz_t == nnz ? "" : "  THREADED COUNT DIFFERS");
+#ifdef MFREE_BENCH_HAVE_NANOFLANN
+  long long pairs = 0;
+  double tk = 1e300;
+  for (int k = 0; k < reps; ++k)
+    tk = std::min(tk, dim == 2 ? nanoflann_time<2>(x, n, r, &pairs) : nanoflann_time<3>(x, n, r, &pairs));
+  std::printf("      nanoflann k-d tree build + radius search %8.4f s %9.3g p/s  pairs %s  "
+              "mfree speed-up %.2fx (target >= 3)\n",
+              tk, n / tk, pairs == nnz ? "equal" : "DIFFER", tk / t1);
+#else
+  std::printf("      nanoflann: not found at configure time (Debian libnanoflann-dev), not measured\n");
+#endif
+  if (ps) {
+    std::vector<int64_t> rowptr(static_cast<size_t>(n) + 1);
+    std::vector<int32_t> cols(static_cast<size_t>(nnz));
+    mfree_particles_get_neighbors(ps, rowptr.data(), cols.data());
+    double tb = 0;
+    const long long bad = oracle_diff(dim, n, x, r, rowptr.data(), cols.data(), &tb);
+    std::printf("      O(N^2) oracle %8.3f s %9.3g p/s  rows differing %lld  mfree speed-up %.0fx\n",
+                tb, n / tb, bad, tb / t1);
+    mfree_particles_destroy(&ps);
+  }
+  std::free(x);
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  std::vector<double> sizes;
+  for (int a = 1; a < argc; ++a) sizes.push_back(std::atof(argv[a]));
+  if (sizes.empty()) sizes = {1e4, 1e5};
+  std::printf("neighbour search, jittered lattices (jitter 0.3 spacing), cubic-spline support 2h\n");
+  for (double s : sizes)
+    for (int dim = 2; dim <= 3; ++dim) run(dim, s);
+  return 0;
+}

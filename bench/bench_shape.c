@@ -1,0 +1,131 @@
+/* Shape-function setup per method (SPH, Randles-Libersky, Krongauz-Belytschko Method 1,
+ * MLS order 1 and 2, SSPH order 2) on jittered lattices with ~21 (2D) / ~57 (3D)
+ * neighbours: value + gradient tables built by mfree_approximant_setup (pattern and
+ * tables) and rebuilt by mfree_approximant_update (tables only, the per-step cost of a
+ * moving-particle code), serial and on all cores. Reference: Compadre 1.7.5 GMLS
+ * gradient weights at 100,489 points on this machine class (issue 8): order 1 0.33 s,
+ * order 2 0.65 s; targets 10x faster. Also the bytes per particle held by the set-up
+ * approximant, counted through the context's allocator hook.
+ * Usage: bench_shape [n ...]  (default 100000). */
+#include "bench_util.h"
+
+#include <mfree.h>
+
+typedef struct {
+  const char *name;
+  mfree_method_t method;
+  int order;
+  double compadre; /* seconds per 100,489 points, or 0 */
+} method_t;
+
+static const method_t kMethods[] = {
+    {"SPH", MFREE_METHOD_SPH, 0, 0.0},
+    {"Randles-Libersky", MFREE_METHOD_RANDLES_LIBERSKY, 0, 0.0},
+    {"KB Method 1", MFREE_METHOD_KB_METHOD1, 0, 0.0},
+    {"MLS order 1", MFREE_METHOD_MLS, 1, 0.33},
+    {"MLS order 2", MFREE_METHOD_MLS, 2, 0.65},
+    {"SSPH order 2", MFREE_METHOD_SSPH, 2, 0.0},
+};
+
+/* Counting allocator installed on the context: bytes currently held. */
+typedef struct {
+  int64_t held, peak, calls;
+} counter_t;
+
+static void *count_alloc(void *user, int64_t bytes) {
+  counter_t *c = (counter_t *)user;
+  c->held += bytes;
+  if (c->held > c->peak) c->peak = c->held;
+  ++c->calls;
+  return malloc((size_t)bytes);
+}
+static void count_free(void *user, void *p, int64_t bytes) {
+  counter_t *c = (counter_t *)user;
+  c->held -= bytes;
+  free(p);
+}
+
+static void check(mfree_context_t *ctx, mfree_status_t st, const char *what) {
+  if (st == MFREE_SUCCESS) return;
+  char msg[512];
+  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  fprintf(stderr, "%s failed (%d): %s\n", what, (int)st, msg);
+  exit(1);
+}
+
+/* Best of reps for setup and for update; bytes held by the approximant after setup. */
+static void time_method(int dim, int n, const double *x, double h, const method_t *m, int threads,
+                        double *t_setup, double *t_update, double *bytes) {
+  counter_t cnt = {0, 0, 0};
+  mfree_context_t *ctx = NULL;
+  mfree_context_create(&ctx);
+  mfree_context_set_num_threads(ctx, threads);
+  mfree_particles_t *ps = NULL;
+  const double vol = 1.0;
+  check(ctx, mfree_particles_create(ctx, dim, n, &ps), "particles_create");
+  mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
+  mfree_particles_set_support(ps, &h, 0, MFREE_COPY);
+  mfree_particles_set_volumes(ps, &vol, 0, MFREE_COPY);
+  check(ctx, mfree_particles_setup(ps), "particles_setup");
+  check(ctx, mfree_context_set_allocator(ctx, count_alloc, count_free, &cnt), "set_allocator");
+  mfree_approximant_t *a = NULL;
+  const int64_t before = cnt.held;
+  check(ctx, mfree_approximant_create(ctx, ps, m->method, &a), "approximant_create");
+  if (m->order) check(ctx, mfree_approximant_set_order(a, m->order), "set_order");
+  check(ctx, mfree_approximant_set_derivatives(a, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT), "set_derivatives");
+  const int reps = n <= 200000 ? 3 : 1;
+  *t_setup = *t_update = 1e300;
+  for (int r = 0; r < reps; ++r) {
+    double t0 = bench_now();
+    check(ctx, mfree_approximant_setup(a), "approximant_setup");
+    double t = bench_now() - t0;
+    if (t < *t_setup) *t_setup = t;
+    t0 = bench_now();
+    check(ctx, mfree_approximant_update(a), "approximant_update");
+    t = bench_now() - t0;
+    if (t < *t_update) *t_update = t;
+  }
+  *bytes = (double)(cnt.held - before) / n;
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+  mfree_context_destroy(&ctx);
+}
+
+static void run(int dim, double n_target) {
+  int n = 0;
+  double *x = bench_lattice(dim, bench_side(dim, n_target), 0.3, &n);
+  const double h = 0.5 * bench_radius(dim);
+  printf("\n%dD, %d particles, ~%d neighbours, value + gradient tables\n", dim, n, dim == 2 ? 21 : 57);
+  printf("%-18s %10s %10s %10s %10s %10s %8s %9s %12s\n", "method", "setup s", "p/s", "update s",
+         "p/s", "all thr s", "speedup", "B/part", "vs Compadre");
+  double t_mls1 = 0;
+  for (size_t k = 0; k < sizeof kMethods / sizeof kMethods[0]; ++k) {
+    const method_t *m = &kMethods[k];
+    double ts, tu, bytes, tsn, tun, bn;
+    time_method(dim, n, x, h, m, 1, &ts, &tu, &bytes);
+    time_method(dim, n, x, h, m, bench_threads(), &tsn, &tun, &bn);
+    if (m->method == MFREE_METHOD_MLS && m->order == 1) t_mls1 = ts;
+    printf("%-18s %10.4f %10.3g %10.4f %10.3g %10.4f %8.2f %9.0f", m->name, ts, n / ts, tu, n / tu, tsn,
+           ts / tsn, bytes);
+    if (m->compadre > 0 && dim == 2)
+      printf(" %11.1fx", m->compadre * (n / 100489.0) / ts);
+    printf("\n");
+  }
+  (void)t_mls1;
+  free(x);
+}
+
+int main(int argc, char **argv) {
+  int ran = 0;
+  for (int a = 1; a < argc; ++a, ran = 1) {
+    run(2, atof(argv[a]));
+    run(3, atof(argv[a]));
+  }
+  if (!ran) {
+    run(2, 100489);
+    run(3, 1e5);
+  }
+  printf("\nvs Compadre: Compadre's time scaled to the same particle count / mfree setup time "
+         "(target >= 10)\n");
+  return 0;
+}

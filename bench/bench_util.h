@@ -1,0 +1,63 @@
+/* Shared helpers of the benchmarks: wall clock, jittered lattices, thread count from the
+ * environment. Header-only; the benchmarks are run by hand and never time a test. */
+#ifndef MFREE_BENCH_UTIL_H
+#define MFREE_BENCH_UTIL_H
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+static inline double bench_now(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Deterministic uniform numbers in [-1, 1) (xorshift64*), the same on every libc. */
+static inline double bench_rand(uint64_t *s) {
+  *s ^= *s >> 12;
+  *s ^= *s << 25;
+  *s ^= *s >> 27;
+  const uint64_t r = *s * 2685821657736338717ULL;
+  return (double)(r >> 11) * (2.0 / 9007199254740992.0) - 1.0;
+}
+
+/* A jittered lattice of m^dim points with spacing 1, each coordinate moved by up to
+ * +-jitter; AoS with dim per point. Returns malloc'ed memory (n = m^dim). */
+static inline double *bench_lattice(int dim, int m, double jitter, int *n_out) {
+  int n = 1;
+  for (int d = 0; d < dim; ++d) n *= m;
+  double *x = (double *)malloc(sizeof(double) * (size_t)dim * (size_t)n);
+  uint64_t seed = 0x9e3779b97f4a7c15ULL + (uint64_t)dim;
+  for (int p = 0; p < n; ++p) {
+    int q = p;
+    for (int c = 0; c < dim; ++c) {
+      x[(size_t)dim * p + c] = (q % m) + jitter * bench_rand(&seed);
+      q /= m;
+    }
+  }
+  *n_out = n;
+  return x;
+}
+
+/* Lattice side for about n_target points. */
+static inline int bench_side(int dim, double n_target) {
+  return (int)floor(pow(n_target, 1.0 / dim) + 0.5);
+}
+
+/* Search radius (lattice spacing 1) giving about 21 neighbours in 2D (pi r^2 = 21) and
+ * 57 in 3D (4/3 pi r^3 = 57), the issue-8 benchmark densities. */
+static inline double bench_radius(int dim) {
+  const double pi = 3.14159265358979323846;
+  return dim == 2 ? sqrt(21.0 / pi) : cbrt(57.0 * 3.0 / (4.0 * pi));
+}
+
+/* Threads for the "all cores" runs: MFREE_BENCH_THREADS, else 0 (all cores). */
+static inline int bench_threads(void) {
+  const char *s = getenv("MFREE_BENCH_THREADS");
+  return s ? atoi(s) : 0;
+}
+
+#endif
