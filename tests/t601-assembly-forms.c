@@ -193,6 +193,53 @@ static void test_mass_sums(void **s) {
   mfree_particles_destroy(&ps);
 }
 
+/* Graded cloud (particle supports h_i = 1.5 times the local spacing: 0.15 on [0,1]^2,
+ * 0.75 on (1,3] x [0,1]) with background cells over [0,3] x [0,1]: each quadrature point
+ * takes the support of its nearest particle. With one mean support (about 0.2) the
+ * points of the coarse part would see a single particle and MLS could not be built;
+ * with the local supports setup succeeds and the consistent mass matrix of MLS sums to
+ * the area to round-off (partition of unity at every point, weights summing to 3). */
+static void test_graded_supports(void **s) {
+  (void)s;
+  enum { NF = 11, NC = 4, NG = NF * NF + NC * 3 };
+  double x[2 * NG], h[NG], v[NG];
+  int k = 0;
+  for (int i = 0; i < NF; ++i)
+    for (int j = 0; j < NF; ++j, ++k) x[2 * k] = 0.1 * i, x[2 * k + 1] = 0.1 * j, h[k] = 0.15, v[k] = 0.01;
+  for (int i = 0; i < NC; ++i)
+    for (int j = 0; j < 3; ++j, ++k) x[2 * k] = 1.5 + 0.5 * i, x[2 * k + 1] = 0.5 * j, h[k] = 0.75, v[k] = 0.25;
+  mfree_particles_t *ps = NULL;
+  assert_ok(ctx, mfree_particles_create(ctx, 2, NG, &ps));
+  assert_ok(ctx, mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, 2, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_support(ps, h, 1, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_volumes(ps, v, 1, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_setup(ps));
+  mfree_approximant_t *a = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  assert_ok(ctx, mfree_approximant_set_order(a, 1));
+  mfree_assembler_t *as = NULL;
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_MASS, &as));
+  const double lo[2] = {0, 0}, hi[2] = {3, 1};
+  const int32_t nc[2] = {12, 4};
+  assert_ok(ctx, mfree_assembler_set_quadrature_cells(as, lo, hi, nc, 3, NULL, NULL));
+  assert_ok(ctx, mfree_assembler_setup(as));
+  mfree_matrix_t *K = NULL;
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  const int64_t *rp;
+  const int32_t *ci;
+  const double *val;
+  int32_t nr;
+  assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &val));
+  assert_ok(ctx, mfree_matrix_get_size(K, &nr, NULL, NULL));
+  double sum = 0.0;
+  for (int64_t q = 0; q < rp[nr]; ++q) sum += val[q];
+  if (fabs(sum - 3.0) > 1e-12) fail_msg("graded cloud: MLS mass sum %.15f, area 3", sum);
+  mfree_matrix_destroy(&K);
+  mfree_assembler_destroy(&as);
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
 static void lin_u(void *u, const double *x, double *v) {
   (void)u;
   v[0] = 0.01 + 0.02 * x[0] - 0.015 * x[1];
@@ -536,6 +583,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_collocation_exact),
       cmocka_unit_test(test_mass_sums),
+      cmocka_unit_test(test_graded_supports),
       cmocka_unit_test(test_efg_patch_nitsche),
       cmocka_unit_test(test_fe_layer_patch),
       cmocka_unit_test(test_refill_after_move),

@@ -633,12 +633,63 @@ ApproxConfig Assembler::values_config(const ApproxConfig &c) const {
   return v;
 }
 
+std::vector<double> Assembler::point_supports(const std::vector<double> &pts) const {
+  const int32_t n = ps_->size(), m = static_cast<int32_t>(pts.size() / dim_);
+  if (!ps_->has_support() || n == 0) return {mean_h()};
+  double hmin = ps_->h(0), hmax = hmin;
+  for (int32_t i = 1; i < n; ++i) {
+    hmin = std::min(hmin, ps_->h(i));
+    hmax = std::max(hmax, ps_->h(i));
+  }
+  if (hmin == hmax || m == 0) return {hmax};
+  // h(x) = sum_j w_j(x) h_j / sum_j w_j(x), the particles' supports averaged with their
+  // own (scatter) cubic-spline weights w_j = f(2 r / (kappa h_j)) / h_j^dim: it follows
+  // the local h inside a uniform region and grows smoothly across a transition, where a
+  // point next to fine particles still reaches the coarse ones beyond them. A point that
+  // no support covers takes its nearest particle's h.
+  const double kappa = ps_->kappa();
+  VectorArray X;
+  X.ptr = pts.data();
+  X.ld = dim_;
+  X.layout = MFREE_LAYOUT_AOS;
+  ScalarArray H;
+  H.ptr = &hmax;
+  H.stride = 0;
+  Csr nb;
+  find_point_neighbors(*ps_, ps_->site_status(), m, X, H, nb);
+  std::vector<double> h(m, hmax);
+  for (int32_t q = 0; q < m; ++q) {
+    double best = HUGE_VAL, sw = 0.0, swh = 0.0;
+    for (int64_t k = nb.rowptr[q]; k < nb.rowptr[q + 1]; ++k) {
+      const int32_t j = nb.cols[k];
+      double d2 = 0.0;
+      for (int c = 0; c < dim_; ++c) {
+        const double d = pts[static_cast<size_t>(q) * dim_ + c] - ps_->x(j, c);
+        d2 += d * d;
+      }
+      const double hj = ps_->h(j), u = 2.0 * std::sqrt(d2) / (kappa * hj);
+      if (d2 < best) best = d2, h[q] = hj;
+      if (u >= 2.0) continue;
+      const double f = u < 1.0 ? 1.0 - 1.5 * u * u + 0.75 * u * u * u : 0.25 * (2.0 - u) * (2.0 - u) * (2.0 - u);
+      const double w = f / std::pow(hj, dim_);
+      sw += w;
+      swh += w * hj;
+    }
+    if (sw > 0.0) h[q] = swh / sw;
+  }
+  return h;
+}
+
 std::unique_ptr<Approximant> Assembler::make(const ApproxConfig &cfg, const std::vector<double> *pts) const {
   auto a = std::make_unique<Approximant>(ps_, cfg);
   if (pts) {
-    const double h = mean_h();
+    // Supports of quadrature and boundary points: the particles' supports averaged around
+    // the point (point_supports), so that on graded clouds a point sees what the
+    // particles around it see, not a mean over the whole set.
+    const std::vector<double> h = point_supports(*pts);
     const int32_t n = static_cast<int32_t>(pts->size() / dim_);
-    a->set_points(n, n ? pts->data() : nullptr, MFREE_LAYOUT_AOS, dim_, &h, 0, MFREE_COPY);
+    a->set_points(n, n ? pts->data() : nullptr, MFREE_LAYOUT_AOS, dim_, h.data(), h.size() == 1 ? 0 : 1,
+                  MFREE_COPY);
   }
   return a;
 }

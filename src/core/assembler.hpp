@@ -120,6 +120,9 @@ class Assembler {
   bool elasticity() const;
   bool mass() const { return form_ == MFREE_FORM_MASS || form_ == MFREE_FORM_MASS_LUMPED; }
   std::unique_ptr<Approximant> make(const ApproxConfig &cfg, const std::vector<double> *pts) const;
+  // Support of each point (AoS): the particles' supports averaged with their scatter
+  // weights around it; one value when the particles' supports are all equal.
+  std::vector<double> point_supports(const std::vector<double> &pts) const;
   ApproxConfig values_config(const ApproxConfig &c) const;
   void check_points(int32_t npts, const double *x, const double *w, const char *what) const;
   void read_points(int32_t npts, const double *x, int layout, int64_t ld, std::vector<double> &out) const;
