@@ -78,7 +78,10 @@ typedef MFREE_ENUM(mfree_status) {
   MFREE_FAIL_SINGULAR = 3,    /**< singular or ill-conditioned local system */
   MFREE_FAIL_NEIGHBORS = 4,   /**< too few neighbours (isolated site, basis too large) */
   MFREE_FAIL_DOMAIN = 5,      /**< a particle left the domain box */
-  MFREE_FAIL_CFL = 6          /**< a time step violates the CFL condition */
+  MFREE_FAIL_CFL = 6,         /**< a time step violates the CFL condition */
+  MFREE_FAIL_SUPPORT = 7      /**< a kernel support exceeds a method's size limit (MPFEM,
+                                   004 eq 13: a node's support reaches an element not
+                                   connected to it, so the functions do not interpolate) */
 } mfree_status_t;
 
 /** How an input array is held. */
@@ -128,7 +131,17 @@ typedef MFREE_ENUM(mfree_kernel) {
                                              psi_{4,2}); R = 2 */
   MFREE_KERNEL_LINEAR = 10,             /**< 001 eq 6.4, (2 - q)/4; R = 2 */
   MFREE_KERNEL_QUADRATIC = 11,          /**< 001 eq 6.5, (1 - q/2)^2; R = 2 */
-  MFREE_KERNEL_QUARTIC_SPLINE = 12      /**< Morris' quartic spline; R = 5/2 */
+  MFREE_KERNEL_QUARTIC_SPLINE = 12,     /**< Morris' quartic spline; R = 5/2 */
+  MFREE_KERNEL_COSINE = 13,             /**< MPFEM kernel, 004 eq 28 as corrected in the
+                                             spec: cos(pi q / 2); R = 1, so in 1D
+                                             W = (pi/(2d)) cos(pi t/d) with width d = 2h;
+                                             C0, gives C1 MPFEM functions */
+  MFREE_KERNEL_COSINE_SQUARED = 14,     /**< cos^2(pi q / 2); R = 1 (1D: (2/d)
+                                             cos^2(pi t/d)); C1 with zero slope at the
+                                             edge (004 eq 36), gives C2 */
+  MFREE_KERNEL_HAAR = 15                /**< box 1 for q <= 1 (004 Sect. 4.2); R = 1;
+                                             discontinuous: use with the assumed-strain
+                                             derivatives (004 eq 22) */
 } mfree_kernel_t;
 
 /** Approximation methods (papers 000 and 001). Values are frozen. */
@@ -152,7 +165,12 @@ typedef MFREE_ENUM(mfree_method) {
                                            derivatives), 000 eqs 63-64 */
   MFREE_METHOD_KB_METHOD3 = 10,       /**< corrected derivatives Method 3, 000 eqs 65-66 */
   MFREE_METHOD_MSPH = 11,             /**< modified SPH, order 1..2, 001 Sect. 2 */
-  MFREE_METHOD_SSPH = 12              /**< symmetric SPH, order 1..3, 001 Sect. 3 */
+  MFREE_METHOD_SSPH = 12,             /**< symmetric SPH, order 1..3, 001 Sect. 3 */
+  MFREE_METHOD_MPFEM = 13             /**< moving particle FEM, 004: element interpolants
+                                           extended over the domain ("general shape
+                                           functions", eqs 1-3), blended with element
+                                           weights from a moving kernel (eqs 4-13); needs
+                                           a mesh (mfree_approximant_set_mesh) */
 } mfree_method_t;
 
 /** Shape-function tables an approximant builds (bit flags, may be or-ed). */
@@ -202,6 +220,27 @@ typedef MFREE_ENUM(mfree_bc) {
                                  with outward normals: consistent, passes patch tests */
 } mfree_bc_t;
 
+/** Element types of a mesh (mfree_mesh_add_elements). Values are frozen. */
+typedef MFREE_ENUM(mfree_element) {
+  MFREE_ELEMENT_LINE2 = 1, /**< 1D two-node line, x_1 < x_2 */
+  MFREE_ELEMENT_TRI3 = 2,  /**< 2D three-node triangle, counter-clockwise */
+  MFREE_ELEMENT_QUAD4 = 3, /**< 2D four-node quadrilateral, counter-clockwise, convex */
+  MFREE_ELEMENT_HEX8 = 4   /**< 3D eight-node hexahedron, nodes as in VTK: bottom face
+                                counter-clockwise seen from above, then the top face */
+} mfree_element_t;
+
+/** How MPFEM differentiates (paper 004). Values are frozen. */
+typedef MFREE_ENUM(mfree_mpfem_deriv) {
+  MFREE_MPFEM_DERIV_FULL = 1,           /**< derivative of the approximation, weights
+                                             differentiated too (004 eq 21); C^n for a
+                                             C^(n-1) kernel */
+  MFREE_MPFEM_DERIV_ASSUMED_STRAIN = 2, /**< weights not differentiated (004 eq 22):
+                                             continuous for any kernel, Haar included */
+  MFREE_MPFEM_DERIV_NODAL = 3           /**< at the nodes only: eq 22 with the weights
+                                             of the elements around the node by inverse
+                                             length/area/volume (004 eqs 37-38) */
+} mfree_mpfem_deriv_t;
+
 /** Native time integrators of paper 003 (eqs 108-121). */
 typedef MFREE_ENUM(mfree_integrator) {
   MFREE_INTEGRATOR_LEAPFROG = 1,            /**< 003 eqs 108-110 and the ten-step algorithm */
@@ -224,6 +263,7 @@ typedef struct mfree_approximant mfree_approximant_t;
 typedef struct mfree_matrix mfree_matrix_t;
 typedef struct mfree_assembler mfree_assembler_t;
 typedef struct mfree_system mfree_system_t;
+typedef struct mfree_mesh mfree_mesh_t;
 
 /** Progress of a native integration: called after every accepted step; a nonzero
  * return stops the integration (MFREE_SUCCESS is returned, t tells where). */
@@ -483,6 +523,64 @@ MFREE_API mfree_status_t mfree_particles_get_site_status(const mfree_particles_t
                                                          int32_t *status, int32_t *nfailed);
 
 /* ------------------------------------------------------------------------------------ */
+/* Meshes (element connectivity over the particles, for MPFEM)                            */
+/* ------------------------------------------------------------------------------------ */
+
+/**
+ * A finite-element mesh whose nodes are the particles of ps (which it keeps alive):
+ * the nodes move with the particles (borrowed positions are re-read at every setup).
+ * Add blocks of elements with mfree_mesh_add_elements; a mesh may mix element types of
+ * its dimension (e.g. triangles and quadrilaterals, 004 Sect. 2.1).
+ * @param[out] mesh  the new mesh
+ */
+MFREE_API mfree_status_t mfree_mesh_create(mfree_context_t *ctx, mfree_particles_t *ps,
+                                           mfree_mesh_t **mesh);
+/** Release a mesh (approximants using it keep it alive). */
+MFREE_API mfree_status_t mfree_mesh_destroy(mfree_mesh_t **mesh);
+
+/**
+ * Append nelem elements of one type.
+ * @param[in] type        an mfree_element_t whose dimension is the particle set's
+ *                        (else MFREE_ERR_MISMATCH: a mesh of mixed dimension)
+ * @param[in] nelem       number of elements (>= 0)
+ * @param[in] conn        nodes per element (2, 3, 4, 8) consecutive per element:
+ *                        particle indices in [index_base, index_base + n); copied or
+ *                        borrowed (re-read and re-checked at every setup) per mem
+ * @param[in] index_base  0 (C) or 1 (Fortran)
+ * @return MFREE_ERR_INPUT for an index out of range or repeated within an element
+ *         (copied arrays are checked here, borrowed ones at setup)
+ */
+MFREE_API mfree_status_t mfree_mesh_add_elements(mfree_mesh_t *mesh, mfree_element_t type,
+                                                 int32_t nelem, const int32_t *conn,
+                                                 int32_t index_base, mfree_mem_t mem);
+
+/**
+ * Check the mesh at the current node positions: indices in range, and every element
+ * valid: positive length (LINE2, x_1 < x_2), positive Jacobian at every corner
+ * (TRI3, QUAD4 counter-clockwise and convex; HEX8), and solvable general shape
+ * functions (a QUAD4 whose nodes make {1, x, y, xy} singular, like the diamond
+ * (+-1, 0), (0, +-1), is rejected). Failures: MFREE_ERR_INPUT, naming the element.
+ * Approximants repeat these checks at their own setup.
+ */
+MFREE_API mfree_status_t mfree_mesh_setup(mfree_mesh_t *mesh);
+
+/** Number of elements. */
+MFREE_API mfree_status_t mfree_mesh_get_size(const mfree_mesh_t *mesh, int32_t *nelem);
+
+/**
+ * Gauss quadrature over the mesh, e.g. for mfree_assembler_set_quadrature_points:
+ * ngauss points per direction and element (LINE2 ngauss, QUAD4 ngauss^2, HEX8 ngauss^3
+ * through the isoparametric map; TRI3 a collapsed ngauss^2 rule), in element order.
+ * Call with x = w = NULL to get the count first.
+ * @param[in]  ngauss  1..10
+ * @param[out] npts    number of points
+ * @param[out] x       dim coordinates per point (AoS), or NULL
+ * @param[out] w       weights (|J| times the rule's weight), or NULL
+ */
+MFREE_API mfree_status_t mfree_mesh_get_quadrature(mfree_mesh_t *mesh, int32_t ngauss,
+                                                   int32_t *npts, double *x, double *w);
+
+/* ------------------------------------------------------------------------------------ */
 /* Approximants                                                                           */
 /* ------------------------------------------------------------------------------------ */
 
@@ -509,6 +607,44 @@ MFREE_API mfree_status_t mfree_approximant_set_derivatives(mfree_approximant_t *
                                                            int32_t flags);
 MFREE_API mfree_status_t mfree_approximant_set_fallback(mfree_approximant_t *a,
                                                         mfree_fallback_t policy);
+
+/**
+ * The mesh of an MPFEM approximant (MFREE_METHOD_MPFEM only; else MFREE_ERR_UNSUPPORTED;
+ * it must be built on the approximant's particle set, else MFREE_ERR_MISMATCH). The
+ * approximant keeps the mesh alive. Required before setup.
+ *
+ * MPFEM (paper 004): u^h(x) = sum_e omega_e(x) sum_{I in e} Nhat^e_I(x) u_I, where
+ * Nhat^e is element e's interpolant ({1,x}, {1,x,y}, {1,x,y,xy}, {1,x,y,z,xy,yz,zx,xyz}
+ * in physical coordinates) extended over the whole domain (eqs 1-3), and
+ * omega_e(x) = int_{e} phi(y - x) dy / int_{mesh} phi(y - x) dy (eqs 6, 11; normalised
+ * per point, so the weights sum to one up to the boundary, eq 12). The kernel phi is the
+ * tensor product prod_c W1(|t_c|, h) of the approximant's kernel in its 1D form, so the
+ * support is the box |t_c| <= R h around x (004 Sect. 4.2); h is the site's support
+ * (the particle's, or the point's). The default kernel is MFREE_KERNEL_COSINE. The
+ * integrals are exact in 1D and on axis-aligned rectangles and bricks; on triangles and
+ * other quadrilaterals they are edge integrals (divergence theorem) with ngauss points
+ * per smooth piece. HEX8 elements must be axis-aligned bricks (else MFREE_ERR_UNSUPPORTED).
+ *
+ * Setup checks the interpolation condition (eq 13) at every node: when a node's
+ * support reaches an element that does not contain it, the tables are still built but
+ * setup returns MFREE_FAIL_SUPPORT naming the node (004 Sect. 4.1: no Kronecker delta).
+ * A site whose support reaches no element gets a zero row and MFREE_FAIL_NEIGHBORS.
+ * Update recomputes the rows, and may change the pattern when nodes moved across
+ * supports.
+ */
+MFREE_API mfree_status_t mfree_approximant_set_mesh(mfree_approximant_t *a,
+                                                    mfree_mesh_t *mesh);
+
+/**
+ * MPFEM options (defaults: MFREE_MPFEM_DERIV_FULL, ngauss 8).
+ * @param[in] deriv   how gradients and Hessians are formed (mfree_mpfem_deriv_t);
+ *                    MFREE_MPFEM_DERIV_NODAL needs the sites to be the particles; FULL
+ *                    Hessians need a continuous kernel (not MFREE_KERNEL_HAAR)
+ * @param[in] ngauss  Gauss points per smooth piece of the edge integrals (1..20)
+ */
+MFREE_API mfree_status_t mfree_approximant_set_mpfem(mfree_approximant_t *a,
+                                                     mfree_mpfem_deriv_t deriv,
+                                                     int32_t ngauss);
 
 /**
  * Evaluate at host points instead of the particles (e.g. quadrature points). Each point

@@ -18,6 +18,7 @@ static void test_status_values(void **s) {
   assert_int_equal(MFREE_FAIL_NEIGHBORS, 4);
   assert_int_equal(MFREE_FAIL_DOMAIN, 5);
   assert_int_equal(MFREE_FAIL_CFL, 6);
+  assert_int_equal(MFREE_FAIL_SUPPORT, 7);
   assert_int_equal(sizeof(mfree_status_t), sizeof(int));
 }
 
@@ -46,6 +47,9 @@ static void test_kernel_values(void **s) {
   assert_int_equal(MFREE_KERNEL_LINEAR, 10);
   assert_int_equal(MFREE_KERNEL_QUADRATIC, 11);
   assert_int_equal(MFREE_KERNEL_QUARTIC_SPLINE, 12);
+  assert_int_equal(MFREE_KERNEL_COSINE, 13);
+  assert_int_equal(MFREE_KERNEL_COSINE_SQUARED, 14);
+  assert_int_equal(MFREE_KERNEL_HAAR, 15);
 }
 
 static void test_method_values(void **s) {
@@ -62,6 +66,7 @@ static void test_method_values(void **s) {
   assert_int_equal(MFREE_METHOD_KB_METHOD3, 10);
   assert_int_equal(MFREE_METHOD_MSPH, 11);
   assert_int_equal(MFREE_METHOD_SSPH, 12);
+  assert_int_equal(MFREE_METHOD_MPFEM, 13);
   assert_int_equal(MFREE_DERIV_VALUE, 1);
   assert_int_equal(MFREE_DERIV_GRADIENT, 2);
   assert_int_equal(MFREE_DERIV_HESSIAN, 4);
@@ -93,6 +98,13 @@ static void test_assembly_values(void **s) {
   assert_int_equal(MFREE_INTEGRATOR_PREDICTOR_CORRECTOR, 2);
   assert_int_equal(MFREE_LUMP_GALERKIN, 1);
   assert_int_equal(MFREE_LUMP_PHYSICAL, 2);
+  assert_int_equal(MFREE_ELEMENT_LINE2, 1);
+  assert_int_equal(MFREE_ELEMENT_TRI3, 2);
+  assert_int_equal(MFREE_ELEMENT_QUAD4, 3);
+  assert_int_equal(MFREE_ELEMENT_HEX8, 4);
+  assert_int_equal(MFREE_MPFEM_DERIV_FULL, 1);
+  assert_int_equal(MFREE_MPFEM_DERIV_ASSUMED_STRAIN, 2);
+  assert_int_equal(MFREE_MPFEM_DERIV_NODAL, 3);
 }
 
 int main(void) {

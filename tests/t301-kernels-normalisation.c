@@ -277,7 +277,7 @@ static void test_bad_input(void **s) {
                    MFREE_ERR_NULL);
   assert_error(ctx, mfree_kernel_eval(ctx, (mfree_kernel_t)0, 2, 0, 1, 2, r, w, NULL, NULL),
                MFREE_ERR_ARG, "unknown kernel");
-  assert_error(ctx, mfree_kernel_eval(ctx, (mfree_kernel_t)13, 2, 0, 1, 2, r, w, NULL, NULL),
+  assert_error(ctx, mfree_kernel_eval(ctx, (mfree_kernel_t)16, 2, 0, 1, 2, r, w, NULL, NULL),
                MFREE_ERR_ARG, "unknown kernel");
   assert_error(ctx, mfree_kernel_eval(ctx, MFREE_KERNEL_CUBIC_SPLINE, 0, 0, 1, 2, r, w, NULL, NULL),
                MFREE_ERR_ARG, "dimension");

@@ -450,6 +450,8 @@ static void claims(const mcase_t *mc, int *dv, int *dg, int *dh) {
       *dv = *dg = k;
       if (k >= 2) *dh = k;
       break;
+    case MFREE_METHOD_MPFEM: /* needs a mesh: checked in tests/mpfem */
+      break;
   }
 }
 

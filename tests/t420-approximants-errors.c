@@ -40,7 +40,7 @@ static void test_create_and_setters(void **s) {
   assert_error(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, NULL), MFREE_ERR_NULL, "NULL");
   assert_error(ctx, mfree_approximant_create(ctx, ps, (mfree_method_t)0, &a), MFREE_ERR_ARG,
                "unknown method");
-  assert_error(ctx, mfree_approximant_create(ctx, ps, (mfree_method_t)13, &a), MFREE_ERR_ARG,
+  assert_error(ctx, mfree_approximant_create(ctx, ps, (mfree_method_t)14, &a), MFREE_ERR_ARG,
                "unknown method");
   assert_null(a);
   assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));

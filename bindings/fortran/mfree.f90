@@ -50,6 +50,7 @@ module mfree
   integer(c_int), parameter, public :: MFREE_FAIL_NEIGHBORS = 4
   integer(c_int), parameter, public :: MFREE_FAIL_DOMAIN = 5
   integer(c_int), parameter, public :: MFREE_FAIL_CFL = 6
+  integer(c_int), parameter, public :: MFREE_FAIL_SUPPORT = 7
 
   ! ---- mfree_mem_t ---------------------------------------------------------------
   integer(c_int), parameter, public :: MFREE_COPY = 1
@@ -77,6 +78,9 @@ module mfree
   integer(c_int), parameter, public :: MFREE_KERNEL_LINEAR = 10
   integer(c_int), parameter, public :: MFREE_KERNEL_QUADRATIC = 11
   integer(c_int), parameter, public :: MFREE_KERNEL_QUARTIC_SPLINE = 12
+  integer(c_int), parameter, public :: MFREE_KERNEL_COSINE = 13
+  integer(c_int), parameter, public :: MFREE_KERNEL_COSINE_SQUARED = 14
+  integer(c_int), parameter, public :: MFREE_KERNEL_HAAR = 15
 
   ! ---- mfree_method_t ------------------------------------------------------------
   integer(c_int), parameter, public :: MFREE_METHOD_SPH = 1
@@ -91,6 +95,7 @@ module mfree
   integer(c_int), parameter, public :: MFREE_METHOD_KB_METHOD3 = 10
   integer(c_int), parameter, public :: MFREE_METHOD_MSPH = 11
   integer(c_int), parameter, public :: MFREE_METHOD_SSPH = 12
+  integer(c_int), parameter, public :: MFREE_METHOD_MPFEM = 13
 
   ! ---- mfree_deriv_t (bit flags: combine with ior) --------------------------------
   integer(c_int), parameter, public :: MFREE_DERIV_VALUE = 1
@@ -133,6 +138,17 @@ module mfree
   integer(c_int), parameter, public :: MFREE_LUMP_GALERKIN = 1
   integer(c_int), parameter, public :: MFREE_LUMP_PHYSICAL = 2
 
+  ! ---- mfree_element_t (mesh element types) -----------------------------------------
+  integer(c_int), parameter, public :: MFREE_ELEMENT_LINE2 = 1
+  integer(c_int), parameter, public :: MFREE_ELEMENT_TRI3 = 2
+  integer(c_int), parameter, public :: MFREE_ELEMENT_QUAD4 = 3
+  integer(c_int), parameter, public :: MFREE_ELEMENT_HEX8 = 4
+
+  ! ---- mfree_mpfem_deriv_t (MPFEM derivative forms, paper 004) -----------------------
+  integer(c_int), parameter, public :: MFREE_MPFEM_DERIV_FULL = 1
+  integer(c_int), parameter, public :: MFREE_MPFEM_DERIV_ASSUMED_STRAIN = 2
+  integer(c_int), parameter, public :: MFREE_MPFEM_DERIV_NODAL = 3
+
   ! ---- typed handles: one C handle each; null until created, null again after destroy
   type, public :: mfree_context
     type(c_ptr) :: ptr = c_null_ptr
@@ -152,6 +168,9 @@ module mfree
   type, public :: mfree_system
     type(c_ptr) :: ptr = c_null_ptr
   end type mfree_system
+  type, public :: mfree_mesh
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_mesh
 
   ! ---- host callbacks: write bind(C) procedures with these interfaces ---------------
   abstract interface
@@ -525,6 +544,70 @@ module mfree
       integer(c_int64_t), value :: h_stride
       integer(c_int), value :: mem
     end function mfree_approximant_set_points_c
+
+    integer(c_int) function mfree_mesh_create_c(ctx, ps, mesh) &
+        bind(C, name="mfree_mesh_create")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ctx
+      type(c_ptr), value :: ps
+      type(c_ptr) :: mesh
+    end function mfree_mesh_create_c
+
+    integer(c_int) function mfree_mesh_destroy_c(mesh) &
+        bind(C, name="mfree_mesh_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr) :: mesh
+    end function mfree_mesh_destroy_c
+
+    integer(c_int) function mfree_mesh_add_elements_c(mesh, type, nelem, conn, index_base, &
+                                                      mem) &
+        bind(C, name="mfree_mesh_add_elements")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: mesh
+      integer(c_int), value :: type
+      integer(c_int32_t), value :: nelem
+      integer(c_int32_t), intent(in), target :: conn(*)
+      integer(c_int32_t), value :: index_base
+      integer(c_int), value :: mem
+    end function mfree_mesh_add_elements_c
+
+    integer(c_int) function mfree_mesh_setup_c(mesh) &
+        bind(C, name="mfree_mesh_setup")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: mesh
+    end function mfree_mesh_setup_c
+
+    integer(c_int) function mfree_mesh_get_size_c(mesh, nelem) &
+        bind(C, name="mfree_mesh_get_size")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: mesh
+      integer(c_int32_t), intent(out) :: nelem
+    end function mfree_mesh_get_size_c
+
+    integer(c_int) function mfree_mesh_get_quadrature_c(mesh, ngauss, npts, x, w) &
+        bind(C, name="mfree_mesh_get_quadrature")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: mesh
+      integer(c_int32_t), value :: ngauss
+      integer(c_int32_t), intent(out) :: npts
+      type(c_ptr), value :: x
+      type(c_ptr), value :: w
+    end function mfree_mesh_get_quadrature_c
+
+    integer(c_int) function mfree_approximant_set_mesh_c(a, mesh) &
+        bind(C, name="mfree_approximant_set_mesh")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: a
+      type(c_ptr), value :: mesh
+    end function mfree_approximant_set_mesh_c
+
+    integer(c_int) function mfree_approximant_set_mpfem_c(a, deriv, ngauss) &
+        bind(C, name="mfree_approximant_set_mpfem")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int), value :: deriv
+      integer(c_int32_t), value :: ngauss
+    end function mfree_approximant_set_mpfem_c
 
     integer(c_int) function mfree_approximant_setup_c(a) &
         bind(C, name="mfree_approximant_setup")
@@ -1114,6 +1197,9 @@ module mfree
   public :: mfree_approximant_assemble_csr_c, mfree_approximant_check_reproduction_c
   public :: mfree_approximant_get_site_status_c, mfree_approximant_get_neighbor_counts_c
   public :: mfree_approximant_get_condition_c, mfree_approximant_get_site_order_c
+  public :: mfree_mesh_create_c, mfree_mesh_destroy_c, mfree_mesh_add_elements_c
+  public :: mfree_mesh_setup_c, mfree_mesh_get_size_c, mfree_mesh_get_quadrature_c
+  public :: mfree_approximant_set_mesh_c, mfree_approximant_set_mpfem_c
   public :: mfree_matrix_create_csr_c, mfree_matrix_destroy_c, mfree_matrix_get_size_c
   public :: mfree_matrix_get_csr_c, mfree_matrix_get_csr_i32_c, mfree_matrix_get_csr_i64_c
   public :: mfree_matrix_get_csc_c, mfree_matrix_get_pattern_id_c
@@ -1187,6 +1273,9 @@ module mfree
   public :: mfree_approximant_assemble_csr, mfree_approximant_check_reproduction
   public :: mfree_approximant_get_site_status, mfree_approximant_get_neighbor_counts
   public :: mfree_approximant_get_condition, mfree_approximant_get_site_order
+  public :: mfree_mesh_create, mfree_mesh_destroy, mfree_mesh_add_elements
+  public :: mfree_mesh_setup, mfree_mesh_get_size, mfree_mesh_get_quadrature
+  public :: mfree_approximant_set_mesh, mfree_approximant_set_mpfem
   public :: mfree_matrix_create_csr, mfree_matrix_destroy, mfree_matrix_get_size
   public :: mfree_matrix_get_csr, mfree_matrix_get_csr_i32, mfree_matrix_get_csr_i64
   public :: mfree_matrix_get_csc, mfree_matrix_get_pattern_id, mfree_matrix_get_symmetric
@@ -1671,6 +1760,69 @@ contains
     real(c_double), intent(in) :: param
     st = mfree_approximant_set_kernel_c(a%ptr, kernel, param)
   end function mfree_approximant_set_kernel
+
+  ! ---- meshes and MPFEM (paper 004) ----------------------------------------------------
+  !> Connectivity conn(nodes per element, nelem); index_base 1 for Fortran numbering.
+  integer(c_int) function mfree_mesh_create(ctx, ps, mesh) result(st)
+    type(mfree_context), intent(in) :: ctx
+    type(mfree_particles), intent(in) :: ps
+    type(mfree_mesh), intent(out) :: mesh
+    st = mfree_mesh_create_c(ctx%ptr, ps%ptr, mesh%ptr)
+  end function mfree_mesh_create
+
+  integer(c_int) function mfree_mesh_destroy(mesh) result(st)
+    type(mfree_mesh), intent(inout) :: mesh
+    st = mfree_mesh_destroy_c(mesh%ptr)
+  end function mfree_mesh_destroy
+
+  integer(c_int) function mfree_mesh_add_elements(mesh, type, nelem, conn, index_base, mem) &
+      result(st)
+    type(mfree_mesh), intent(in) :: mesh
+    integer(c_int), intent(in) :: type
+    integer(c_int32_t), intent(in) :: nelem
+    integer(c_int32_t), intent(in), target :: conn(*)
+    integer(c_int32_t), intent(in) :: index_base
+    integer(c_int), intent(in) :: mem
+    st = mfree_mesh_add_elements_c(mesh%ptr, type, nelem, conn, index_base, mem)
+  end function mfree_mesh_add_elements
+
+  integer(c_int) function mfree_mesh_setup(mesh) result(st)
+    type(mfree_mesh), intent(in) :: mesh
+    st = mfree_mesh_setup_c(mesh%ptr)
+  end function mfree_mesh_setup
+
+  integer(c_int) function mfree_mesh_get_size(mesh, nelem) result(st)
+    type(mfree_mesh), intent(in) :: mesh
+    integer(c_int32_t), intent(out) :: nelem
+    st = mfree_mesh_get_size_c(mesh%ptr, nelem)
+  end function mfree_mesh_get_size
+
+  !> x(dim, npts) and w(npts) are optional: call without them for the count first.
+  integer(c_int) function mfree_mesh_get_quadrature(mesh, ngauss, npts, x, w) result(st)
+    type(mfree_mesh), intent(in) :: mesh
+    integer(c_int32_t), intent(in) :: ngauss
+    integer(c_int32_t), intent(out) :: npts
+    real(c_double), intent(out), optional, target :: x(*), w(*)
+    type(c_ptr) :: px, pw
+    px = c_null_ptr
+    pw = c_null_ptr
+    if (present(x)) px = c_loc(x)
+    if (present(w)) pw = c_loc(w)
+    st = mfree_mesh_get_quadrature_c(mesh%ptr, ngauss, npts, px, pw)
+  end function mfree_mesh_get_quadrature
+
+  integer(c_int) function mfree_approximant_set_mesh(a, mesh) result(st)
+    type(mfree_approximant), intent(in) :: a
+    type(mfree_mesh), intent(in) :: mesh
+    st = mfree_approximant_set_mesh_c(a%ptr, mesh%ptr)
+  end function mfree_approximant_set_mesh
+
+  integer(c_int) function mfree_approximant_set_mpfem(a, deriv, ngauss) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: deriv
+    integer(c_int32_t), intent(in) :: ngauss
+    st = mfree_approximant_set_mpfem_c(a%ptr, deriv, ngauss)
+  end function mfree_approximant_set_mpfem
 
   integer(c_int) function mfree_approximant_set_order(a, order) result(st)
     type(mfree_approximant), intent(in) :: a

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <memory>
 #include <new>
 #include <string>
 
@@ -12,6 +13,7 @@
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "core/matrix.hpp"
+#include "core/mpfem.hpp"
 #include "core/particles.hpp"
 #include "mfree.h"
 
@@ -43,6 +45,17 @@ struct mfree_approximant {
       : ctx(c), ps(p), a(&p->set, method) {}
   mfree::Approximant &core() { return a; }
   const mfree::Approximant &core() const { return a; }
+};
+
+struct mfree_mesh {
+  std::atomic<int> refs{1};
+  mfree_context_t *ctx = nullptr;
+  mfree_particles_t *ps = nullptr;  // retained
+  std::shared_ptr<mfree::Mesh> m;   // shared with the approximants that use it
+  mfree_mesh(mfree_context_t *c, mfree_particles_t *p)
+      : ctx(c), ps(p), m(std::make_shared<mfree::Mesh>(&p->set)) {}
+  mfree::Mesh &core() { return *m; }
+  const mfree::Mesh &core() const { return *m; }
 };
 
 struct mfree_matrix {

@@ -26,8 +26,8 @@ bool hessian_needs_d2w(int m) {
 const char *method_name(int m) {
   static const char *names[] = {"?", "SPH", "SPH symmetric", "Shepard", "MLS", "RKPM",
                                 "Johnson-Beissel", "Randles-Libersky", "KB Method 1",
-                                "KB Method 2", "KB Method 3", "MSPH", "SSPH"};
-  return (m >= 1 && m <= 12) ? names[m] : names[0];
+                                "KB Method 2", "KB Method 3", "MSPH", "SSPH", "MPFEM"};
+  return (m >= 1 && m <= 13) ? names[m] : names[0];
 }
 int default_order(int m) {
   switch (m) {
@@ -46,9 +46,13 @@ int default_order(int m) {
 }  // namespace
 
 Approximant::Approximant(const ParticleSet *ps, int method) : ps_(ps), method_(method) {
-  if (method < MFREE_METHOD_SPH || method > MFREE_METHOD_SSPH)
+  if (method < MFREE_METHOD_SPH || method > MFREE_METHOD_MPFEM)
     throw Error(MFREE_ERR_ARG, "unknown method " + std::to_string(method));
   order_ = default_order(method);
+  if (method == MFREE_METHOD_MPFEM) {  // linear general shape functions, cosine kernel
+    order_ = 1;
+    kernel_id_ = MFREE_KERNEL_COSINE;
+  }
   kernel_ = std::make_unique<Kernel>(kernel_id_, ps->dim(), kernel_param_);
 }
 
@@ -57,6 +61,10 @@ Approximant::Approximant(const ParticleSet *ps, const ApproxConfig &cfg) : Appro
   if (has_order(method_)) set_order(cfg.order);
   set_derivatives(cfg.flags);
   set_fallback(cfg.fallback);
+  if (method_ == MFREE_METHOD_MPFEM) {
+    set_mesh(cfg.mesh);
+    set_mpfem(cfg.mpfem_deriv, cfg.mpfem_ngauss);
+  }
 }
 
 ApproxConfig Approximant::config() const {
@@ -67,6 +75,9 @@ ApproxConfig Approximant::config() const {
   c.order = order_;
   c.flags = flags_;
   c.fallback = fallback_;
+  c.mesh = mesh_;
+  c.mpfem_deriv = mpfem_deriv_;
+  c.mpfem_ngauss = mpfem_ngauss_;
   return c;
 }
 
@@ -79,6 +90,11 @@ void Approximant::set_kernel(int kernel, double param) {
 }
 
 void Approximant::set_order(int order) {
+  if (method_ == MFREE_METHOD_MPFEM) {
+    if (order != 1)
+      throw Error(MFREE_ERR_UNSUPPORTED, "MPFEM has fixed order 1 (linear general shape functions)");
+    return;
+  }
   if (!has_order(method_)) {
     if (order != fixed_order(method_))
       throw Error(MFREE_ERR_UNSUPPORTED, std::string(method_name(method_)) + " has fixed order " +
@@ -98,7 +114,8 @@ void Approximant::set_derivatives(int flags) {
   if (flags <= 0 || flags > 7)
     throw Error(MFREE_ERR_ARG, "derivative flags " + std::to_string(flags) +
                                    " are not an or of MFREE_DERIV_VALUE/GRADIENT/HESSIAN");
-  if ((flags & MFREE_DERIV_HESSIAN) && !provides_hessian(method_, max_order(method_)))
+  if ((flags & MFREE_DERIV_HESSIAN) && method_ != MFREE_METHOD_MPFEM &&
+      !provides_hessian(method_, max_order(method_)))
     throw Error(MFREE_ERR_UNSUPPORTED,
                 std::string(method_name(method_)) + " provides no second derivatives");
   flags_ = flags;
@@ -401,6 +418,11 @@ Report Approximant::compute(const char *what) {
 }
 
 Report Approximant::setup() {
+  if (method_ == MFREE_METHOD_MPFEM) {
+    Report rep = compute_mpfem();
+    setup_done_ = true;
+    return rep;
+  }
   validate_config();
   build_pattern();
   Report rep = compute("setup");
@@ -410,6 +432,7 @@ Report Approximant::setup() {
 
 Report Approximant::update() {
   if (!setup_done_) throw Error(MFREE_ERR_STATE, "update called before setup");
+  if (method_ == MFREE_METHOD_MPFEM) return compute_mpfem();
   validate_config();
   return compute("update");
 }

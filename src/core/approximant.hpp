@@ -14,6 +14,8 @@
 
 namespace mfree {
 
+class Mesh;
+
 // Everything that defines an approximant apart from its particle set and sites; the
 // assembler clones it onto its own quadrature points.
 struct ApproxConfig {
@@ -23,6 +25,9 @@ struct ApproxConfig {
   int order = 1;
   int flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
   int fallback = MFREE_FALLBACK_NONE;
+  std::shared_ptr<const Mesh> mesh;  // MPFEM only
+  int mpfem_deriv = MFREE_MPFEM_DERIV_FULL;
+  int mpfem_ngauss = 8;
 };
 
 class Approximant {
@@ -43,6 +48,11 @@ class Approximant {
   void set_fallback(int policy);
   void set_points(int32_t npts, const double *x, int layout, int64_t ld, const double *h,
                   int64_t h_stride, int mem);
+  // MPFEM (mpfem.cpp): the mesh, the derivative form and the edge-integral rule.
+  void set_mesh(std::shared_ptr<const Mesh> mesh);
+  void set_mpfem(int deriv, int ngauss);
+  // True after an MPFEM setup whose supports satisfy 004 eq 13 (Kronecker delta).
+  bool interpolating() const { return method_ == MFREE_METHOD_MPFEM && interpolating_; }
 
   // Build pattern and tables (positive failures reported, negative ones thrown).
   Report setup();
@@ -74,6 +84,7 @@ class Approximant {
   void validate_config() const;
   void build_pattern();
   Report compute(const char *what);
+  Report compute_mpfem();
   double site_x(int32_t s, int c) const;
   double site_h(int32_t s) const;
   int32_t site_particle(int32_t s) const { return points_ ? -1 : s; }
@@ -88,6 +99,10 @@ class Approximant {
   int order_;
   int flags_ = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
   int fallback_ = MFREE_FALLBACK_NONE;
+  std::shared_ptr<const Mesh> mesh_;
+  int mpfem_deriv_ = MFREE_MPFEM_DERIV_FULL;
+  int mpfem_ngauss_ = 8;
+  bool interpolating_ = false;
 
   // host points (sites), when set
   bool points_ = false;

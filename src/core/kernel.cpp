@@ -25,7 +25,7 @@ inline double tp(double p, int k) {
 }  // namespace
 
 bool Kernel::valid_id(int k) {
-  return k >= MFREE_KERNEL_CUBIC_SPLINE && k <= MFREE_KERNEL_QUARTIC_SPLINE;
+  return k >= MFREE_KERNEL_CUBIC_SPLINE && k <= MFREE_KERNEL_HAAR;
 }
 
 double Kernel::support_radius(int k, double param) {
@@ -37,6 +37,10 @@ double Kernel::support_radius(int k, double param) {
       return 3.0;
     case MFREE_KERNEL_QUARTIC_SPLINE:
       return 2.5;
+    case MFREE_KERNEL_COSINE:  // the MPFEM kernels of paper 004: width d = 2h
+    case MFREE_KERNEL_COSINE_SQUARED:
+    case MFREE_KERNEL_HAAR:
+      return 1.0;
     default:
       if (!valid_id(k)) throw Error(MFREE_ERR_ARG, "unknown kernel " + std::to_string(k));
       return 2.0;
@@ -189,6 +193,22 @@ void Kernel::shape(double q, double &f, double &df, double &d2f) const {
       d2f = 0.5;
       return;
     }
+    case MFREE_KERNEL_COSINE: {  // 004 eq 28 with the spec's correction: cos(pi t / d)
+      const double a = 0.5 * kPi;
+      f = std::cos(a * q);
+      df = -a * std::sin(a * q);
+      d2f = -a * a * f;
+      return;
+    }
+    case MFREE_KERNEL_COSINE_SQUARED: {  // (1 + cos(pi q)) / 2
+      f = 0.5 * (1.0 + std::cos(kPi * q));
+      df = -0.5 * kPi * std::sin(kPi * q);
+      d2f = -0.5 * kPi * kPi * std::cos(kPi * q);
+      return;
+    }
+    case MFREE_KERNEL_HAAR:  // closed box: 1 up to and including q = 1
+      f = 1.0;
+      return;
     default:
       return;
   }
