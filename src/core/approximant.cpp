@@ -360,9 +360,10 @@ Report Approximant::compute(const char *what) {
       in.vol = w.v.data();
       in.h = w.h.data();
       LocalOutput out;
-      out.phi = fv ? &val_[k0] : nullptr;
-      out.grad = fg ? &grad_[k0 * dim] : nullptr;
-      out.hess = fh ? &hess_[k0 * nh] : nullptr;
+      // data() + offset, not &v[k]: the tables are empty when no site has a neighbour
+      out.phi = fv ? val_.data() + k0 : nullptr;
+      out.grad = fg ? grad_.data() + k0 * dim : nullptr;
+      out.hess = fh ? hess_.data() + k0 * nh : nullptr;
       cfg.method = method_;
       cfg.order = order_;
       compute_site(cfg, in, w.work, out);
