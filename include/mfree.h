@@ -962,6 +962,19 @@ MFREE_API mfree_status_t mfree_system_set_walls(mfree_system_t *sys, int32_t nwa
 MFREE_API mfree_status_t mfree_system_set_box(mfree_system_t *sys, const double *lo,
                                               const double *hi);
 
+/**
+ * Shepard fallback of the fluid (003 Sect. 6): at every evaluation, the particles whose
+ * linear MLS moment matrix has a condition estimate above max_cond use Shepard functions
+ * N_j = W_j V_j / sum_k W_k V_k (constant basis) instead; singular sites always do. The
+ * paper gives no tolerance. Default 100: lattice sites estimate 10-15, free edges and
+ * corners 30-60, while particles left in thin sheets climb past 1e3 within a few steps and
+ * their gradients then drive densities negative (dam break, T ~ 2.2). Pass INFINITY for
+ * singular sites only, 1 for Shepard functions everywhere (no linear consistency).
+ * @param[in] max_cond  >= 1 (NaN or below 1: MFREE_ERR_ARG)
+ */
+MFREE_API mfree_status_t mfree_system_set_shepard_condition(mfree_system_t *sys,
+                                                            double max_cond);
+
 /** Length of the state vector. */
 MFREE_API mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq);
 /** ydot = f(t, y) (y and ydot borrowed for the call). Non-finite or out-of-range state
@@ -1017,6 +1030,27 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx,
                                                            mfree_assembler_t *as,
                                                            double density,
                                                            mfree_system_t **sys);
+/**
+ * Linear elastodynamics by Galerkin with any approximant: M u'' = g(t) f - K u, K and f
+ * from a set-up Galerkin assembler (MFREE_FORM_LAPLACE with c = E for the 1D bar
+ * rho u'' = E u'', or an MFREE_FORM_ELASTICITY_* form; tractions, body forces, penalty or
+ * Nitsche terms as assembled; the load history g(t) scales the whole load vector), M
+ * from a set-up mass assembler on the same particles (MFREE_FORM_MASS, consistent, or
+ * MFREE_FORM_MASS_LUMPED; coefficient = density; Bubnov). Unknowns whose rows a node
+ * condition replaced (mfree_assembler_add_dirichlet_nodes, FE layer) are constraints as
+ * in the collocation system; their mass couplings are dropped (exact for a lumped mass
+ * or constant boundary data). Lagrange multipliers are MFREE_ERR_UNSUPPORTED. State
+ * y: displacements then velocities (ncomp per particle each). Central differences
+ * (MFREE_INTEGRATOR_LEAPFROG) with the step limit 2 / omega_max of M^-1 K (lumped:
+ * Gershgorin's bound; consistent: power iteration plus 5 %); mfree_system_assemble_mass
+ * gives the identity and, in the velocity block, the mass the right-hand side divides
+ * by. The system keeps both assemblers alive. mfree_system_get_stress is
+ * MFREE_ERR_UNSUPPORTED: apply the trial approximant's gradient to the displacements.
+ */
+MFREE_API mfree_status_t mfree_system_create_elastodynamic_galerkin(mfree_context_t *ctx,
+                                                                    mfree_assembler_t *stiffness,
+                                                                    mfree_assembler_t *mass,
+                                                                    mfree_system_t **sys);
 MFREE_API mfree_status_t mfree_system_set_load_history(mfree_system_t *sys,
                                                        mfree_history_fn g, void *user);
 /** Stress at the particles (1D: sigma = E u'; 2D: xx, yy, xy), boundary constraints

@@ -202,11 +202,74 @@ static void test_failures(void **s) {
   mfree_system_destroy(&sys);
 }
 
+/* The Shepard fallback threshold (mfree_system_set_shepard_condition; 003 Sect. 6): on
+ * the lattice patch every site's condition estimate is below the default 100, so the
+ * interpolation matrix S_kj = N_j(x_k) reproduces linear fields (MLS, to round-off) and
+ * equals the one with the threshold at infinity; with threshold 1 every row is a Shepard
+ * row: non-negative, summing to 1, and no longer linear at the patch's edges. */
+static double linear_error(mfree_matrix_t *S, const double *y, double *rowsum_err, double *minval) {
+  const int64_t *rp;
+  const int32_t *ci;
+  const double *v;
+  assert_ok(ctx, mfree_matrix_get_csr(S, &rp, &ci, &v));
+  double err = 0.0;
+  *rowsum_err = 0.0;
+  *minval = 1e300;
+  for (int k = 0; k < N; ++k) {
+    double sx = 0.0, sz = 0.0, s1 = 0.0;
+    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
+      sx += v[e] * y[2 * ci[e]];
+      sz += v[e] * y[2 * ci[e] + 1];
+      s1 += v[e];
+      *minval = fmin(*minval, v[e]);
+    }
+    err = fmax(err, fmax(fabs(sx - y[2 * k]), fabs(sz - y[2 * k + 1])));
+    *rowsum_err = fmax(*rowsum_err, fabs(s1 - 1.0));
+  }
+  return err;
+}
+
+static void test_shepard_condition(void **s) {
+  (void)s;
+  double m[N];
+  double *y = patch(m, 0, 1);
+  mfree_system_t *sys = fluid(m, NZ * D, 0.0, 1);
+  assert_error(ctx, mfree_system_set_shepard_condition(sys, 0.5), MFREE_ERR_ARG, "Shepard");
+  assert_error(ctx, mfree_system_set_shepard_condition(sys, NAN), MFREE_ERR_ARG, "Shepard");
+  mfree_matrix_t *S = NULL, *Sinf = NULL, *S1 = NULL;
+  double rs, mn;
+  assert_ok(ctx, mfree_system_assemble_interpolation(sys, y, &S)); /* default 100 */
+  const double e_default = linear_error(S, y, &rs, &mn);
+  assert_true(e_default < 1e-12 * NX * D);
+  assert_true(mn < 0.0); /* MLS rows at the edges have negative entries */
+  assert_ok(ctx, mfree_system_set_shepard_condition(sys, INFINITY));
+  assert_ok(ctx, mfree_system_assemble_interpolation(sys, y, &Sinf));
+  const int64_t *rp, *rp2;
+  const int32_t *ci, *ci2;
+  const double *v, *v2;
+  assert_ok(ctx, mfree_matrix_get_csr(S, &rp, &ci, &v));
+  assert_ok(ctx, mfree_matrix_get_csr(Sinf, &rp2, &ci2, &v2));
+  assert_memory_equal(rp, rp2, (N + 1) * sizeof(int64_t));
+  assert_memory_equal(v, v2, (size_t)rp[N] * sizeof(double));
+  assert_ok(ctx, mfree_system_set_shepard_condition(sys, 1.0));
+  assert_ok(ctx, mfree_system_assemble_interpolation(sys, y, &S1));
+  const double e_shepard = linear_error(S1, y, &rs, &mn);
+  assert_true(rs < 1e-14);
+  assert_true(mn >= 0.0);
+  assert_true(e_shepard > 0.1 * D); /* edge rows pull towards the interior */
+  mfree_matrix_destroy(&S);
+  mfree_matrix_destroy(&Sinf);
+  mfree_matrix_destroy(&S1);
+  mfree_system_destroy(&sys);
+  free(y);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_conservation),
       cmocka_unit_test(test_hydrostatic_interior),
       cmocka_unit_test(test_failures),
+      cmocka_unit_test(test_shepard_condition),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -1139,6 +1139,13 @@ module mfree
       type(c_ptr), value :: nsteps
     end function mfree_system_integrate_c
 
+    integer(c_int) function mfree_system_set_shepard_condition_c(sys, max_cond) &
+        bind(C, name="mfree_system_set_shepard_condition")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), value :: max_cond
+    end function mfree_system_set_shepard_condition_c
+
     integer(c_int) function mfree_system_create_elastodynamic_c(ctx, as, density, sys) &
         bind(C, name="mfree_system_create_elastodynamic")
       import :: c_int, c_double, c_ptr
@@ -1147,6 +1154,15 @@ module mfree
       real(c_double), value :: density
       type(c_ptr), intent(out) :: sys
     end function mfree_system_create_elastodynamic_c
+
+    integer(c_int) function mfree_system_create_elastodynamic_galerkin_c(ctx, stiffness, mass, sys) &
+        bind(C, name="mfree_system_create_elastodynamic_galerkin")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ctx
+      type(c_ptr), value :: stiffness
+      type(c_ptr), value :: mass
+      type(c_ptr), intent(out) :: sys
+    end function mfree_system_create_elastodynamic_galerkin_c
 
     integer(c_int) function mfree_system_set_load_history_c(sys, g, user) &
         bind(C, name="mfree_system_set_load_history")
@@ -1222,6 +1238,8 @@ module mfree
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
   public :: mfree_system_create_elastodynamic_c, mfree_system_set_load_history_c
+  public :: mfree_system_create_elastodynamic_galerkin_c
+  public :: mfree_system_set_shepard_condition_c
   public :: mfree_system_get_stress_c
 
   ! ---- per-particle scalars and point supports: an array, or one value (stride 0) -----
@@ -1296,6 +1314,8 @@ module mfree
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
   public :: mfree_system_create_elastodynamic, mfree_system_set_load_history
+  public :: mfree_system_create_elastodynamic_galerkin
+  public :: mfree_system_set_shepard_condition
   public :: mfree_system_get_stress
 
   ! Targets of zero-length matrix views (a C view of an empty array may be NULL).
@@ -2490,6 +2510,21 @@ contains
     type(mfree_system), intent(out) :: sys
     st = mfree_system_create_elastodynamic_c(ctx%ptr, as%ptr, density, sys%ptr)
   end function mfree_system_create_elastodynamic
+
+  !> Condition threshold of the fluid's Shepard fallback (default 100).
+  integer(c_int) function mfree_system_set_shepard_condition(sys, max_cond) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: max_cond
+    st = mfree_system_set_shepard_condition_c(sys%ptr, max_cond)
+  end function mfree_system_set_shepard_condition
+
+  !> Galerkin elastodynamics M u'' = g(t) f - K u from a stiffness and a mass assembler.
+  integer(c_int) function mfree_system_create_elastodynamic_galerkin(ctx, stiffness, mass, sys) result(st)
+    type(mfree_context), intent(in) :: ctx
+    type(mfree_assembler), intent(in) :: stiffness, mass
+    type(mfree_system), intent(out) :: sys
+    st = mfree_system_create_elastodynamic_galerkin_c(ctx%ptr, stiffness%ptr, mass%ptr, sys%ptr)
+  end function mfree_system_create_elastodynamic_galerkin
 
   !> Load history g(t) scaling the boundary data; absent g: back to the default 1.
   integer(c_int) function mfree_system_set_load_history(sys, g, user) result(st)

@@ -123,6 +123,10 @@ mfree_status_t mfree_system_set_box(mfree_system_t *sys, const double *lo, const
   MFREE_SYS_SETTER("mfree_system_set_box", f.set_box(lo, hi));
 }
 
+mfree_status_t mfree_system_set_shepard_condition(mfree_system_t *sys, double max_cond) {
+  MFREE_SYS_SETTER("mfree_system_set_shepard_condition", f.set_shepard_condition(max_cond));
+}
+
 mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
   return mfree::with_handle(sys, "mfree_system_get_size", [&](const mfree::System &f) {
     MFREE_REQUIRE(neq, MFREE_ERR_NULL, "output pointer is NULL");

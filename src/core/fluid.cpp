@@ -96,6 +96,13 @@ void FluidSystem::set_box(const double *lo, const double *hi) {
   box_ = true;
 }
 
+void FluidSystem::set_shepard_condition(double max_cond) {
+  if (std::isnan(max_cond) || !(max_cond >= 1.0))
+    throw Error(MFREE_ERR_ARG, "the Shepard condition threshold must be >= 1 (or +infinity), not " +
+                                   std::to_string(max_cond));
+  shepard_cond_ = max_cond;
+}
+
 void FluidSystem::check_ready() const {
   if (mass_.size() != static_cast<size_t>(n_)) throw Error(MFREE_ERR_STATE, "particle masses are not set");
   if (!(h_ > 0.0)) throw Error(MFREE_ERR_STATE, "the smoothing length is not set");
@@ -171,13 +178,14 @@ void FluidSystem::shepard_ill_conditioned() {
   // paper gives no tolerance. A lattice site has a condition estimate of 10-15, a free
   // edge or corner 30-60; a particle left in a thin sheet or strand climbs past 1e3 within
   // a few steps, and its gradients then drive the density negative in one step (dam
-  // break along the wall, T ~ 2.2, at every resolution and CFL number tried).
+  // break along the wall, T ~ 2.2, at every resolution and CFL number tried). Hence the
+  // default threshold 100 (mfree_system_set_shepard_condition).
   N_ = approx_->values();
   G_ = approx_->gradients();
   const auto &cond = approx_->site_cond();
   const auto &rp = approx_->rowptr();
   const auto &cols = approx_->cols();
-  constexpr double tol = 100.0;
+  const double tol = shepard_cond_;
   const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim_, 0.0);
   for (int32_t k = 0; k < n_; ++k) {
     if (!(cond[k] > tol)) continue;

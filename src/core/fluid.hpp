@@ -27,6 +27,8 @@ class FluidSystem : public System {
   void set_lumping(int lump);
   void set_walls(int32_t nwall, const double *x, const double *normals, double r0, double strength);
   void set_box(const double *lo, const double *hi);
+  // Sites whose moment-matrix condition estimate exceeds max_cond use Shepard functions.
+  void set_shepard_condition(double max_cond);
 
   int dim() const { return dim_; }
   int32_t size() const { return n_; }
@@ -63,6 +65,7 @@ class FluidSystem : public System {
   std::unique_ptr<ParticleSet> walls_;
   std::vector<double> wall_n_;
   double r0_ = 0.0, strength_ = 0.0;
+  double shepard_cond_ = 100.0;
   bool box_ = false;
   double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
 
