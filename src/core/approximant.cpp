@@ -333,6 +333,9 @@ Report Approximant::compute(const char *what) {
     w.work.reserve(maxrow, dim, maxL);
   }
   const auto &pst = ps_->site_status();
+  bool periodic = false;
+  for (int c = 0; c < dim; ++c) periodic = periodic || ps_->periodic(c);
+  const bool gather = ps_->search_convention() == MFREE_SEARCH_GATHER;
   parallel_blocks(nsites_, nt, [&](int t, int64_t b, int64_t e) {
     SiteScratch &w = scratch_[t];
     LocalConfig cfg = base;
@@ -344,13 +347,19 @@ Report Approximant::compute(const char *what) {
       }
       const int64_t k0 = rowptr_[s];
       const int n = static_cast<int>(rowptr_[s + 1] - k0);
+      // x_j - x_s as site_displacement computes it, with the site's data hoisted
+      double xs[3] = {0, 0, 0};
+      for (int c = 0; c < dim; ++c) xs[c] = site_x(s, c);
+      const double hs = site_h(s);
       for (int q = 0; q < n; ++q) {
         const int32_t j = cols_[k0 + q];
         double *d = &w.d[3 * static_cast<size_t>(q)];
         d[0] = d[1] = d[2] = 0.0;
-        site_displacement(s, j, d);
+        if (periodic) site_displacement(s, j, d);
+        else
+          for (int c = 0; c < dim; ++c) d[c] = ps_->x(j, c) - xs[c];
         w.v[q] = have_vol ? ps_->volume(j) : 1.0;
-        w.h[q] = pair_h(s, j);
+        w.h[q] = gather ? hs : pair_h(s, j);
       }
       LocalInput in;
       in.n = n;

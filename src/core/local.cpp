@@ -153,11 +153,37 @@ bool check_rcond(Site &s, const Solver &solver) {
 // and live in registers and on the stack; M and its first derivatives M_,i (symmetric,
 // like M) are accumulated in one pass over the neighbours from the lower triangle of
 // p p^T, computed once per neighbour.
-template <int L>
+// The complete basis of order <= 2 in the order of Basis (1; s_i; s_i^2; s1 s2, s2 s3,
+// s3 s1) written out for a compile-time dimension; higher orders use Basis::eval.
+template <int D, int L>
+inline void eval_basis(const Basis &B, const double *sj, double *p) {
+  if (L == 1) {
+    p[0] = 1.0;
+  } else if (L == D + 1) {
+    p[0] = 1.0;
+    for (int c = 0; c < D; ++c) p[1 + c] = sj[c];
+  } else if (L == (D + 1) * (D + 2) / 2) {
+    p[0] = 1.0;
+    for (int c = 0; c < D; ++c) {
+      p[1 + c] = sj[c];
+      p[1 + D + c] = sj[c] * sj[c];
+    }
+    if (D >= 2) p[1 + 2 * D] = sj[0] * sj[1];
+    if (D >= 3) {
+      p[2 + 2 * D] = sj[1] * sj[2];
+      p[3 + 2 * D] = sj[2] * sj[0];
+    }
+  } else {
+    B.eval(sj, p);
+  }
+}
+
+template <int D, int L>
 int mls_fixed(Site &s, const Basis &B, bool rkpm) {
   using MatL = Eigen::Matrix<double, L, L>;
   using VecL = Eigen::Matrix<double, L, 1>;
-  const int dim = s.dim, n = s.n;
+  constexpr int dim = D;
+  const int n = s.n;
   const double ih = 1.0 / s.in.hs;
   const bool deriv = s.cfg.want_grad || s.cfg.want_hess;
   double *P = s.w.p.data();
@@ -165,30 +191,37 @@ int mls_fixed(Site &s, const Basis &B, bool rkpm) {
   auto domega = [&](int j, int c) { return rkpm ? s.gw(j)[c] * s.in.vol[j] : s.gw(j)[c]; };
   auto ddomega = [&](int j, int e) { return rkpm ? s.hw(j)[e] * s.in.vol[j] : s.hw(j)[e]; };
 
-  MatL M = MatL::Zero(), Mi[3] = {MatL::Zero(), MatL::Zero(), MatL::Zero()};
+  // lower triangles of M and M_,i in local accumulators (no aliasing with the
+  // neighbour arrays, so that they can stay in registers for small L)
+  constexpr int T = L * (L + 1) / 2;
+  double m0[T] = {0}, mi[D][T] = {{0}};
   for (int j = 0; j < n; ++j) {
     double sj[3] = {0, 0, 0};
     for (int c = 0; c < dim; ++c) sj[c] = s.d(j)[c] * ih;
-    double *p = P + j * L;
-    B.eval(sj, p);
+    double pl[L];
+    eval_basis<D, L>(B, sj, pl);
+    std::copy(pl, pl + L, P + j * L);
     const double o = omega(j);
-    double od[3] = {0, 0, 0};
-    bool any = o != 0.0;
-    if (deriv)
-      for (int c = 0; c < dim; ++c) {
-        od[c] = domega(j, c);
-        any = any || od[c] != 0.0;
-      }
-    if (!any) continue;
-    for (int a = 0; a < L; ++a)
-      for (int b = 0; b <= a; ++b) {
-        const double t = p[a] * p[b];
-        M(a, b) += o * t;
-        if (deriv)
-          for (int c = 0; c < dim; ++c) Mi[c](a, b) += od[c] * t;
-      }
+    if (deriv) {
+      double od[D];
+      for (int c = 0; c < D; ++c) od[c] = domega(j, c);
+      for (int a = 0, t = 0; a < L; ++a)
+        for (int b = 0; b <= a; ++b, ++t) {
+          const double pp = pl[a] * pl[b];
+          m0[t] += o * pp;
+          for (int c = 0; c < D; ++c) mi[c][t] += od[c] * pp;
+        }
+    } else if (o != 0.0) {
+      for (int a = 0, t = 0; a < L; ++a)
+        for (int b = 0; b <= a; ++b, ++t) m0[t] += o * (pl[a] * pl[b]);
+    }
   }
-  M.template triangularView<Eigen::StrictlyUpper>() = M.transpose();
+  MatL M, Mi[D];
+  for (int a = 0, t = 0; a < L; ++a)
+    for (int b = 0; b <= a; ++b, ++t) {
+      M(a, b) = M(b, a) = m0[t];
+      for (int c = 0; c < D; ++c) Mi[c](a, b) = Mi[c](b, a) = mi[c][t];
+    }
   Eigen::LDLT<MatL> ldlt(M);
   if (ldlt.info() != Eigen::Success || !check_rcond(s, ldlt)) return MFREE_FAIL_SINGULAR;
 
@@ -206,14 +239,16 @@ int mls_fixed(Site &s, const Basis &B, bool rkpm) {
       for (int j = 0; j < n; ++j) s.out.phi[j] = omega(j) * dot(g, j);
     return 0;
   }
-  VecL gi[3];
+  // the D derivative systems share the factorisation: one solve with D right-hand sides
+  Eigen::Matrix<double, L, D> rhs;
   for (int i = 0; i < dim; ++i) {
-    Mi[i].template triangularView<Eigen::StrictlyUpper>() = Mi[i].transpose();
-    VecL rhs = -(Mi[i] * g);
+    rhs.col(i) = -(Mi[i] * g);
     const int li = B.linear(i);
-    if (li >= 0 && li < L) rhs(li) += ih;
-    gi[i] = ldlt.solve(rhs);
+    if (li >= 0 && li < L) rhs(li, i) += ih;
   }
+  const Eigen::Matrix<double, L, D> gsol = ldlt.solve(rhs);
+  VecL gi[D];
+  for (int i = 0; i < dim; ++i) gi[i] = gsol.col(i);
   for (int j = 0; j < n; ++j) {
     const double gp = dot(g, j), o = omega(j);
     if (s.cfg.want_value) s.out.phi[j] = o * gp;
@@ -246,14 +281,19 @@ int mls_fixed(Site &s, const Basis &B, bool rkpm) {
 int mls(Site &s, int order, bool rkpm) {
   const Basis B(s.dim, order);
   if (s.out.support < B.size()) return MFREE_FAIL_NEIGHBORS;
-  switch (B.size()) {  // basis_size(dim, order) for dim 1..3, order 0..3
-    case 1: return mls_fixed<1>(s, B, rkpm);
-    case 2: return mls_fixed<2>(s, B, rkpm);
-    case 3: return mls_fixed<3>(s, B, rkpm);
-    case 4: return mls_fixed<4>(s, B, rkpm);
-    case 6: return mls_fixed<6>(s, B, rkpm);
-    case 10: return mls_fixed<10>(s, B, rkpm);
-    case 20: return mls_fixed<20>(s, B, rkpm);
+  switch (s.dim * 100 + B.size()) {  // basis_size(dim, order) for dim 1..3, order 0..3
+    case 101: return mls_fixed<1, 1>(s, B, rkpm);
+    case 102: return mls_fixed<1, 2>(s, B, rkpm);
+    case 103: return mls_fixed<1, 3>(s, B, rkpm);
+    case 104: return mls_fixed<1, 4>(s, B, rkpm);
+    case 201: return mls_fixed<2, 1>(s, B, rkpm);
+    case 203: return mls_fixed<2, 3>(s, B, rkpm);
+    case 206: return mls_fixed<2, 6>(s, B, rkpm);
+    case 210: return mls_fixed<2, 10>(s, B, rkpm);
+    case 301: return mls_fixed<3, 1>(s, B, rkpm);
+    case 304: return mls_fixed<3, 4>(s, B, rkpm);
+    case 310: return mls_fixed<3, 10>(s, B, rkpm);
+    case 320: return mls_fixed<3, 20>(s, B, rkpm);
     default: return MFREE_FAIL_SINGULAR;
   }
 }
