@@ -147,6 +147,7 @@ static int read_data(const char *path, double *T, double *Z, int cap) {
 typedef struct {
   int quiet, last;
   double t0, t1;
+  int64_t base; /* steps of earlier integrate calls */
 } progress_t;
 
 static int32_t progress_cb(void *user, int64_t step, double t, double dt) {
@@ -158,7 +159,7 @@ static int32_t progress_cb(void *user, int64_t step, double t, double dt) {
     p->last = pct;
     const int w = 40, fill = pct * w / 100;
     fprintf(stderr, "\r[%.*s%*s] %3d%%  t = %.4f s  step %lld", fill,
-            "########################################", w - fill, "", pct, t, (long long)step);
+            "########################################", w - fill, "", pct, t, (long long)(p->base + step));
     fflush(stderr);
   }
   return 0;
@@ -293,7 +294,7 @@ int main(int argc, char **argv) {
   double t = 0.0, next_vtu = 0.0;
   int64_t steps = 0;
   mfree_status_t run = MFREE_SUCCESS;
-  progress_t prog = {o.quiet, -1, 0.0, o.t_end / tscale};
+  progress_t prog = {o.quiet, -1, 0.0, o.t_end / tscale, 0};
   struct timespec c0, c1;
   clock_gettime(CLOCK_MONOTONIC, &c0);
   for (int io = 0; io <= nout; ++io) {
@@ -303,6 +304,7 @@ int main(int argc, char **argv) {
       run = mfree_system_integrate(sys, (mfree_integrator_t)o.scheme, y, &t, T_target / tscale, o.cfl, 0.0,
                                    progress_cb, &prog, &ns_);
       steps += ns_;
+      prog.base = steps;
       if (run != MFREE_SUCCESS) break;
     }
     double xmax = -1e300, xfloor = -1e300;
