@@ -17,10 +17,12 @@
  * (the same growth at CFL 0.5, 0.25 and 0.1, so eigenvalues of the semi-discrete system
  * with positive real part, not a step-size instability): the first 10 us still meet the
  * speed and amplitude targets, but the state explodes after the reflection. h = 1.2 dx
- * stays bounded to 300 us. The paper reports only the 1D bar. */
+ * stays bounded to 300 us. The paper reports only the 1D bar. test_blow_up uses that
+ * instability for the bad-input case "non-finite state produced by a blow-up". */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "testutil.h"
 
@@ -49,9 +51,9 @@ typedef struct {
   mfree_system_t *sys;
 } bar_t;
 
-static bar_t make_bar(void) {
+static bar_t make_bar_h(double hfac) {
   bar_t b;
-  const double dx = L / (NX - 1), h = 1.2 * dx, vol = dx * dx;
+  const double dx = L / (NX - 1), h = hfac * dx, vol = dx * dx;
   int32_t nodes[N];
   double nrm[2 * N];
   int nb = 0;
@@ -88,6 +90,8 @@ static bar_t make_bar(void) {
   assert_ok(ctx, mfree_system_set_load_history(b.sys, pulse, NULL));
   return b;
 }
+
+static bar_t make_bar(void) { return make_bar_h(1.2); }
 
 static void free_bar(bar_t *b) {
   mfree_system_destroy(&b->sys);
@@ -171,9 +175,49 @@ static void test_wave(void **s) {
   free_bar(&b);
 }
 
+/* A genuine blow-up (issue 5, bad input): with h = 1.5 dx the strip's growing modes
+ * overflow the state after some 15000 steps. The integration stops with
+ * MFREE_FAIL_NONFINITE naming the step and the particle, and y, t hold the last good
+ * (finite) state, from which a rerun reproduces the same failure at the same step. */
+static void test_blow_up(void **s) {
+  (void)s;
+  bar_t b = make_bar_h(1.5);
+  double *y = calloc(4 * N, sizeof(double)), *y2 = calloc(4 * N, sizeof(double)), t = 0.0, t2 = 0.0;
+  int64_t ns = 0, ns2 = 0;
+  const double t_end = 5e-3;
+  assert_error(ctx, mfree_system_integrate(b.sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, t_end, 0.5, 0.0, NULL, NULL, &ns),
+               MFREE_FAIL_NONFINITE, "particle");
+  char msg[512];
+  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  char expect[64];
+  snprintf(expect, sizeof expect, "step %lld:", (long long)(ns + 1));
+  if (!strstr(msg, expect)) fail_msg("message '%s' does not name %s", msg, expect);
+  printf("[ t705 ] h = 1.5 dx: %s (t = %.3f ms)\n", msg, t * 1e3);
+  assert_true(t > 120e-6 && t < t_end);
+  double big = 0.0;
+  for (int q = 0; q < 4 * N; ++q) {
+    assert_true(isfinite(y[q]));
+    big = fmax(big, fabs(y[q]));
+  }
+  assert_true(big > 1e100); /* it did grow without bound */
+  /* the kept state is the last good one: one more step from it fails again at once */
+  memcpy(y2, y, 4 * N * sizeof(double));
+  t2 = t;
+  assert_error(ctx,
+               mfree_system_integrate(b.sys, MFREE_INTEGRATOR_LEAPFROG, y2, &t2, t_end, 0.5, 0.0, NULL, NULL, &ns2),
+               MFREE_FAIL_NONFINITE, "step 1:");
+  assert_int_equal(ns2, 0);
+  assert_true(t2 == t);
+  assert_memory_equal(y2, y, 4 * N * sizeof(double));
+  free(y);
+  free(y2);
+  free_bar(&b);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_wave),
+      cmocka_unit_test(test_blow_up),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
