@@ -863,7 +863,10 @@ MFREE_API mfree_status_t mfree_assembler_add_dirichlet(mfree_assembler_t *as,
                                                        const double *normals,
                                                        int32_t component_mask,
                                                        mfree_field_fn g, void *user);
-/** Essential condition by row replacement at particles (MFREE_BC_COLLOCATION). */
+/** Essential condition by row replacement at particles (MFREE_BC_COLLOCATION): the row of
+ * each prescribed component becomes u^h(x_J) = g(x_J) with the trial values at the node;
+ * for the particles-only methods (symmetrised SPH, Johnson-Beissel, Randles-Libersky),
+ * whose derivatives act on the particle values, u_J = g(x_J) on the particle value. */
 MFREE_API mfree_status_t mfree_assembler_add_dirichlet_nodes(mfree_assembler_t *as,
                                                              int32_t nnodes,
                                                              const int32_t *nodes,

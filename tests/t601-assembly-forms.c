@@ -493,6 +493,52 @@ static void g_zero(void *u, const double *x, double *v) {
   v[0] = v[1] = 0.0;
 }
 
+static void lin_scalar2(void *u, const double *x, double *v) {
+  (void)u;
+  v[0] = 0.3 + 1.5 * x[0] - 0.7 * x[1];
+}
+
+/* Dirichlet rows for particles-only methods (symmetrised SPH, Johnson-Beissel,
+ * Randles-Libersky) impose u_J = g(x_J) on the particle value itself: the replaced rows
+ * are identity rows with g on the right-hand side (for the other methods they hold the
+ * trial values at the node). */
+static void test_particles_only_dirichlet(void **s) {
+  (void)s;
+  mfree_particles_t *ps = cloud(1.6);
+  const mfree_method_t methods[3] = {MFREE_METHOD_SPH_SYMMETRIC, MFREE_METHOD_JOHNSON_BEISSEL,
+                                     MFREE_METHOD_RANDLES_LIBERSKY};
+  for (int m = 0; m < 3; ++m) {
+    mfree_approximant_t *a = NULL;
+    assert_ok(ctx, mfree_approximant_create(ctx, ps, methods[m], &a));
+    mfree_assembler_t *as = NULL;
+    assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_LAPLACE, &as));
+    assert_ok(ctx, mfree_assembler_set_quadrature_nodal(as));
+    assert_ok(ctx, mfree_assembler_add_dirichlet_nodes(as, NB, BND, 1, lin_scalar2, NULL));
+    assert_ok(ctx, mfree_assembler_setup(as));
+    mfree_matrix_t *K = NULL;
+    assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+    double f[N];
+    assert_ok(ctx, mfree_assembler_assemble_rhs(as, f));
+    const int64_t *rp;
+    const int32_t *ci;
+    const double *v;
+    assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &v));
+    for (int b = 0; b < NB; ++b) {
+      const int32_t J = BND[b];
+      for (int64_t k = rp[J]; k < rp[J + 1]; ++k)
+        if (v[k] != (ci[k] == J ? 1.0 : 0.0))
+          fail_msg("method %d: row %d has %g in column %d", (int)methods[m], (int)J, v[k], (int)ci[k]);
+      double g;
+      lin_scalar2(NULL, X + 2 * J, &g);
+      assert_true(f[J] == g);
+    }
+    mfree_matrix_destroy(&K);
+    mfree_assembler_destroy(&as);
+    mfree_approximant_destroy(&a);
+  }
+  mfree_particles_destroy(&ps);
+}
+
 static void test_bad_input(void **s) {
   (void)s;
   mfree_particles_t *ps = cloud(1.6), *other = cloud(1.6);
@@ -587,6 +633,7 @@ int main(void) {
       cmocka_unit_test(test_efg_patch_nitsche),
       cmocka_unit_test(test_fe_layer_patch),
       cmocka_unit_test(test_refill_after_move),
+      cmocka_unit_test(test_particles_only_dirichlet),
       cmocka_unit_test(test_bad_input),
   };
   return cmocka_run_group_tests(tests, setup, teardown);

@@ -54,8 +54,9 @@ int es_bc_parse(const char *s, es_bc_t *bc) {
  *    SPH, JB, RL, CD1 (their gradients act on nodal values) but the test functions of
  *    the inner nodes do not vanish on Gamma_u, which leaves an O(1/h) residual there.
  *  - rows (mfree_assembler_add_dirichlet_nodes): u^h(x_J) = g(x_J) with the trial values,
- *    which are Shepard functions for SPH, JB, RL and KB Method 1: not linearly complete,
- *    so even a linear field is not imposed exactly.
+ *    which are Shepard functions for KB Method 1: not linearly complete, so even a linear
+ *    field is not imposed exactly; for SPH, JB and RL mfree imposes u_J = g(x_J) on the
+ *    particle values (the same as direct).
  *  - nitsche: not available for SPH, JB, RL (no functions between the particles); with
  *    Shepard test functions (CD1, CD2) it leaves a rigid rotation of the clamped end.
  *  - penalty, lagrange: on boundary Gauss points / at the boundary nodes. */

@@ -906,7 +906,10 @@ void Assembler::build_pattern() {
         for (int c = 0; c < nc; ++c) {
           if (ns.kind != 2 && !(ns.mask & (1 << c))) continue;
           const int32_t dof = ns.nodes[k] * nc + c;
-          row_kind_[dof] = ns.kind;
+          // Particles-only methods (symmetrised SPH, JB, RL) have no values between or at
+          // the particles beyond the particle values their derivatives act on: their
+          // Dirichlet rows hold u_J = g(x_J) on the parameter itself (identity rows).
+          row_kind_[dof] = ns.kind == 1 && is_particles_only(trial_cfg_.method) ? 3 : ns.kind;
           row_set_[dof] = static_cast<int32_t>(si);
           row_node_[dof] = static_cast<int32_t>(k);
         }
@@ -1150,8 +1153,6 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
     const NodeSet &ns = nsets_[row_set_[dof]];
     if (row_kind_[dof] == 3) {
       at(dof, dof) += 1.0;
-    } else if (row_kind_[dof] == 1 && tn->interpolating()) {
-      at(dof, dof) += 1.0;  // Kronecker delta (MPFEM, 004 Sect. 2.4): u_J = g(x_J) exactly
     } else if (row_kind_[dof] == 1) {
       for (int64_t b = tn->rowptr()[J]; b < tn->rowptr()[J + 1]; ++b)
         at(dof, tn->cols()[b] * nc + c) += tn->values()[b];

@@ -251,7 +251,7 @@ elseif(PROBLEM STREQUAL "hole")
   # 000 Table III, hole: SPH and JB "NC". On this quasi-uniform cloud (a regular grid cut
   # by the hole) their energy errors fall, slowly: SPH 0.76 (from 140 %), JB 0.47 (like
   # RL's 0.65), and so they do with every boundary treatment tried (direct 0.67/0.59,
-  # penalty 0.79/0.88, rows 0.69/0.67, Lagrange 0.76/0.56). On a jittered cloud all
+  # penalty 0.79/0.88, Lagrange 0.76/0.56). On a jittered cloud all
   # nodal-quadrature schemes stop converging, so that does not single them out either.
   # What holds: SPH has no useful accuracy (energy error above 50 % at every level), JB
   # improves on SPH (000 Sect. 6.2.3), and JB's error at the nodes (000 eq 114, the norm
