@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <sstream>
 
@@ -592,6 +593,96 @@ bool box_overlaps(const MeshGeometry &geo, int32_t e, const double *d0, double R
   return true;
 }
 
+
+// Uniform bucket grid over the elements' bounding boxes (absolute coordinates), so that
+// a site finds the elements its support box may reach without a sweep over the mesh.
+// Not used on periodic sets, whose elements are placed by nearest image.
+class ElementGrid {
+ public:
+  ElementGrid(const MeshGeometry &geo, const ParticleSet &ps) : dim_(geo.dim) {
+    const int32_t ne = geo.size();
+    lo_.assign(static_cast<size_t>(ne) * 3, 0.0);
+    hi_.assign(static_cast<size_t>(ne) * 3, 0.0);
+    double glo[3] = {0, 0, 0}, ghi[3] = {0, 0, 0}, ext = 0.0;
+    for (int32_t e = 0; e < ne; ++e)
+      for (int c = 0; c < dim_; ++c) {
+        const double x0 = ps.x(geo.nodes[geo.ptr[e]], c);
+        lo_[3 * e + c] = x0 + geo.lo[3 * e + c];
+        hi_[3 * e + c] = x0 + geo.hi[3 * e + c];
+        glo[c] = e ? std::min(glo[c], lo_[3 * e + c]) : lo_[3 * e + c];
+        ghi[c] = e ? std::max(ghi[c], hi_[3 * e + c]) : hi_[3 * e + c];
+        ext += hi_[3 * e + c] - lo_[3 * e + c];
+      }
+    ext = ne ? ext / (static_cast<double>(ne) * dim_) : 1.0;
+    int64_t cells = 1;
+    for (int c = 0; c < dim_; ++c) {
+      org_[c] = glo[c];
+      const double span = ghi[c] - glo[c];
+      n_[c] = static_cast<int32_t>(std::min(1024.0, std::max(1.0, std::floor(span / std::max(ext, 1e-300)))));
+      cs_[c] = span > 0.0 ? span / n_[c] : 1.0;
+      cells *= n_[c];
+    }
+    start_.assign(static_cast<size_t>(cells) + 1, 0);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int32_t e = 0; e < ne; ++e) {
+        int32_t a[3], b[3];
+        range(&lo_[3 * e], &hi_[3 * e], a, b);
+        for (int32_t k = a[2]; k <= b[2]; ++k)
+          for (int32_t j = a[1]; j <= b[1]; ++j)
+            for (int32_t i = a[0]; i <= b[0]; ++i) {
+              const int64_t cell = (static_cast<int64_t>(k) * n_[1] + j) * n_[0] + i;
+              if (pass == 0) ++start_[cell + 1];
+              else elems_[fill_[cell]++] = e;
+            }
+      }
+      if (pass == 0) {
+        for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+        elems_.assign(static_cast<size_t>(start_.back()), 0);
+        fill_.assign(start_.begin(), start_.end() - 1);
+      }
+    }
+    stamp_.assign(ne, -1);
+  }
+  // Elements whose box may overlap [x - r, x + r], ascending, each once.
+  void query(const double *x, double r, int32_t tag, std::vector<int32_t> &out) {
+    out.clear();
+    double qlo[3] = {0, 0, 0}, qhi[3] = {0, 0, 0};
+    for (int c = 0; c < dim_; ++c) qlo[c] = x[c] - r, qhi[c] = x[c] + r;
+    int32_t a[3], b[3];
+    range(qlo, qhi, a, b);
+    for (int32_t k = a[2]; k <= b[2]; ++k)
+      for (int32_t j = a[1]; j <= b[1]; ++j)
+        for (int32_t i = a[0]; i <= b[0]; ++i) {
+          const int64_t cell = (static_cast<int64_t>(k) * n_[1] + j) * n_[0] + i;
+          for (int64_t q = start_[cell]; q < start_[cell + 1]; ++q) {
+            const int32_t e = elems_[q];
+            if (stamp_[e] == tag) continue;
+            stamp_[e] = tag;
+            out.push_back(e);
+          }
+        }
+    std::sort(out.begin(), out.end());
+  }
+
+ private:
+  void range(const double *lo, const double *hi, int32_t *a, int32_t *b) const {
+    for (int c = 0; c < 3; ++c) {
+      if (c >= dim_) {
+        a[c] = b[c] = 0;
+        continue;
+      }
+      const double fa = std::floor((lo[c] - org_[c]) / cs_[c]), fb = std::floor((hi[c] - org_[c]) / cs_[c]);
+      a[c] = static_cast<int32_t>(std::min<double>(n_[c] - 1, std::max(0.0, fa)));
+      b[c] = static_cast<int32_t>(std::min<double>(n_[c] - 1, std::max(0.0, fb)));
+    }
+  }
+  int dim_;
+  double org_[3] = {0, 0, 0}, cs_[3] = {1, 1, 1};
+  int32_t n_[3] = {1, 1, 1};
+  std::vector<double> lo_, hi_;
+  std::vector<int64_t> start_, fill_;
+  std::vector<int32_t> elems_, stamp_;
+};
 }  // namespace
 
 void Approximant::set_mesh(std::shared_ptr<const Mesh> mesh) {
@@ -665,7 +756,11 @@ Report Approximant::compute_mpfem() {
 
   const bool full = mode == MFREE_MPFEM_DERIV_FULL;
   const bool d1 = full && (fg || fh), d2 = full && fh;
-  std::vector<int32_t> cand;
+  std::vector<int32_t> cand, near;
+  bool periodic = false;
+  for (int c = 0; c < dim; ++c) periodic = periodic || ps_->periodic(c);
+  std::unique_ptr<ElementGrid> grid;
+  if (!periodic && ne > 0) grid = std::make_unique<ElementGrid>(geo, *ps_);
   std::vector<ElemWeight> ew;
   std::vector<double> dfirst;
   std::vector<int32_t> rnode;
@@ -696,7 +791,14 @@ Report Approximant::compute_mpfem() {
         dfirst.insert(dfirst.end(), d, d + 3);
       }
     } else {
-      for (int32_t e = 0; e < ne; ++e) {
+      if (grid) {
+        double xs[3] = {0, 0, 0};
+        for (int c = 0; c < dim; ++c) xs[c] = site_x(s, c);
+        grid->query(xs, Rh, s, near);
+      }
+      const int32_t nscan = grid ? static_cast<int32_t>(near.size()) : ne;
+      for (int32_t i = 0; i < nscan; ++i) {
+        const int32_t e = grid ? near[i] : i;
         double d[3] = {0, 0, 0};
         site_displacement(s, geo.nodes[geo.ptr[e]], d);
         if (!box_overlaps(geo, e, d, Rh)) continue;
@@ -810,7 +912,14 @@ Report Approximant::compute_mpfem() {
       if (geo.node_ptr[P] == geo.node_ptr[P + 1] || pst[P] != 0) continue;
       const double h = ps_->h(P), Rh = K.radius() * h;
       bool bad = false;
-      for (int32_t e = 0; e < ne && !bad; ++e) {
+      if (grid) {
+        double xp[3] = {0, 0, 0};
+        for (int c = 0; c < dim; ++c) xp[c] = ps_->x(P, c);
+        grid->query(xp, Rh, nsites_ + P, near);
+      }
+      const int32_t nscan = grid ? static_cast<int32_t>(near.size()) : ne;
+      for (int32_t i = 0; i < nscan && !bad; ++i) {
+        const int32_t e = grid ? near[i] : i;
         bool mine = false;
         for (int32_t k = geo.ptr[e]; k < geo.ptr[e + 1]; ++k) mine = mine || geo.nodes[k] == P;
         if (mine) continue;
