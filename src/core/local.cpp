@@ -103,6 +103,7 @@ int shepard(Site &s, bool write) {
     phi[j] = wj * iS;
     const double *g = s.gw(j);
     for (int c = 0; c < dim; ++c) gphi[3 * j + c] = g[c] * iS - wj * gS[c] * iS * iS;
+    if (!s.cfg.want_hess) continue;  // only the Hessian row reads hphi
     const double *H = s.hw(j);
     for (int a = 0; a < dim; ++a)
       for (int b = a; b < dim; ++b) {
@@ -406,17 +407,33 @@ int msph(Site &s, int order) {
 // Derivative corrections with alpha = A^-T (spec 000 sections 4.6, 4.8, 4.9):
 // A_ab = sum_j p_a(j) q_b(j); the corrected functions are (A^-T q_j)_k. p and q are
 // n x m arrays; writes C = A^-T into coef (m x m, row-major).
-int correction(Site &s, int m, const double *p, const double *q, double *coef) {
-  Mat A = Mat::Zero(m, m);
+// (m is 1..4: a compile-time size keeps A and its LU in registers.)
+template <int M>
+int correction_fixed(Site &s, const double *p, const double *q, double *coef) {
+  using MatM = Eigen::Matrix<double, M, M>;
+  double acc[M][M] = {{0}};
   for (int j = 0; j < s.n; ++j)
-    for (int a = 0; a < m; ++a)
-      for (int b = 0; b < m; ++b) A(a, b) += p[j * m + a] * q[j * m + b];
-  Eigen::PartialPivLU<Mat> lu(A);
+    for (int a = 0; a < M; ++a)
+      for (int b = 0; b < M; ++b) acc[a][b] += p[j * M + a] * q[j * M + b];
+  MatM A;
+  for (int a = 0; a < M; ++a)
+    for (int b = 0; b < M; ++b) A(a, b) = acc[a][b];
+  Eigen::PartialPivLU<MatM> lu(A);
   if (!check_rcond(s, lu)) return MFREE_FAIL_SINGULAR;
-  const Mat C = lu.inverse().transpose();
-  for (int a = 0; a < m; ++a)
-    for (int b = 0; b < m; ++b) coef[a * m + b] = C(a, b);
+  const MatM C = lu.inverse().transpose();
+  for (int a = 0; a < M; ++a)
+    for (int b = 0; b < M; ++b) coef[a * M + b] = C(a, b);
   return 0;
+}
+
+int correction(Site &s, int m, const double *p, const double *q, double *coef) {
+  switch (m) {
+    case 1: return correction_fixed<1>(s, p, q, coef);
+    case 2: return correction_fixed<2>(s, p, q, coef);
+    case 3: return correction_fixed<3>(s, p, q, coef);
+    case 4: return correction_fixed<4>(s, p, q, coef);
+    default: return MFREE_FAIL_SINGULAR;
+  }
 }
 
 void sph_values(Site &s) {
