@@ -1153,6 +1153,8 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
     const NodeSet &ns = nsets_[row_set_[dof]];
     if (row_kind_[dof] == 3) {
       at(dof, dof) += 1.0;
+    } else if (row_kind_[dof] == 1 && tn->interpolating()) {
+      at(dof, dof) += 1.0;  // Kronecker delta (MPFEM, 004 Sect. 2.4): u_J = g(x_J) exactly
     } else if (row_kind_[dof] == 1) {
       for (int64_t b = tn->rowptr()[J]; b < tn->rowptr()[J + 1]; ++b)
         at(dof, tn->cols()[b] * nc + c) += tn->values()[b];
