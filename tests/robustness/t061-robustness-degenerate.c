@@ -266,9 +266,72 @@ static void test_degenerate_matrix(void **state) {
   if (findings) fail_msg("%d findings (listed above)", findings);
 }
 
+/* Host points (sites that are not particles) at degenerate places: far from every
+ * particle (no neighbour at all: it fails even with the fallback, and is reported), on top
+ * of a particle, and with a support below the spacing. Every method that takes points. */
+static void test_degenerate_points(void **state) {
+  (void)state;
+  assert_ok(NULL, mfree_context_create(&ctx));
+  enum { K = 16, P = 4 };
+  double x[2 * K];
+  for (int p = 0; p < K; ++p) x[2 * p] = 0.1 * (p % 4), x[2 * p + 1] = 0.1 * (p / 4);
+  const double h = 0.15, vol = 0.01;
+  const double px[2 * P] = {7.0, 7.0, 0.1, 0.1, 0.15, 0.15, 0.305, 0.005};
+  const double ph[P] = {0.15, 0.15, 0.15, 0.01};
+  mfree_particles_t *ps = NULL;
+  assert_ok(ctx, mfree_particles_create(ctx, 2, K, &ps));
+  assert_ok(ctx, mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, 2, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_volumes(ps, &vol, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_support(ps, &h, 0, MFREE_COPY));
+  int tried = 0;
+  for (size_t mi = 0; mi < sizeof METHODS / sizeof METHODS[0]; ++mi)
+    for (int fb = 0; fb < 2; ++fb) {
+      const method_t *m = &METHODS[mi];
+      const config_t cc = {"host points", 2, K, {0}, h}, *c = &cc;
+      mfree_approximant_t *a = NULL;
+      assert_ok(ctx, mfree_approximant_create(ctx, ps, m->method, &a));
+      if (m->order >= 0) assert_ok(ctx, mfree_approximant_set_order(a, m->order));
+      if (fb) assert_ok(ctx, mfree_approximant_set_fallback(a, MFREE_FALLBACK_LOWER_ORDER));
+      if (mfree_approximant_set_points(a, P, px, MFREE_LAYOUT_AOS, 2, ph, 1, MFREE_COPY) !=
+          MFREE_SUCCESS) { /* particles-only methods */
+        mfree_approximant_destroy(&a);
+        continue;
+      }
+      ++tried;
+      const mfree_status_t st = mfree_approximant_setup(a);
+      CHECK(st > 0, "setup returned %d, expected a positive status (point 0 sees nothing)", (int)st);
+      int32_t sst[P], nf = 0;
+      assert_ok(ctx, mfree_approximant_get_site_status(a, sst, &nf));
+      CHECK(sst[0] != 0, "the isolated point is not reported");
+      int64_t nnz = 0, rp[P + 1];
+      assert_ok(ctx, mfree_approximant_get_nnz(a, &nnz));
+      int32_t *cols = malloc((size_t)(nnz + 1) * sizeof *cols);
+      double *vals = malloc((size_t)(nnz + 1) * sizeof *vals);
+      assert_ok(ctx, mfree_approximant_assemble_csr(a, MFREE_DERIV_GRADIENT, 0, rp, cols, vals));
+      CHECK(all_finite(vals, nnz), "non-finite gradient entry");
+      for (int i = 0; i < P; ++i)
+        if (sst[i])
+          for (int64_t k = rp[i]; k < rp[i + 1]; ++k) CHECK(vals[k] == 0.0, "failed point %d: %g", i, vals[k]);
+      if (fb)
+        for (int i = 1; i < P; ++i) CHECK(sst[i] == 0, "point %d fails despite the fallback", i);
+      free(cols), free(vals);
+      double u[K], out[2 * P];
+      for (int p = 0; p < K; ++p) u[p] = 1.0 + x[2 * p] - x[2 * p + 1];
+      assert_ok(ctx, mfree_approximant_apply(a, MFREE_OP_GRADIENT, 1, u, MFREE_LAYOUT_AOS, 1, out,
+                                             MFREE_LAYOUT_AOS, 2));
+      CHECK(all_finite(out, 2 * P), "apply GRADIENT at the points gives a non-finite value");
+      mfree_approximant_destroy(&a);
+    }
+  assert_true(tried >= 20);
+  mfree_particles_destroy(&ps);
+  mfree_context_destroy(&ctx);
+  if (findings) fail_msg("%d findings (listed above)", findings);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_degenerate_matrix),
+      cmocka_unit_test(test_degenerate_points),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
