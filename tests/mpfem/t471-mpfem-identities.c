@@ -520,12 +520,55 @@ static void test_update(void **state) {
   mfree_particles_destroy(&ps2);
 }
 
+/* Element Gauss quadrature of the mesh (mfree_mesh_get_quadrature): the weights sum to
+ * the measure and integrate x y (QUAD4, TRI3) and x y z (HEX8 bricks) exactly. */
+static void test_quadrature(void **state) {
+  (void)state;
+  enum { NX = 3, NY = 2, NN = (NX + 1) * (NY + 1) };
+  double x2[2 * NN];
+  int32_t cq[4 * NX * NY], ct[6 * NX * NY];
+  nodes_2d(NX, NY, 0.2, 53, x2); /* interior nodes moved: the boundary stays [0,3]x[0,2] */
+  mp_grid_quads(NX, NY, cq);
+  mp_grid_tris(NX, NY, ct);
+  for (int type = 0; type < 2; ++type) {
+    mfree_particles_t *ps = mp_particles(ctx, 2, NN, x2, 0.2);
+    mfree_mesh_t *m = type ? mp_mesh(ctx, ps, MFREE_ELEMENT_TRI3, 2 * NX * NY, ct)
+                           : mp_mesh(ctx, ps, MFREE_ELEMENT_QUAD4, NX * NY, cq);
+    int32_t np = 0;
+    assert_ok(ctx, mfree_mesh_get_quadrature(m, 3, &np, NULL, NULL));
+    assert_int_equal(np, (type ? 2 : 1) * NX * NY * 9);
+    double *q = malloc(sizeof(double) * 2 * (size_t)np), *w = malloc(sizeof(double) * (size_t)np);
+    assert_ok(ctx, mfree_mesh_get_quadrature(m, 3, &np, q, w));
+    double area = 0, ixy = 0;
+    for (int32_t i = 0; i < np; ++i) area += w[i], ixy += w[i] * q[2 * i] * q[2 * i + 1];
+    assert_true(fabs(area - 6.0) < 1e-13);
+    assert_true(fabs(ixy - 9.0) < 1e-12); /* int_0^3 x dx int_0^2 y dy */
+    free(q), free(w);
+    mfree_mesh_destroy(&m);
+    mfree_particles_destroy(&ps);
+  }
+  const double x3[24] = {0, 0, 0, 2, 0, 0, 2, 1, 0, 0, 1, 0, 0, 0, 3, 2, 0, 3, 2, 1, 3, 0, 1, 3};
+  const int32_t h8[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  mfree_particles_t *ps = mp_particles(ctx, 3, 8, x3, 0.2);
+  mfree_mesh_t *m = mp_mesh(ctx, ps, MFREE_ELEMENT_HEX8, 1, h8);
+  double q[3 * 8], w[8];
+  int32_t np = 0;
+  assert_ok(ctx, mfree_mesh_get_quadrature(m, 2, &np, q, w));
+  assert_int_equal(np, 8);
+  double vol = 0, ixyz = 0;
+  for (int i = 0; i < 8; ++i) vol += w[i], ixyz += w[i] * q[3 * i] * q[3 * i + 1] * q[3 * i + 2];
+  assert_true(fabs(vol - 6.0) < 1e-13);
+  assert_true(fabs(ixyz - 2.0 * 0.5 * 4.5) < 1e-12);
+  mfree_mesh_destroy(&m);
+  mfree_particles_destroy(&ps);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_kronecker),     cmocka_unit_test(test_kronecker_failure),
       cmocka_unit_test(test_reproduction),  cmocka_unit_test(test_fem_reduction),
       cmocka_unit_test(test_tensor_product), cmocka_unit_test(test_nodal_scheme),
-      cmocka_unit_test(test_update),
+      cmocka_unit_test(test_update),        cmocka_unit_test(test_quadrature),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
