@@ -619,8 +619,21 @@ class ElementGrid {
       org_[c] = glo[c];
       const double span = ghi[c] - glo[c];
       n_[c] = static_cast<int32_t>(std::min(1024.0, std::max(1.0, std::floor(span / std::max(ext, 1e-300)))));
+    }
+    // at most a few cells per element (scattered elements must not make a huge grid)
+    const int64_t cap = std::max<int64_t>(64, 4 * static_cast<int64_t>(ne));
+    for (;;) {
+      cells = 1;
+      for (int c = 0; c < dim_; ++c) cells *= n_[c];
+      if (cells <= cap) break;
+      int big = 0;
+      for (int c = 1; c < dim_; ++c)
+        if (n_[c] > n_[big]) big = c;
+      n_[big] = std::max(1, n_[big] / 2);
+    }
+    for (int c = 0; c < dim_; ++c) {
+      const double span = ghi[c] - glo[c];
       cs_[c] = span > 0.0 ? span / n_[c] : 1.0;
-      cells *= n_[c];
     }
     start_.assign(static_cast<size_t>(cells) + 1, 0);
     for (int pass = 0; pass < 2; ++pass) {
