@@ -121,8 +121,41 @@ static void test_haar_and_small_support(void **state) {
   check_rows(MFREE_KERNEL_COSINE, 0.5, MFREE_MPFEM_DERIV_FULL, 2, pts, f1, n1, Nc, NULL);
 }
 
+/* The MPFEM kernels as radial kernels (mfree_kernel_eval): support radius 1 and the
+ * normalisation constants in closed form, 1D (004 eq 28 corrected: pi/(2d) with
+ * d = 2h), 2D and 3D: cosine pi/4, 1/(4 - 8/pi), 1/(8 - 64/pi^2); cos^2 1,
+ * 1/(pi/2 - 2/pi), 1/(2pi/3 - 4/pi); Haar 1/2, 1/pi, 3/(4pi). */
+static void test_kernel_constants(void **state) {
+  (void)state;
+  const double pi = 3.14159265358979323846;
+  const mfree_kernel_t ks[3] = {MFREE_KERNEL_COSINE, MFREE_KERNEL_COSINE_SQUARED, MFREE_KERNEL_HAAR};
+  const double c[3][3] = {{pi / 4, 1 / (4 - 8 / pi), 1 / (8 - 64 / (pi * pi))},
+                          {1.0, 1 / (pi / 2 - 2 / pi), 1 / (2 * pi / 3 - 4 / pi)},
+                          {0.5, 1 / pi, 3 / (4 * pi)}};
+  for (int k = 0; k < 3; ++k) {
+    double R = 0.0;
+    assert_ok(ctx, mfree_kernel_get_support_radius(ctx, ks[k], 0.0, &R));
+    assert_true(R == 1.0);
+    for (int d = 1; d <= 3; ++d) {
+      double v = 0.0;
+      assert_ok(ctx, mfree_kernel_get_normalization(ctx, ks[k], d, 0.0, &v));
+      if (fabs(v - c[k][d - 1]) > 1e-14 * c[k][d - 1])
+        fail_msg("kernel %d, %dD: normalisation %.17g, closed form %.17g", ks[k], d, v, c[k][d - 1]);
+    }
+  }
+  /* 1D values: W(t) = (pi/(2d)) cos(pi t/d), d = 2h = 2 */
+  const double r[3] = {0.0, 0.5, 1.0};
+  double w[3], dw[3];
+  assert_ok(ctx, mfree_kernel_eval(ctx, MFREE_KERNEL_COSINE, 1, 0.0, 1.0, 3, r, w, dw, NULL));
+  for (int i = 0; i < 3; ++i) {
+    assert_true(fabs(w[i] - pi / 4 * cos(pi * r[i] / 2)) < 1e-15);
+    assert_true(fabs(dw[i] + pi * pi / 8 * sin(pi * r[i] / 2)) < 1e-15);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_kernel_constants),
       cmocka_unit_test(test_cosine_d2),
       cmocka_unit_test(test_haar_and_small_support),
   };
