@@ -12,6 +12,7 @@
  *    rows run, and the file must stay empty).
  * A last check reads mfree.h and fails when a public function has no row here, so that
  * a new function comes with its bad-input rows. */
+#define _POSIX_C_SOURCE 200809L /* dup, dup2, fileno */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -851,6 +852,11 @@ static void rows_system(void) {
   ROW(MFREE_ERR_INPUT, mfree_system_set_walls(F.sys, 2, wx, wnbad, 0.1, 10));
   ROW(MFREE_ERR_ARG, mfree_system_set_walls(F.sys, 2, wx, wn, -0.1, 10));
   ROW(MFREE_ERR_ARG, mfree_system_set_walls(F.sys, 2, wx, wn, 0.1, NAN));
+#if MFREE_T060_SHEPARD_CONDITION
+  ROW0(MFREE_ERR_NULL, mfree_system_set_shepard_condition(NULL, 100.0));
+  ROW(MFREE_ERR_ARG, mfree_system_set_shepard_condition(F.sys, 0.5));
+  ROW(MFREE_ERR_ARG, mfree_system_set_shepard_condition(F.sys, NAN));
+#endif
   ROW0(MFREE_ERR_NULL, mfree_system_set_box(NULL, lo, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, NULL, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, lo, NULL));

@@ -328,10 +328,95 @@ static void test_degenerate_points(void **state) {
   if (findings) fail_msg("%d findings (listed above)", findings);
 }
 
+#if MFREE_T060_MESH
+/* MPFEM (needs a mesh): a single element (cloud of 2, 3, 4 particles in 1D/2D), supports
+ * below the spacing and above the element size (MFREE_FAIL_SUPPORT, tables still built),
+ * and a host point outside the mesh (MFREE_FAIL_NEIGHBORS, zero row). */
+static int mpfem_case(const char *name, int dim, int n, const double *x, double h,
+                      mfree_element_t type, int nel, const int32_t *conn, int with_far_point) {
+  int bad = 0;
+  mfree_particles_t *ps = NULL;
+  mfree_mesh_t *mesh = NULL;
+  mfree_approximant_t *a = NULL;
+  const double vol = 0.01;
+  assert_ok(ctx, mfree_particles_create(ctx, dim, n, &ps));
+  assert_ok(ctx, mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_volumes(ps, &vol, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_support(ps, &h, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_mesh_create(ctx, ps, &mesh));
+  assert_ok(ctx, mfree_mesh_add_elements(mesh, type, nel, conn, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MPFEM, &a));
+  assert_ok(ctx, mfree_approximant_set_mesh(a, mesh));
+  int nsites = n;
+  if (with_far_point) {
+    const double far[3] = {9.0, 9.0, 9.0};
+    assert_ok(ctx, mfree_approximant_set_points(a, 1, far, MFREE_LAYOUT_AOS, dim, &h, 0, MFREE_COPY));
+    nsites = 1;
+  }
+  const mfree_status_t st = mfree_approximant_setup(a);
+  int32_t sst[8], nf = -1;
+  if (st < 0) {
+    print_message("MPFEM %s: setup returned %d\n", name, (int)st);
+    bad++;
+  } else {
+    assert_ok(ctx, mfree_approximant_get_site_status(a, sst, &nf));
+    int count = 0;
+    for (int i = 0; i < nsites; ++i) count += sst[i] != 0;
+    if (count != nf) print_message("MPFEM %s: nfailed %d, %d statuses\n", name, nf, count), bad++;
+    if (with_far_point && (st != MFREE_FAIL_NEIGHBORS || sst[0] == 0))
+      print_message("MPFEM %s: status %d for a point outside the mesh\n", name, (int)st), bad++;
+    int64_t nnz = 0, rp[9];
+    assert_ok(ctx, mfree_approximant_get_nnz(a, &nnz));
+    int32_t cols[64];
+    double vals[64], u[8], out[3 * 8];
+    assert_true(nnz <= 64);
+    for (int c = 0; c < dim; ++c) {
+      assert_ok(ctx, mfree_approximant_assemble_csr(a, MFREE_DERIV_GRADIENT, c, rp, cols, vals));
+      if (!all_finite(vals, nnz)) print_message("MPFEM %s: non-finite gradient\n", name), bad++;
+      for (int i = 0; i < nsites; ++i)
+        if (sst[i])
+          for (int64_t k = rp[i]; k < rp[i + 1]; ++k)
+            if (vals[k] != 0.0) print_message("MPFEM %s: failed site %d row not zero\n", name, i), bad++;
+    }
+    for (int i = 0; i < n; ++i) u[i] = 1.0 + x[dim * i];
+    assert_ok(ctx, mfree_approximant_apply(a, MFREE_OP_VALUE, 1, u, MFREE_LAYOUT_AOS, 1, out,
+                                           MFREE_LAYOUT_AOS, 1));
+    if (!all_finite(out, nsites)) print_message("MPFEM %s: non-finite value\n", name), bad++;
+  }
+  mfree_approximant_destroy(&a);
+  mfree_mesh_destroy(&mesh);
+  mfree_particles_destroy(&ps);
+  return bad;
+}
+
+static void test_degenerate_mpfem(void **state) {
+  (void)state;
+  assert_ok(NULL, mfree_context_create(&ctx));
+  const double x1[4] = {0.0, 0.1, 0.2, 0.3};
+  const int32_t c1[6] = {0, 1, 1, 2, 2, 3};
+  const double x2[8] = {0, 0, 0.1, 0, 0.1, 0.1, 0, 0.1};
+  const int32_t q[4] = {0, 1, 2, 3}, t[3] = {0, 1, 2};
+  int bad = 0;
+  bad += mpfem_case("cloud of 2 in 1D", 1, 2, x1, 0.04, MFREE_ELEMENT_LINE2, 1, c1, 0);
+  bad += mpfem_case("1D, support below the spacing", 1, 4, x1, 0.01, MFREE_ELEMENT_LINE2, 3, c1, 0);
+  bad += mpfem_case("1D, support above the element", 1, 4, x1, 0.5, MFREE_ELEMENT_LINE2, 3, c1, 0);
+  bad += mpfem_case("1D, point outside the mesh", 1, 4, x1, 0.04, MFREE_ELEMENT_LINE2, 3, c1, 1);
+  bad += mpfem_case("cloud of 3 in 2D (one triangle)", 2, 3, x2, 0.04, MFREE_ELEMENT_TRI3, 1, t, 0);
+  bad += mpfem_case("cloud of 4 in 2D (one quad)", 2, 4, x2, 0.04, MFREE_ELEMENT_QUAD4, 1, q, 0);
+  bad += mpfem_case("one quad, large support", 2, 4, x2, 0.5, MFREE_ELEMENT_QUAD4, 1, q, 0);
+  bad += mpfem_case("one quad, point outside", 2, 4, x2, 0.04, MFREE_ELEMENT_QUAD4, 1, q, 1);
+  mfree_context_destroy(&ctx);
+  assert_int_equal(bad, 0);
+}
+#endif
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_degenerate_matrix),
       cmocka_unit_test(test_degenerate_points),
+#if MFREE_T060_MESH
+      cmocka_unit_test(test_degenerate_mpfem),
+#endif
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
