@@ -17,7 +17,7 @@
  * Output: a table with rates (default) or one JSON object (--json)
  *   {"h":[...],"fem":{"L2":[...],"H1":[...]},"mpfem":{"L2":[...],"H1":[...]},
  *    "rates":{"fem":{"L2":[...],"H1":[...]},"mpfem":{"L2":[...],"H1":[...]}}}
- * (rates between successive spacings). DIR/mpfem_1d_du.dat holds u' of FEM, MPFEM
+ * (rates between successive spacings; the PNG's path goes to stderr). DIR/mpfem_1d_du.dat holds u' of FEM, MPFEM
  * (eq 22 and eq 21) and the exact solution at h = 0.02 (Fig. 5b), DIR/mpfem_1d.gp plots
  * it to DIR/mpfem_1d.png when gnuplot is on PATH.
  */
@@ -325,9 +325,10 @@ int main(int argc, char **argv) {
     have_png = system(cmd) == 0;
   }
   if (json) {
+    if (have_png) fprintf(stderr, "plot: %s\n", png);
     printf("{\"h\":");
     json_array(kH, NH);
-    printf(",\"gauss\":%d,\"fem\":{\"L2\":", ng);
+    printf(",\"fem\":{\"L2\":");
     json_array(fl2, NH);
     printf(",\"H1\":");
     json_array(fh1, NH);
@@ -343,7 +344,7 @@ int main(int argc, char **argv) {
     json_array(rml, NH - 1);
     printf(",\"H1\":");
     json_array(rmh, NH - 1);
-    printf("}},\"plot\":\"%s\"}\n", have_png ? png : "");
+    printf("}}}\n");
   } else {
     printf("Paper 004 Example B: u'' + g = 0, alpha = %g, x0 = %g; %d Gauss points per element\n", ALPHA, X0, ng);
     printf("MPFEM: cosine kernel, d = 2h, eq 21 stiffness; H1 semi-norm with eq 22 (paper)\n\n");
