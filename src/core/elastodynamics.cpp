@@ -269,31 +269,30 @@ Report ElasticSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   (void)consistent;
   // y' = f is explicit for collocation: the identity. Galerkin: the velocity block holds
   // the mass the right-hand side divides by (lumped or consistent, as assembled) on the
-  // free unknowns, the identity on the constrained ones.
-  std::vector<int64_t> rp(static_cast<size_t>(neq()) + 1, 0);
-  std::vector<int32_t> ci;
-  std::vector<double> vals;
-  for (int32_t q = 0; q < neq(); ++q) {
-    const int32_t d = q - nd_;
-    if (galerkin_ && d >= 0 && fpos_[d] >= 0) {
-      const int32_t p = fpos_[d];
-      std::vector<std::pair<int32_t, double>> row;
-      // Mff_ is column-major and symmetric: column p is row p
-      for (Eigen::SparseMatrix<double>::InnerIterator it(Mff_, p); it; ++it)
-        row.push_back({nd_ + fdofs_[it.row()], it.value()});
-      std::sort(row.begin(), row.end());
-      for (auto &e : row) {
-        ci.push_back(e.first);
-        vals.push_back(e.second);
+  // free unknowns, the identity on the constrained ones. Constant: built once.
+  if (mrp_.empty()) {
+    mrp_.assign(static_cast<size_t>(neq()) + 1, 0);
+    for (int32_t q = 0; q < neq(); ++q) {
+      const int32_t d = q - nd_;
+      if (galerkin_ && d >= 0 && fpos_[d] >= 0) {
+        std::vector<std::pair<int32_t, double>> row;
+        // Mff_ is column-major and symmetric: column p is row p
+        for (Eigen::SparseMatrix<double>::InnerIterator it(Mff_, fpos_[d]); it; ++it)
+          row.push_back({nd_ + fdofs_[it.row()], it.value()});
+        std::sort(row.begin(), row.end());
+        for (auto &e : row) {
+          mci_.push_back(e.first);
+          mval_.push_back(e.second);
+        }
+      } else {
+        mci_.push_back(q);
+        mval_.push_back(1.0);
       }
-    } else {
-      ci.push_back(q);
-      vals.push_back(1.0);
+      mrp_[q + 1] = static_cast<int64_t>(mci_.size());
     }
-    rp[q + 1] = static_cast<int64_t>(ci.size());
   }
-  M.set_pattern(neq(), neq(), std::move(rp), std::move(ci));
-  std::copy(vals.begin(), vals.end(), M.values_mut().begin());
+  M.set_pattern(neq(), neq(), mrp_, mci_);
+  std::copy(mval_.begin(), mval_.end(), M.values_mut().begin());
   return Report();
 }
 

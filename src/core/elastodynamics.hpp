@@ -70,6 +70,9 @@ class ElasticSystem : public System {
   std::vector<double> minv_;
   Eigen::SparseMatrix<double> Mff_;
   std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> mfac_;
+  std::vector<int64_t> mrp_;  // the state's mass matrix (constant), built at first use
+  std::vector<int32_t> mci_;
+  std::vector<double> mval_;
   mutable std::vector<double> rb_, work_;
 };
 
