@@ -180,8 +180,8 @@ void FluidSystem::shepard_ill_conditioned() {
   // a few steps, and its gradients then drive the density negative in one step (dam
   // break along the wall, T ~ 2.2, at every resolution and CFL number tried). Hence the
   // default threshold 100 (mfree_system_set_shepard_condition).
-  N_ = approx_->values();
-  G_ = approx_->gradients();
+  N_.assign(approx_->values().begin(), approx_->values().end());  // reuses N_'s storage
+  G_.assign(approx_->gradients().begin(), approx_->gradients().end());
   const auto &cond = approx_->site_cond();
   const auto &rp = approx_->rowptr();
   const auto &cols = approx_->cols();
