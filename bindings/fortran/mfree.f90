@@ -1271,6 +1271,7 @@ module mfree
   public :: mfree_context_create, mfree_context_destroy, mfree_context_get_last_error
   public :: mfree_context_set_error, mfree_context_set_error_handler
   public :: mfree_context_set_num_threads, mfree_context_get_num_threads
+  public :: mfree_context_set_allocator
   public :: mfree_kernel_eval, mfree_kernel_get_support_radius
   public :: mfree_kernel_get_normalization
   public :: mfree_particles_create, mfree_particles_destroy, mfree_particles_set_num_ghost
@@ -1528,6 +1529,24 @@ contains
     integer(c_int32_t), intent(out) :: nthreads
     st = mfree_context_get_num_threads_c(ctx%ptr, nthreads)
   end function mfree_context_get_num_threads
+
+  !> Install an allocator (mfree_context_set_allocator): alloc = c_funloc of a bind(C)
+  !> function (user, bytes) returning type(c_ptr), release = c_funloc of a bind(C)
+  !> subroutine (user, ptr, bytes); both absent restores malloc.
+  integer(c_int) function mfree_context_set_allocator(ctx, alloc, release, user) result(st)
+    type(mfree_context), intent(in) :: ctx
+    type(c_funptr), intent(in), optional :: alloc, release
+    type(c_ptr), intent(in), optional :: user
+    type(c_funptr) :: fa, fr
+    type(c_ptr) :: up
+    fa = c_null_funptr
+    fr = c_null_funptr
+    up = c_null_ptr
+    if (present(alloc)) fa = alloc
+    if (present(release)) fr = release
+    if (present(user)) up = user
+    st = mfree_context_set_allocator_c(ctx%ptr, fa, fr, up)
+  end function mfree_context_set_allocator
 
   ! ==== kernels ========================================================================
 
