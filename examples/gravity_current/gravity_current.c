@@ -28,7 +28,8 @@
  * Output in --out DIR (default gravity_current_out): head.csv, gravity_current.pvd with
  * VTU snapshots every --vtu-every s (default 0.05, 0 = none; point data "fluid" = 1 or 2).
  * --json: {"status":..,"t":..,"steps":..,"particles":..,"head_speed":..,"reference":0.217,
- * "rel_dev":..,"fit_points":..,"mass_rel_error":..,"wall_seconds":..}. */
+ * "rel_dev":..,"fit_points":..,"mass_rel_error":..,"wall_seconds":..} (head_speed and
+ * rel_dev null when fewer than 3 head positions fell in the window). */
 #define _XOPEN_SOURCE 700
 #include <math.h>
 #include <stdio.h>
@@ -185,10 +186,16 @@ int main(int argc, char **argv) {
   double mass1 = 0.0;
   for (int q = 0; q < n; ++q) mass1 += m[q];
   const double merr = fabs(mass1 - mass0) / mass0;
-  if (json)
-    printf("{\"status\":%d,\"t\":%.5f,\"steps\":%lld,\"particles\":%d,\"head_speed\":%.5f,\"reference\":%.5f,"
-           "\"rel_dev\":%.4f,\"fit_points\":%d,\"mass_rel_error\":%.3e,\"wall_seconds\":%.2f}\n",
-           (int)run, t, (long long)steps, n, speed, ref, (speed - ref) / ref, nfit, merr, wall);
+  if (json) {
+    char sp[32] = "null", dv[32] = "null"; /* JSON has no NaN: null without a fit */
+    if (nfit >= 3) {
+      snprintf(sp, sizeof sp, "%.5f", speed);
+      snprintf(dv, sizeof dv, "%.4f", (speed - ref) / ref);
+    }
+    printf("{\"status\":%d,\"t\":%.5f,\"steps\":%lld,\"particles\":%d,\"head_speed\":%s,\"reference\":%.5f,"
+           "\"rel_dev\":%s,\"fit_points\":%d,\"mass_rel_error\":%.3e,\"wall_seconds\":%.2f}\n",
+           (int)run, t, (long long)steps, n, sp, ref, dv, nfit, merr, wall);
+  }
   else {
     printf("gravity current: %d particles, t = %.3f s, %lld steps, %.1f s\n", n, t, (long long)steps, wall);
     printf("head speed %.4f m/s over %d samples; Rottman & Simpson 0.4 (g D drho/rho0)^1/2 = %.4f m/s (%+.1f %%)\n",
