@@ -147,7 +147,9 @@ static void test_no_allocation_2d(void **state) {
 static void test_no_allocation_3d(void **state) {
   (void)state;
   no_allocation_after_setup(3, 9, 1);
+#ifdef __OPTIMIZE__ /* 2744 sites, threaded: seconds unoptimised under sanitizers */
   no_allocation_after_setup(3, 14, 2);
+#endif
 }
 
 /* Blocks go back to the allocator that made them, after the hook changed. */
