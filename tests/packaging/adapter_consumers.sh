@@ -51,7 +51,7 @@ step "install $build into $prefix"
 "$cmake_cmd" --install "$build" --prefix "$prefix" >"$scratch/install.log" 2>&1 ||
   { cat "$scratch/install.log" >&2; fail "cmake --install"; }
 
-pc=$(find "$prefix" -path '*/pkgconfig/$pkg.pc' -print -quit)
+pc=$(find "$prefix" -path "*/pkgconfig/$pkg.pc" -print -quit)
 [[ -n "$pc" ]] || fail "no pkgconfig/$pkg.pc under $prefix"
 pcdir=$(dirname "$pc")
 libdir=$(dirname "$pcdir")
