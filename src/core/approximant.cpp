@@ -239,11 +239,37 @@ double Approximant::pair_h(int32_t s, int32_t j) const {
   }
 }
 
+void Approximant::pack() {
+  const int dim = ps_->dim();
+  const int32_t np = ps_->size();
+  const bool have_vol = ps_->has_volumes();
+  const size_t N = static_cast<size_t>(np);
+  pack_.resize((static_cast<size_t>(dim) + 2) * N);
+  double *P = pack_.data();
+  parallel_blocks(np, num_threads(np), [&](int, int64_t b, int64_t e) {
+    for (int64_t i = b; i < e; ++i) {
+      const int32_t j = static_cast<int32_t>(i);
+      for (int c = 0; c < dim; ++c) P[c * N + i] = ps_->x(j, c);
+      P[dim * N + i] = have_vol ? ps_->volume(j) : 1.0;
+      P[(dim + 1) * N + i] = ps_->h(j);
+    }
+  });
+  if (!points_) {
+    spack_.clear();
+    return;
+  }
+  const size_t M = static_cast<size_t>(npts_);
+  spack_.resize((static_cast<size_t>(dim) + 1) * M);
+  for (int32_t s = 0; s < npts_; ++s) {
+    for (int c = 0; c < dim; ++c) spack_[c * M + s] = px_(s, c);
+    spack_[dim * M + s] = ph_(s);
+  }
+}
+
 void Approximant::build_pattern() {
   const int dim = ps_->dim();
   const double R = kernel_->radius();
   const Csr *src = &ps_->neighbors();
-  std::vector<int32_t> pstatus;
   if (points_) {
     // validate the points' borrowed data like particle data
     for (int32_t s = 0; s < npts_; ++s) {
@@ -260,36 +286,78 @@ void Approximant::build_pattern() {
     nsites_ = ps_->num_owned();
   }
   rowptr_.assign(static_cast<size_t>(nsites_) + 1, 0);
-  cols_.clear();
   self_.assign(nsites_, -1);
   status_.assign(nsites_, 0);
   const auto &pst = ps_->site_status();
-  for (int32_t s = 0; s < nsites_; ++s) {
+  // The row of site s: its neighbours within the kernel's support (closed, kEdgeTol) in
+  // the order of the neighbour list, the particle itself always (appended when a host
+  // list omits it). Counted in a first pass and written in a second, both over static
+  // blocks of sites, so that the pattern is the same for any thread count.
+  const size_t N = static_cast<size_t>(ps_->size()), M = static_cast<size_t>(nsites_);
+  const double *X[3] = {nullptr, nullptr, nullptr}, *SX[3] = {nullptr, nullptr, nullptr};
+  for (int c = 0; c < dim; ++c) {
+    X[c] = pack_.data() + c * N;
+    SX[c] = points_ ? spack_.data() + c * M : X[c];
+  }
+  const double *H = pack_.data() + (dim + 1) * N;
+  const double *SH = points_ ? spack_.data() + dim * M : H;
+  bool per[3] = {false, false, false};
+  double period[3] = {0, 0, 0};
+  for (int c = 0; c < dim; ++c) {
+    per[c] = ps_->periodic(c);
+    period[c] = ps_->box_hi(c) - ps_->box_lo(c);
+  }
+  const int conv = ps_->search_convention();
+  const double tol = 1.0 + kEdgeTol2;
+  auto row = [&](int32_t s, auto &&emit) {
     const int32_t me = site_particle(s);
-    if (me >= 0 && pst[me] != 0) {
-      status_[s] = pst[me];
-      rowptr_[s + 1] = static_cast<int64_t>(cols_.size());
-      continue;
-    }
+    if (me >= 0 && pst[me] != 0) return;
+    const double hs = SH[s];
+    const double xs[3] = {SX[0][s], dim > 1 ? SX[1][s] : 0.0, dim > 2 ? SX[2][s] : 0.0};
+    bool have_self = false;
     for (int64_t k = src->rowptr[s]; k < src->rowptr[s + 1]; ++k) {
       const int32_t j = src->cols[k];
       if (j == me) {
-        self_[s] = static_cast<int32_t>(cols_.size() - rowptr_[s]);
-        cols_.push_back(j);
+        have_self = true;
+        emit(j, true);
         continue;
       }
-      double d[3] = {0, 0, 0}, r2 = 0.0;
-      site_displacement(s, j, d);
-      for (int c = 0; c < dim; ++c) r2 += d[c] * d[c];
-      const double rad = R * pair_h(s, j);
-      if (r2 <= rad * rad * (1.0 + kEdgeTol2)) cols_.push_back(j);
+      double r2 = 0.0;
+      for (int c = 0; c < dim; ++c) {
+        double v = X[c][j] - xs[c];
+        if (per[c]) v -= period[c] * std::nearbyint(v / period[c]);
+        r2 += v * v;
+      }
+      const double hp = conv == MFREE_SEARCH_SYMMETRIC_MAX    ? std::max(hs, H[j])
+                        : conv == MFREE_SEARCH_SYMMETRIC_MEAN ? 0.5 * (hs + H[j])
+                                                              : hs;
+      const double rad = R * hp;
+      if (r2 <= rad * rad * tol) emit(j, false);
     }
-    if (me >= 0 && self_[s] < 0) {  // host lists may omit the particle itself
-      self_[s] = static_cast<int32_t>(cols_.size() - rowptr_[s]);
-      cols_.push_back(me);
+    if (me >= 0 && !have_self) emit(me, true);
+  };
+  const int nt = num_threads(src->nnz());
+  int64_t *rp = rowptr_.data();
+  parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
+    for (int64_t s = b; s < e; ++s) {
+      int64_t cnt = 0;
+      row(static_cast<int32_t>(s), [&](int32_t, bool) { ++cnt; });
+      rp[s + 1] = cnt;
     }
-    rowptr_[s + 1] = static_cast<int64_t>(cols_.size());
-  }
+  });
+  for (int32_t s = 0; s < nsites_; ++s) rp[s + 1] += rp[s];
+  cols_.resize(static_cast<size_t>(rp[nsites_]));
+  int32_t *cl = cols_.data();
+  int32_t *self = self_.data();
+  parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
+    for (int64_t s = b; s < e; ++s) {
+      int64_t k = rp[s];
+      row(static_cast<int32_t>(s), [&](int32_t j, bool is_self) {
+        if (is_self) self[s] = static_cast<int32_t>(k - rp[s]);
+        cl[k++] = j;
+      });
+    }
+  });
 }
 
 Report Approximant::compute(const char *what) {
@@ -298,10 +366,11 @@ Report Approximant::compute(const char *what) {
   const size_t nnz = cols_.size();
   const bool fv = flags_ & MFREE_DERIV_VALUE, fg = flags_ & MFREE_DERIV_GRADIENT,
              fh = flags_ & MFREE_DERIV_HESSIAN;
-  // same sizes on update: assign reuses the storage, nothing is allocated
-  val_.assign(fv ? nnz : 0, 0.0);
-  grad_.assign(fg ? nnz * dim : 0, 0.0);
-  hess_.assign(fh ? nnz * nh : 0, 0.0);
+  // same sizes on update: nothing is allocated; every row is written below (by the fast
+  // path or by compute_site, which zeroes failed rows), so no fill is needed
+  val_.resize(fv ? nnz : 0);
+  grad_.resize(fg ? nnz * dim : 0);
+  hess_.resize(fh ? nnz * nh : 0);
   support_.assign(nsites_, 0);
   cond_.assign(nsites_, 1.0);
   order_used_.assign(nsites_, -1);
@@ -331,7 +400,31 @@ Report Approximant::compute(const char *what) {
     if (w.v.size() < need) w.v.resize(need);
     if (w.h.size() < need) w.h.resize(need);
     w.work.reserve(maxrow, dim, maxL);
+    w.fast.reserve(maxrow);
   }
+  // The specialised path for the common configurations (shape_fast.hpp); a site it
+  // cannot finish is recomputed below by the general path with its fallbacks.
+  const FastPath fast(dim, method_, order_, *kernel_, flags_);
+  FastTables ft;
+  if (fast.ok()) {
+    const size_t N = static_cast<size_t>(ps_->size()), M = static_cast<size_t>(nsites_);
+    ft.rowptr = rowptr_.data();
+    ft.cols = cols_.data();
+    ft.self = self_.data();
+    for (int c = 0; c < dim; ++c) {
+      ft.x[c] = pack_.data() + c * N;
+      ft.sx[c] = points_ ? spack_.data() + c * M : ft.x[c];
+      ft.periodic[c] = ps_->periodic(c);
+      ft.period[c] = ps_->box_hi(c) - ps_->box_lo(c);
+    }
+    ft.vol = pack_.data() + dim * N;
+    ft.h = pack_.data() + (dim + 1) * N;
+    ft.sh = points_ ? spack_.data() + dim * M : ft.h;
+    ft.convention = ps_->search_convention();
+    ft.val = fv ? val_.data() : nullptr;
+    ft.grad = fg ? grad_.data() : nullptr;
+  }
+  const int fast_order = has_order(method_) ? order_ : fixed_order(method_);
   const auto &pst = ps_->site_status();
   bool periodic = false;
   for (int c = 0; c < dim; ++c) periodic = periodic || ps_->periodic(c);
@@ -344,6 +437,17 @@ Report Approximant::compute(const char *what) {
       if (me >= 0 && pst[me] != 0) {
         status_[s] = pst[me];
         continue;
+      }
+      if (fast.ok()) {
+        int sup = 0;
+        double cnd = 1.0;
+        if (fast.site(ft, s, w.fast, sup, cnd) == 0) {
+          status_[s] = 0;
+          support_[s] = sup;
+          cond_[s] = cnd;
+          order_used_[s] = fast_order;
+          continue;
+        }
       }
       const int64_t k0 = rowptr_[s];
       const int n = static_cast<int>(rowptr_[s + 1] - k0);
@@ -434,6 +538,7 @@ Report Approximant::setup() {
     return rep;
   }
   validate_config();
+  pack();
   build_pattern();
   Report rep = compute("setup");
   setup_done_ = true;
@@ -444,129 +549,8 @@ Report Approximant::update() {
   if (!setup_done_) throw Error(MFREE_ERR_STATE, "update called before setup");
   if (method_ == MFREE_METHOD_MPFEM) return compute_mpfem();
   validate_config();
+  pack();
   return compute("update");
-}
-
-int Approximant::op_components(int op, int ncomp) const {
-  const int dim = ps_->dim();
-  switch (op) {
-    case MFREE_OP_VALUE:
-    case MFREE_OP_LAPLACIAN:
-      return ncomp;
-    case MFREE_OP_GRADIENT:
-      return ncomp * dim;
-    case MFREE_OP_DIVERGENCE:
-      if (ncomp != dim)
-        throw Error(MFREE_ERR_MISMATCH, "divergence needs ncomp = dim = " + std::to_string(dim) +
-                                            ", got " + std::to_string(ncomp));
-      return 1;
-    case MFREE_OP_HESSIAN:
-      return ncomp * hessian_size(dim);
-    default:
-      throw Error(MFREE_ERR_ARG, "unknown operator " + std::to_string(op));
-  }
-}
-
-namespace {
-
-// Up to kBlock outputs of one site are accumulated together in one pass over its row;
-// each output is still the sum over the row in row order, as a one-output loop would
-// give, so the result does not depend on the blocking or on the thread count.
-constexpr int kBlock = 24;
-
-// out rows [b, e) of the gradient of ncomp fields (D compile-time: the inner loops
-// unroll).
-template <int D>
-void gradient_rows(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
-                   int ncomp, const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co,
-                   bool add) {
-  for (int64_t s = b; s < e; ++s) {
-    for (int c0 = 0; c0 < ncomp; c0 += kBlock / D) {
-      const int nc = std::min(kBlock / D, ncomp - c0);
-      double acc[kBlock] = {0};
-      for (int64_t k = rowptr[s]; k < rowptr[s + 1]; ++k) {
-        const double *g = grad + k * D;
-        const double *uj = u + cols[k] * ju + c0 * cu;
-        for (int c = 0; c < nc; ++c) {
-          const double v = uj[c * cu];
-          for (int d = 0; d < D; ++d) acc[c * D + d] += g[d] * v;
-        }
-      }
-      double *o = out + s * so + static_cast<int64_t>(c0) * D * co;
-      for (int q = 0; q < nc * D; ++q) {
-        if (add) o[q * co] += acc[q];
-        else o[q * co] = acc[q];
-      }
-    }
-  }
-}
-
-}  // namespace
-
-void Approximant::apply(int op, int ncomp, const double *u, int ulayout, int64_t uld, double *out,
-                        int olayout, int64_t old, bool add) const {
-  const int dim = ps_->dim(), nh = hessian_size(dim);
-  const int ocomp = op_components(op, ncomp);
-  // strides of a site / particle index and of a component in the two layouts
-  const int64_t ju = ulayout == MFREE_LAYOUT_AOS ? uld : 1, cu = ulayout == MFREE_LAYOUT_AOS ? 1 : uld;
-  const int64_t so = olayout == MFREE_LAYOUT_AOS ? old : 1, co = olayout == MFREE_LAYOUT_AOS ? 1 : old;
-  const int64_t *rp = rowptr_.data();
-  const int32_t *cl = cols_.data();
-  const int nt = num_threads(static_cast<int64_t>(cols_.size()) / 8);
-  parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
-    if (op == MFREE_OP_GRADIENT) {
-      if (dim == 1) gradient_rows<1>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
-      else if (dim == 2) gradient_rows<2>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
-      else gradient_rows<3>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
-      return;
-    }
-    double acc[kBlock];
-    for (int64_t s = b; s < e; ++s) {
-      const int64_t k0 = rp[s], k1 = rp[s + 1];
-      for (int oc0 = 0; oc0 < ocomp; oc0 += kBlock) {
-        const int nb = std::min(kBlock, ocomp - oc0);
-        for (int q = 0; q < nb; ++q) acc[q] = 0.0;
-        switch (op) {
-          case MFREE_OP_VALUE:
-            for (int64_t k = k0; k < k1; ++k) {
-              const double v = val_[k], *uj = u + cl[k] * ju;
-              for (int q = 0; q < nb; ++q) acc[q] += v * uj[(oc0 + q) * cu];
-            }
-            break;
-          case MFREE_OP_DIVERGENCE:
-            for (int64_t k = k0; k < k1; ++k) {
-              const double *uj = u + cl[k] * ju;
-              for (int d = 0; d < dim; ++d) acc[0] += grad_[k * dim + d] * uj[d * cu];
-            }
-            break;
-          case MFREE_OP_LAPLACIAN:
-            for (int64_t k = k0; k < k1; ++k) {
-              double tr = 0.0;
-              for (int d = 0; d < dim; ++d) tr += hess_[k * nh + hessian_index(dim, d, d)];
-              const double *uj = u + cl[k] * ju;
-              for (int q = 0; q < nb; ++q) acc[q] += tr * uj[(oc0 + q) * cu];
-            }
-            break;
-          case MFREE_OP_HESSIAN:
-            for (int64_t k = k0; k < k1; ++k) {
-              const double *H = &hess_[k * nh], *uj = u + cl[k] * ju;
-              for (int q = 0; q < nb; ++q) {
-                const int oc = oc0 + q;
-                acc[q] += H[oc % nh] * uj[(oc / nh) * cu];
-              }
-            }
-            break;
-          default:
-            break;
-        }
-        for (int q = 0; q < nb; ++q) {
-          double &o = out[s * so + (oc0 + q) * co];
-          if (add) o += acc[q];
-          else o = acc[q];
-        }
-      }
-    }
-  });
 }
 
 void Approximant::export_csr(int deriv, int component, int64_t *rowptr, int32_t *cols,
