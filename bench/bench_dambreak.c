@@ -3,7 +3,8 @@
  * rebuilt every step, forces, wall forces, kinematics, update. The column is nx x 2nx
  * particles (default nx = 112: 25,088 particles, close to PySPH's 25,153-particle WCSPH
  * dam break, 21 ms per step on this machine class = 1.2 million particle-steps/s; the
- * issue-8 target is 2x that per core). Usage: bench_dambreak [nx] [steps]. */
+ * issue-8 target is 2x that per core). Usage: bench_dambreak [nx] [steps] [threads]: without
+ * a thread count, one thread and then all. */
 #include "bench_util.h"
 
 #include <mfree.h>
@@ -87,12 +88,15 @@ int main(int argc, char **argv) {
   const int64_t steps = argc > 2 ? atoll(argv[2]) : 20;
   int n = 0;
   const double pysph = 21e-3 / 25153.0; /* seconds per particle-step */
-  for (int pass = 0; pass < 2; ++pass) {
-    const int threads = pass == 0 ? 1 : bench_threads();
+  const int only = argc > 3 ? atoi(argv[3]) : 0;
+  for (int pass = only > 0 ? 1 : 0; pass < 2; ++pass) {
+    const int threads = only > 0 ? only : pass == 0 ? 1 : bench_threads();
     const double ts = run(nx, steps, threads, &n);
+    char label[16];
+    snprintf(label, sizeof label, threads > 0 ? "%d" : "all", threads);
     printf("dam break, %d particles, threads %-3s: %8.3f ms per step, %9.3g particle-steps/s, "
            "%.2fx PySPH WCSPH (target >= 2 on 1 thread)\n",
-           n, threads == 1 ? "1" : "all", 1e3 * ts, n / ts, pysph * n / ts);
+           n, label, 1e3 * ts, n / ts, pysph * n / ts);
   }
   return 0;
 }
