@@ -1,0 +1,611 @@
+// Fast path of the value + gradient tables (see shape_fast.hpp). The formulas are those
+// of local.cpp (same notation: d_j = x_j - x, s_j = d_j / hs, w_j = W(|d_j|, h_j),
+// grad_x w_j = gf_j d_j with the radial factor gf_j = -W'(r_j) / r_j); only the
+// arithmetic is arranged differently, so that tables agree with the general path to
+// round-off (tests t404 against an O(N^2) oracle, t432 against the general path).
+//
+// Moments: for a monomial basis p of order K, the entries of M = sum w p p^T and of its
+// derivatives M_,i = sum gf d_i p p^T are sums of single monomials, M_ab = sum w s^(a+b)
+// and (M_,i)_ab = hs sum gf s^(a+b+e_i). So one neighbour pass accumulates the
+// binom(2K+D, D) moments of w and the binom(2K+1+D, D) moments of gf (for 2D order 2:
+// 15 + 21 sums instead of 3 x 21 matrix entries), in loops of fixed even length that the
+// compiler vectorises.
+#include "shape_fast.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "local.hpp"
+
+namespace mfree {
+
+namespace {
+
+// As in local.cpp: a local system whose reciprocal condition number is below this is
+// singular (the site then goes to the general path, which decides and reports).
+constexpr double kMinRcond = 1e-12;
+
+// ---------------------------------------------------------------------------------------
+// Monomials s^e, |e| <= 2K+1, in D variables, ordered by degree (degree-1 monomials are
+// s_1..s_D at positions 1..D), with each one's parent (one degree lower) and the
+// variable that multiplies it, and the moment index of every p_a p_b and s_i p_a p_b.
+
+constexpr int binom(int n, int k) {
+  int r = 1;
+  for (int i = 1; i <= k; ++i) r = r * (n - k + i) / i;
+  return r;
+}
+
+template <int D, int K>
+struct Tab {
+  static constexpr int L = binom(K + D, D);
+  static constexpr int NW = binom(2 * K + D, D);
+  static constexpr int NM = binom(2 * K + 1 + D, D);
+  static constexpr int PW = (NW + 1) / 2 * 2;  // padded to even lengths
+  static constexpr int PM = (NM + 1) / 2 * 2;
+  int e[NM][3] = {};
+  int parent[NM] = {};
+  int var[NM] = {};
+  int mw[L][L] = {};
+  int mg[D][L][L] = {};
+};
+
+template <int D, int K>
+constexpr int find_mono(const Tab<D, K> &t, int a, int b, int c) {
+  for (int m = 0; m < Tab<D, K>::NM; ++m)
+    if (t.e[m][0] == a && t.e[m][1] == b && t.e[m][2] == c) return m;
+  return -1;
+}
+
+template <int D, int K>
+constexpr Tab<D, K> make_tab() {
+  Tab<D, K> t{};
+  int m = 0;
+  for (int deg = 0; deg <= 2 * K + 1; ++deg)
+    for (int a = deg; a >= 0; --a)
+      for (int b = deg - a; b >= 0; --b) {
+        const int c = deg - a - b;
+        if ((D < 2 && b) || (D < 3 && c)) continue;
+        t.e[m][0] = a;
+        t.e[m][1] = b;
+        t.e[m][2] = c;
+        ++m;
+      }
+  for (int q = 1; q < Tab<D, K>::NM; ++q) {
+    int v = 0;
+    while (t.e[q][v] == 0) ++v;
+    t.var[q] = v;
+    t.parent[q] = find_mono(t, t.e[q][0] - (v == 0), t.e[q][1] - (v == 1), t.e[q][2] - (v == 2));
+  }
+  for (int a = 0; a < Tab<D, K>::L; ++a)
+    for (int b = 0; b < Tab<D, K>::L; ++b) {
+      const int e0 = t.e[a][0] + t.e[b][0], e1 = t.e[a][1] + t.e[b][1], e2 = t.e[a][2] + t.e[b][2];
+      t.mw[a][b] = find_mono(t, e0, e1, e2);
+      for (int i = 0; i < D; ++i) t.mg[i][a][b] = find_mono(t, e0 + (i == 0), e1 + (i == 1), e2 + (i == 2));
+    }
+  return t;
+}
+
+template <int D, int K>
+constexpr Tab<D, K> kTab = make_tab<D, K>();
+
+// Monomials 0..N-1 of s (N <= NM), zero up to P.
+template <int D, int K, int N, int P>
+inline void monomials(const double *s, double *mo) {
+  constexpr const Tab<D, K> &T = kTab<D, K>;
+  mo[0] = 1.0;
+  for (int m = 1; m < N; ++m) mo[m] = mo[T.parent[m]] * s[T.var[m]];
+  for (int m = N; m < P; ++m) mo[m] = 0.0;
+}
+
+// ---------------------------------------------------------------------------------------
+// Small dense inverses with the exact 1-norm condition number ||A||_1 ||A^-1||_1 (the
+// quantity Eigen's rcond() estimates from below in the general path).
+
+template <int L>
+double norm1(const double (&A)[L][L]) {
+  double big = 0.0;
+  for (int b = 0; b < L; ++b) {
+    double s = 0.0;
+    for (int a = 0; a < L; ++a) s += std::fabs(A[a][b]);
+    big = std::max(big, s);
+  }
+  return big;
+}
+
+template <int L>
+bool accept(const double (&A)[L][L], const double (&X)[L][L], double &cond) {
+  const double c = norm1(A) * norm1(X);
+  if (!std::isfinite(c) || !(c > 0.0)) return false;
+  cond = c;
+  return 1.0 / c >= kMinRcond;
+}
+
+// Symmetric positive definite A (moment matrices of non-negative weights): LDL^T
+// without pivoting, X = L^-T D^-1 L^-1. False when a pivot is not positive or the
+// system is ill-conditioned.
+template <int L>
+bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
+  double Lw[L][L] = {}, iD[L];
+  for (int k = 0; k < L; ++k) {
+    double dk = A[k][k];
+    for (int m = 0; m < k; ++m) dk -= Lw[k][m] * Lw[k][m] / iD[m];
+    if (!(dk > 0.0)) return false;
+    iD[k] = 1.0 / dk;
+    for (int i = k + 1; i < L; ++i) {
+      double v = A[i][k];
+      for (int m = 0; m < k; ++m) v -= Lw[i][m] * Lw[k][m] / iD[m];
+      Lw[i][k] = v * iD[k];
+    }
+  }
+  double Y[L][L] = {};  // L^-1, unit lower triangular
+  for (int c = 0; c < L; ++c) {
+    Y[c][c] = 1.0;
+    for (int i = c + 1; i < L; ++i) {
+      double v = 0.0;
+      for (int m = c; m < i; ++m) v -= Lw[i][m] * Y[m][c];
+      Y[i][c] = v;
+    }
+  }
+  for (int a = 0; a < L; ++a)
+    for (int b = a; b < L; ++b) {
+      double v = 0.0;
+      for (int k = b; k < L; ++k) v += Y[k][a] * Y[k][b] * iD[k];
+      X[a][b] = X[b][a] = v;
+    }
+  return accept(A, X, cond);
+}
+
+// General A (the corrected-derivative systems): Gauss-Jordan with partial pivoting.
+template <int L>
+bool gen_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
+  double W[L][L];
+  for (int a = 0; a < L; ++a)
+    for (int b = 0; b < L; ++b) {
+      W[a][b] = A[a][b];
+      X[a][b] = a == b ? 1.0 : 0.0;
+    }
+  for (int k = 0; k < L; ++k) {
+    int p = k;
+    for (int i = k + 1; i < L; ++i)
+      if (std::fabs(W[i][k]) > std::fabs(W[p][k])) p = i;
+    if (!(std::fabs(W[p][k]) > 0.0)) return false;
+    if (p != k)
+      for (int b = 0; b < L; ++b) {
+        std::swap(W[p][b], W[k][b]);
+        std::swap(X[p][b], X[k][b]);
+      }
+    const double ip = 1.0 / W[k][k];
+    for (int b = 0; b < L; ++b) {
+      W[k][b] *= ip;
+      X[k][b] *= ip;
+    }
+    for (int i = 0; i < L; ++i) {
+      if (i == k) continue;
+      const double f = W[i][k];
+      if (f == 0.0) continue;
+      for (int b = 0; b < L; ++b) {
+        W[i][b] -= f * W[k][b];
+        X[i][b] -= f * X[k][b];
+      }
+    }
+  }
+  return accept(A, X, cond);
+}
+
+// ---------------------------------------------------------------------------------------
+// Kernel shapes f(q), f'(q). The cubic spline is written out (the default kernel and the
+// one of the papers' benchmarks), with Kernel::shape's expressions and closed support;
+// every other non-negative kernel goes through Kernel::shape.
+
+struct CubicSpline {
+  explicit CubicSpline(const Kernel &) {}
+  void operator()(double q, double &f, double &df) const {
+    if (q < 1.0) {
+      f = 1.0 - 1.5 * q * q + 0.75 * q * q * q;
+      df = -3.0 * q + 2.25 * q * q;
+    } else {
+      double t = 2.0 - q;
+      if (!(t > 0.0)) t = 0.0;
+      f = 0.25 * t * t * t;
+      df = -0.75 * t * t;
+    }
+  }
+};
+
+struct AnyShape {
+  explicit AnyShape(const Kernel &k) : k_(&k) {}
+  void operator()(double q, double &f, double &df) const {
+    double d2f;
+    k_->shape(q, f, df, d2f);
+  }
+  const Kernel *k_;
+};
+
+// Displacements, volumes, weights and radial gradient factors of the row of site s into
+// the scratch (SoA); returns the number of non-zero weights.
+template <int D, class Kern, bool G>
+int gather(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, int n) {
+  const int32_t *cl = t.cols + t.rowptr[s];
+  const double hs = t.sh[s];
+  double *d[3] = {w.d(0), w.d(1), w.d(2)};
+  for (int c = 0; c < D; ++c) {
+    const double *X = t.x[c], x0 = t.sx[c][s];
+    double *dc = d[c];
+    for (int j = 0; j < n; ++j) dc[j] = X[cl[j]] - x0;
+    if (t.periodic[c]) {
+      const double L = t.period[c];
+      for (int j = 0; j < n; ++j) dc[j] -= L * std::nearbyint(dc[j] / L);
+    }
+  }
+  double *v = w.v();
+  for (int j = 0; j < n; ++j) v[j] = t.vol[cl[j]];
+  const Kern K(fp.kernel());
+  const double c0 = fp.kernel().norm();
+  double *wt = w.w(), *gf = w.gf();
+  int support = 0;
+  auto pair = [&](int j, double ih, double sw) {
+    double r2 = 0.0;
+    for (int c = 0; c < D; ++c) r2 += d[c][j] * d[c][j];
+    const double r = std::sqrt(r2);
+    double f, df;
+    K(r * ih, f, df);
+    const double wv = sw * f;
+    wt[j] = wv;
+    support += wv != 0.0;
+    if (G) gf[j] = r > 0.0 ? -(sw * ih * df) / r : 0.0;
+  };
+  if (t.convention == MFREE_SEARCH_GATHER) {
+    const double ih = 1.0 / hs;
+    double sw = c0;
+    for (int c = 0; c < D; ++c) sw *= ih;
+    for (int j = 0; j < n; ++j) pair(j, ih, sw);
+  } else {
+    const bool mx = t.convention == MFREE_SEARCH_SYMMETRIC_MAX;
+    for (int j = 0; j < n; ++j) {
+      const double hj = t.h[cl[j]], h = mx ? std::max(hs, hj) : 0.5 * (hs + hj), ih = 1.0 / h;
+      double sw = c0;
+      for (int c = 0; c < D; ++c) sw *= ih;
+      pair(j, ih, sw);
+    }
+  }
+  return support;
+}
+
+// Output rows of one site.
+struct Rows {
+  double *val, *grad;
+};
+
+// Difference form: the site's own gradient entry is minus the sum of the others.
+template <int D>
+void close_difference(double *grad, int n, int self) {
+  double sum[D] = {};
+  for (int j = 0; j < n; ++j)
+    if (j != self)
+      for (int c = 0; c < D; ++c) sum[c] += grad[j * D + c];
+  for (int c = 0; c < D; ++c) grad[self * D + c] = -sum[c];
+}
+
+template <int D>
+int sph(FastScratch &w, int n, Rows o, int self) {
+  const double *wt = w.w(), *gf = w.gf(), *v = w.v();
+  if (o.val)
+    for (int j = 0; j < n; ++j) o.val[j] = wt[j] * v[j];
+  if (o.grad) {
+    for (int j = 0; j < n; ++j) {
+      const double gv = gf[j] * v[j];
+      for (int c = 0; c < D; ++c) o.grad[j * D + c] = gv * w.d(c)[j];
+    }
+    if (self >= 0) close_difference<D>(o.grad, n, self);
+  }
+  return 0;
+}
+
+// Shepard functions into scratch a (values) and b(c) (gradients).
+template <int D>
+int shepard(FastScratch &w, int n) {
+  const double *wt = w.w(), *gf = w.gf();
+  double S = 0.0, gS[D] = {};
+  for (int j = 0; j < n; ++j) {
+    S += wt[j];
+    for (int c = 0; c < D; ++c) gS[c] += gf[j] * w.d(c)[j];
+  }
+  if (!(S > 0.0)) return MFREE_FAIL_NEIGHBORS;
+  const double iS = 1.0 / S;
+  double *phi = w.a();
+  for (int j = 0; j < n; ++j) phi[j] = wt[j] * iS;
+  for (int c = 0; c < D; ++c) {
+    const double *dc = w.d(c);
+    double *g = w.b(c);
+    for (int j = 0; j < n; ++j) g[j] = gf[j] * dc[j] * iS - wt[j] * gS[c] * iS * iS;
+  }
+  return 0;
+}
+
+template <int D>
+void write_shepard(FastScratch &w, int n, Rows o) {
+  if (o.val) std::copy(w.a(), w.a() + n, o.val);
+  if (o.grad)
+    for (int j = 0; j < n; ++j)
+      for (int c = 0; c < D; ++c) o.grad[j * D + c] = w.b(c)[j];
+}
+
+// Randles-Libersky (q_j = grad w_j V_j, difference form) and Krongauz-Belytschko
+// Method 1 (q_j = grad phi^S_j): A_ab = sum_j d_ja q_jb, corrected gradient A^-T q_j.
+template <int D>
+int corrected(FastScratch &w, int n, Rows o, int self, bool rl, double &cond) {
+  double *q[3];
+  if (rl) {
+    const double *gf = w.gf(), *v = w.v();
+    for (int c = 0; c < D; ++c) {
+      q[c] = w.b(c);
+      const double *dc = w.d(c);
+      for (int j = 0; j < n; ++j) q[c][j] = gf[j] * v[j] * dc[j];
+    }
+  } else {
+    const int st = shepard<D>(w, n);
+    if (st) return st;
+    for (int c = 0; c < D; ++c) q[c] = w.b(c);
+  }
+  double acc[D][D] = {};
+  for (int j = 0; j < n; ++j)
+    for (int a = 0; a < D; ++a)
+      for (int b = 0; b < D; ++b) acc[a][b] += w.d(a)[j] * q[b][j];
+  double X[D][D];
+  if (!gen_inverse<D>(acc, X, cond)) return MFREE_FAIL_SINGULAR;
+  if (o.val) {
+    if (rl)
+      for (int j = 0; j < n; ++j) o.val[j] = w.w()[j] * w.v()[j];
+    else
+      std::copy(w.a(), w.a() + n, o.val);
+  }
+  if (o.grad) {
+    for (int j = 0; j < n; ++j) {
+      double qj[D];
+      for (int b = 0; b < D; ++b) qj[b] = q[b][j];
+      for (int c = 0; c < D; ++c) {
+        double g = 0.0;
+        for (int b = 0; b < D; ++b) g += X[b][c] * qj[b];
+        o.grad[j * D + c] = g;
+      }
+    }
+    if (rl) close_difference<D>(o.grad, n, self);
+  }
+  return 0;
+}
+
+// Johnson-Beissel: grad_c = grad_c w_j V_j / sum_j grad_c w_j V_j d_jc, difference form.
+template <int D>
+int johnson_beissel(FastScratch &w, int n, Rows o, int self) {
+  const double *wt = w.w(), *gf = w.gf(), *v = w.v();
+  double beta[D];
+  if (o.grad)
+    for (int c = 0; c < D; ++c) {
+      const double *dc = w.d(c);
+      double den = 0.0;
+      for (int j = 0; j < n; ++j) den += gf[j] * dc[j] * v[j] * dc[j];
+      if (!(std::fabs(den) > 0.0)) return MFREE_FAIL_SINGULAR;
+      beta[c] = 1.0 / den;
+    }
+  if (o.val)
+    for (int j = 0; j < n; ++j) o.val[j] = wt[j] * v[j];
+  if (o.grad) {
+    for (int j = 0; j < n; ++j)
+      for (int c = 0; c < D; ++c) o.grad[j * D + c] = beta[c] * gf[j] * w.d(c)[j] * v[j];
+    close_difference<D>(o.grad, n, self);
+  }
+  return 0;
+}
+
+// MLS (weights w) and RKPM (weights w V) of order K with true derivatives (local.cpp
+// mls_fixed): M gamma = p(0), M gamma_,i = e_i / hs - M_,i gamma,
+// Phi_j = w_j gamma . p_j, Phi_j,i = w_j gamma_,i . p_j + w_j,i gamma . p_j.
+template <int D, int K>
+int mls(FastScratch &w, int n, int support, double hs, Rows o, bool rkpm, double &cond) {
+  using T = Tab<D, K>;
+  constexpr const T &tab = kTab<D, K>;
+  constexpr int L = T::L;
+  if (support < L) return MFREE_FAIL_NEIGHBORS;
+  double *wt = w.w(), *gf = w.gf();
+  const bool deriv = o.grad != nullptr;
+  if (rkpm) {
+    const double *v = w.v();
+    for (int j = 0; j < n; ++j) wt[j] *= v[j];
+    if (deriv)
+      for (int j = 0; j < n; ++j) gf[j] *= v[j];
+  }
+  const double ih = 1.0 / hs;
+  const double *d[3] = {w.d(0), w.d(1), w.d(2)};
+  double aw[T::PM] = {}, ag[T::PM] = {};
+  for (int j = 0; j < n; ++j) {
+    double s[D];
+    for (int c = 0; c < D; ++c) s[c] = d[c][j] * ih;
+    double mo[T::PM];
+    if (deriv) {
+      monomials<D, K, T::NM, T::PM>(s, mo);
+      const double wj = wt[j], gj = gf[j];
+      for (int m = 0; m < T::PW; ++m) aw[m] += wj * mo[m];
+      for (int m = 0; m < T::PM; ++m) ag[m] += gj * mo[m];
+    } else {
+      monomials<D, K, T::NW, T::PW>(s, mo);
+      const double wj = wt[j];
+      for (int m = 0; m < T::PW; ++m) aw[m] += wj * mo[m];
+    }
+  }
+  double M[L][L], X[L][L];
+  for (int a = 0; a < L; ++a)
+    for (int b = 0; b < L; ++b) M[a][b] = aw[tab.mw[a][b]];
+  if (!spd_inverse<L>(M, X, cond)) return MFREE_FAIL_SINGULAR;
+  double g[L], gi[D][L];
+  for (int a = 0; a < L; ++a) g[a] = X[a][0];
+  if (deriv)
+    for (int i = 0; i < D; ++i) {
+      double rhs[L];
+      for (int a = 0; a < L; ++a) {
+        double t = 0.0;
+        for (int b = 0; b < L; ++b) t += ag[tab.mg[i][a][b]] * g[b];
+        rhs[a] = -hs * t;
+      }
+      if (1 + i < L) rhs[1 + i] += ih;
+      for (int a = 0; a < L; ++a) {
+        double t = 0.0;
+        for (int b = 0; b < L; ++b) t += X[a][b] * rhs[b];
+        gi[i][a] = t;
+      }
+    }
+  for (int j = 0; j < n; ++j) {
+    double s[D], p[L];
+    for (int c = 0; c < D; ++c) s[c] = d[c][j] * ih;
+    monomials<D, K, L, L>(s, p);
+    double gp = 0.0;
+    for (int a = 0; a < L; ++a) gp += g[a] * p[a];
+    if (o.val) o.val[j] = wt[j] * gp;
+    if (deriv)
+      for (int i = 0; i < D; ++i) {
+        double t = 0.0;
+        for (int a = 0; a < L; ++a) t += gi[i][a] * p[a];
+        o.grad[j * D + i] = wt[j] * t + gf[j] * d[i][j] * gp;
+      }
+  }
+  return 0;
+}
+
+// SSPH of order K (001 eqs 3.3-3.10): K = sum W V p p^T, value (K^-1 p_j)_0 W_j V_j,
+// gradient (K^-1 p_j)_{e_i} W_j V_j / hs; the kernel is not differentiated.
+template <int D, int K>
+int ssph(FastScratch &w, int n, int support, double hs, Rows o, double &cond) {
+  using T = Tab<D, K>;
+  constexpr const T &tab = kTab<D, K>;
+  constexpr int L = T::L;
+  if (support < L) return MFREE_FAIL_NEIGHBORS;
+  double *om = w.w();
+  const double *v = w.v();
+  for (int j = 0; j < n; ++j) om[j] *= v[j];
+  const double ih = 1.0 / hs;
+  const double *d[3] = {w.d(0), w.d(1), w.d(2)};
+  double aw[T::PW] = {};
+  for (int j = 0; j < n; ++j) {
+    double s[D], mo[T::PW];
+    for (int c = 0; c < D; ++c) s[c] = d[c][j] * ih;
+    monomials<D, K, T::NW, T::PW>(s, mo);
+    const double oj = om[j];
+    for (int m = 0; m < T::PW; ++m) aw[m] += oj * mo[m];
+  }
+  double M[L][L], X[L][L];
+  for (int a = 0; a < L; ++a)
+    for (int b = 0; b < L; ++b) M[a][b] = aw[tab.mw[a][b]];
+  if (!spd_inverse<L>(M, X, cond)) return MFREE_FAIL_SINGULAR;
+  for (int j = 0; j < n; ++j) {
+    double s[D], p[L];
+    for (int c = 0; c < D; ++c) s[c] = d[c][j] * ih;
+    monomials<D, K, L, L>(s, p);
+    if (o.val) {
+      double t = 0.0;
+      for (int a = 0; a < L; ++a) t += X[0][a] * p[a];
+      o.val[j] = om[j] * t;
+    }
+    if (o.grad)
+      for (int i = 0; i < D; ++i) {
+        double t = 0.0;
+        for (int a = 0; a < L; ++a) t += X[1 + i][a] * p[a];
+        o.grad[j * D + i] = ih * om[j] * t;
+      }
+  }
+  return 0;
+}
+
+template <int D>
+int mls_order(int order, FastScratch &w, int n, int support, double hs, Rows o, bool rkpm, double &cond) {
+  switch (order) {
+    case 0: return mls<D, 0>(w, n, support, hs, o, rkpm, cond);
+    case 1: return mls<D, 1>(w, n, support, hs, o, rkpm, cond);
+    default: return mls<D, 2>(w, n, support, hs, o, rkpm, cond);
+  }
+}
+
+template <int D, class Kern>
+int site_fn(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, int &support,
+            double &cond) {
+  const int64_t k0 = t.rowptr[s];
+  const int n = static_cast<int>(t.rowptr[s + 1] - k0);
+  const int m = fp.method();
+  Rows o{t.val ? t.val + k0 : nullptr, t.grad ? t.grad + k0 * D : nullptr};
+  const bool corr = m == MFREE_METHOD_RANDLES_LIBERSKY || m == MFREE_METHOD_KB_METHOD1;
+  const bool need_grad = m != MFREE_METHOD_SSPH && (o.grad || corr);
+  support = need_grad ? gather<D, Kern, true>(fp, t, s, w, n) : gather<D, Kern, false>(fp, t, s, w, n);
+  cond = 1.0;
+  const double hs = t.sh[s];
+  const int self = t.self[s];
+  switch (m) {
+    case MFREE_METHOD_SPH:
+      if (support < 1) return MFREE_FAIL_NEIGHBORS;
+      return sph<D>(w, n, o, -1);
+    case MFREE_METHOD_SPH_SYMMETRIC:
+      if (support < 1) return MFREE_FAIL_NEIGHBORS;
+      return sph<D>(w, n, o, self);
+    case MFREE_METHOD_SHEPARD: {
+      const int st = shepard<D>(w, n);
+      if (!st) write_shepard<D>(w, n, o);
+      return st;
+    }
+    case MFREE_METHOD_JOHNSON_BEISSEL:
+      if (support < 2) return MFREE_FAIL_NEIGHBORS;
+      return johnson_beissel<D>(w, n, o, self);
+    case MFREE_METHOD_RANDLES_LIBERSKY:
+    case MFREE_METHOD_KB_METHOD1:
+      if (support < D + 1) return MFREE_FAIL_NEIGHBORS;
+      return corrected<D>(w, n, o, self, m == MFREE_METHOD_RANDLES_LIBERSKY, cond);
+    case MFREE_METHOD_MLS:
+    case MFREE_METHOD_RKPM:
+      return mls_order<D>(fp.order(), w, n, support, hs, o, m == MFREE_METHOD_RKPM, cond);
+    case MFREE_METHOD_SSPH:
+      if (fp.order() == 1) return ssph<D, 1>(w, n, support, hs, o, cond);
+      return ssph<D, 2>(w, n, support, hs, o, cond);
+    default:
+      return MFREE_FAIL_SINGULAR;
+  }
+}
+
+}  // namespace
+
+void FastScratch::reserve(int maxrow) {
+  if (maxrow <= cap) return;
+  cap = maxrow;
+  buf.assign(static_cast<size_t>(cap) * 10, 0.0);
+}
+
+FastPath::FastPath(int dim, int method, int order, const Kernel &kernel, int flags)
+    : method_(method), order_(order), kernel_(&kernel) {
+  if (flags & MFREE_DERIV_HESSIAN) return;
+  if (dim < 1 || dim > 3) return;
+  // LDL^T without pivoting needs non-negative weights
+  const int k = kernel.id();
+  if (k == MFREE_KERNEL_SUPER_GAUSS || k == MFREE_KERNEL_REVISED_SUPER_GAUSS) return;
+  switch (method) {
+    case MFREE_METHOD_SPH:
+    case MFREE_METHOD_SPH_SYMMETRIC:
+    case MFREE_METHOD_SHEPARD:
+    case MFREE_METHOD_JOHNSON_BEISSEL:
+    case MFREE_METHOD_RANDLES_LIBERSKY:
+    case MFREE_METHOD_KB_METHOD1:
+      break;
+    case MFREE_METHOD_MLS:
+    case MFREE_METHOD_RKPM:
+      if (order < 0 || order > 2) return;
+      break;
+    case MFREE_METHOD_SSPH:
+      if (order < 1 || order > 2) return;
+      break;
+    default:
+      return;
+  }
+  const bool cubic = k == MFREE_KERNEL_CUBIC_SPLINE;
+  switch (dim) {
+    case 1: fn_ = cubic ? &site_fn<1, CubicSpline> : &site_fn<1, AnyShape>; break;
+    case 2: fn_ = cubic ? &site_fn<2, CubicSpline> : &site_fn<2, AnyShape>; break;
+    default: fn_ = cubic ? &site_fn<3, CubicSpline> : &site_fn<3, AnyShape>; break;
+  }
+}
+
+}  // namespace mfree

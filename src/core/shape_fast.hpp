@@ -1,0 +1,76 @@
+// Specialised per-site shape functions for the common value + gradient tables (issue 8):
+// one template per (dimension, kernel shape, method family, basis order), SoA neighbour
+// data gathered once per site, the kernel shape inlined for the cubic spline, moments
+// accumulated as sums of monomials in one neighbour pass, fixed-size factorisations with
+// an exact 1-norm condition number. Everything it does not cover (Hessians, MSPH, KB
+// Methods 2 and 3, order 3, sign-changing kernels) stays on the general path of
+// local.cpp, and a site it cannot finish (any non-zero status) is recomputed there from
+// scratch, so that statuses, fallbacks and failure rows are those of the general path.
+#pragma once
+
+#include <cstdint>
+
+#include "alloc.hpp"
+#include "kernel.hpp"
+
+namespace mfree {
+
+// Borrowed views of one approximant's data for the fast path.
+struct FastTables {
+  const int64_t *rowptr = nullptr;
+  const int32_t *cols = nullptr;
+  const int32_t *self = nullptr;  // position of the site in its row, -1 at host points
+  // particles, SoA: coordinates, volumes (1 when the set has none), supports
+  const double *x[3] = {nullptr, nullptr, nullptr};
+  const double *vol = nullptr;
+  const double *h = nullptr;
+  // sites (the particles themselves or host points), SoA
+  const double *sx[3] = {nullptr, nullptr, nullptr};
+  const double *sh = nullptr;
+  int convention = MFREE_SEARCH_GATHER;
+  bool periodic[3] = {false, false, false};
+  double period[3] = {0, 0, 0};
+  double *val = nullptr;   // nullptr when the value table is not built
+  double *grad = nullptr;  // nullptr when the gradient table is not built
+};
+
+// Per-thread scratch, sized for the longest row before the sites are computed.
+struct FastScratch {
+  HVec<double> buf;
+  int cap = 0;
+  void reserve(int maxrow);
+  double *d(int c) { return buf.data() + static_cast<size_t>(c) * cap; }
+  double *w() { return d(3); }
+  double *gf() { return d(4); }
+  double *v() { return d(5); }
+  double *a() { return d(6); }  // method-specific (Shepard values)
+  double *b(int c) { return d(7 + c); }  // method-specific (Shepard gradients)
+};
+
+class FastPath {
+ public:
+  // Selects the specialised code for this configuration; ok() is false when the general
+  // path must be used for every site.
+  FastPath(int dim, int method, int order, const Kernel &kernel, int flags);
+  bool ok() const { return fn_ != nullptr; }
+
+  // Rows of site s (written only on success). Returns 0, or a positive status when the
+  // site must be recomputed by the general path. support: neighbours with non-zero
+  // weight; cond: exact 1-norm condition number of the local system (1 when none).
+  int site(const FastTables &t, int32_t s, FastScratch &w, int &support, double &cond) const {
+    return fn_(*this, t, s, w, support, cond);
+  }
+
+  int method() const { return method_; }
+  int order() const { return order_; }
+  const Kernel &kernel() const { return *kernel_; }
+
+ private:
+  using Fn = int (*)(const FastPath &, const FastTables &, int32_t, FastScratch &, int &, double &);
+  Fn fn_ = nullptr;
+  int method_;
+  int order_;
+  const Kernel *kernel_;
+};
+
+}  // namespace mfree
