@@ -901,6 +901,31 @@ MFREE_API mfree_status_t mfree_assembler_set_fe_layer(mfree_assembler_t *as, int
 /** Penalty factor alpha (default 1e6 times the modulus E or coefficient c), which is
  * also Nitsche's beta when set (default 100 modulus / mean h). */
 MFREE_API mfree_status_t mfree_assembler_set_penalty(mfree_assembler_t *as, double alpha);
+/**
+ * Variationally consistent integration (VCI; Chen, Hillman and Rueter, IJNME 93 (2013)
+ * 245-267), first order, for the Galerkin stiffness forms (elasticity, Laplace): the test
+ * gradients at the quadrature points of each test function J get a constant correction
+ * xi_J (over J's support) such that the quadrature satisfies the divergence theorem,
+ * sum_q grad Psi_J(x_q) w_q = sum_p Psi_J(x_p) n_p w_p on the boundary points given here.
+ * Trial functions that reproduce linear fields then pass the linear patch test with any
+ * domain quadrature, nodal quadrature included, and the finite-element layer's strip
+ * (mfree_assembler_set_fe_layer) is consistent too. Not in paper 000: an option beside
+ * its schemes. The assembled matrix is then unsymmetric even for Bubnov-Galerkin.
+ * @param[in] npts     boundary points (copied); 0 switches the correction off
+ * @param[in] x        the points: the whole boundary of the domain (essential and
+ *                     natural parts alike), best the same rule as the tractions on the
+ *                     natural part
+ * @param[in] w        weights (non-negative, finite)
+ * @param[in] normals  outward unit normals, dim per point (AoS)
+ * MFREE_ERR_UNSUPPORTED for mass and collocation forms and for test functions without
+ * values between the particles (symmetrised SPH, Johnson-Beissel, Randles-Libersky).
+ */
+MFREE_API mfree_status_t mfree_assembler_set_consistent_integration(mfree_assembler_t *as,
+                                                                    int32_t npts,
+                                                                    const double *x,
+                                                                    mfree_layout_t layout,
+                                                                    int64_t ld, const double *w,
+                                                                    const double *normals);
 
 /**
  * Build the quadrature, the shape-function tables at the quadrature and boundary points,

@@ -965,6 +965,18 @@ module mfree
       real(c_double), value :: alpha
     end function mfree_assembler_set_penalty_c
 
+    integer(c_int) function mfree_assembler_set_consistent_integration_c(as, npts, x, layout, &
+                                                                         ld, w, normals) &
+        bind(C, name="mfree_assembler_set_consistent_integration")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: as
+      integer(c_int32_t), value :: npts
+      real(c_double), intent(in) :: x(*)
+      integer(c_int), value :: layout
+      integer(c_int64_t), value :: ld
+      real(c_double), intent(in) :: w(*), normals(*)
+    end function mfree_assembler_set_consistent_integration_c
+
     integer(c_int) function mfree_assembler_setup_c(as) &
         bind(C, name="mfree_assembler_setup")
       import :: c_int, c_ptr
@@ -1228,6 +1240,7 @@ module mfree
   public :: mfree_assembler_add_dirichlet_c, mfree_assembler_add_dirichlet_nodes_c
   public :: mfree_assembler_add_traction_nodes_c, mfree_assembler_set_fe_layer_c
   public :: mfree_assembler_set_penalty_c, mfree_assembler_setup_c
+  public :: mfree_assembler_set_consistent_integration_c
   public :: mfree_assembler_update_c, mfree_assembler_get_size_c
   public :: mfree_assembler_assemble_matrix_c, mfree_assembler_assemble_rhs_c
   public :: mfree_system_create_fluid_c, mfree_system_destroy_c, mfree_system_set_fluid_c
@@ -1306,6 +1319,7 @@ module mfree
   public :: mfree_assembler_add_traction_segments, mfree_assembler_add_dirichlet
   public :: mfree_assembler_add_dirichlet_nodes, mfree_assembler_add_traction_nodes
   public :: mfree_assembler_set_fe_layer, mfree_assembler_set_penalty
+  public :: mfree_assembler_set_consistent_integration
   public :: mfree_assembler_setup, mfree_assembler_update, mfree_assembler_get_size
   public :: mfree_assembler_assemble_matrix, mfree_assembler_assemble_rhs
   public :: mfree_system_create_fluid, mfree_system_destroy, mfree_system_set_fluid
@@ -2333,6 +2347,18 @@ contains
     real(c_double), intent(in) :: alpha
     st = mfree_assembler_set_penalty_c(as%ptr, alpha)
   end function mfree_assembler_set_penalty
+
+  !> Variationally consistent integration: the whole boundary as points, weights and
+  !> outward unit normals (dim per point); npts = 0 switches it off.
+  integer(c_int) function mfree_assembler_set_consistent_integration(as, npts, x, layout, ld, &
+                                                                     w, normals) result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(in) :: npts
+    real(c_double), intent(in) :: x(*), w(*), normals(*)
+    integer(c_int), intent(in) :: layout
+    integer(c_int64_t), intent(in) :: ld
+    st = mfree_assembler_set_consistent_integration_c(as%ptr, npts, x, layout, ld, w, normals)
+  end function mfree_assembler_set_consistent_integration
 
   integer(c_int) function mfree_assembler_setup(as) result(st)
     type(mfree_assembler), intent(in) :: as

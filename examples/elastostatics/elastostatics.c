@@ -54,7 +54,9 @@ typedef struct {
   int run[3]; /* beam, hole, patch */
   const char *out;
   es_bc_t bc;
-  int only; /* -1 all schemes, else index */
+  int only; /* -1 all schemes, else a bit mask of the selected ones */
+  int vci;  /* mfree_assembler_set_consistent_integration for the schemes with test values */
+  int first; /* index of the coarsest level (0: 17x3 beam, 118-node hole) */
 } options_t;
 
 typedef struct {
@@ -81,11 +83,12 @@ static const char kUsage[] =
     "usage: mfree_elastostatics [--json] [--problem beam|hole|patch|both|all] [--levels N]\n"
     "                           [--out DIR] [--no-plot] [--bc auto|fe-layer|fe-nodal|fe-gauss|\n"
     "                           direct|rows|nitsche|penalty|lagrange]"
-    " [--scheme NAME] [--threads N]\n"
+    " [--scheme NAME[,NAME..]] [--threads N] [--vci] [--first K]\n"
     "Paper 000 Table III: convergence of SPH, JB, RL, CD1, CD2, MLS and EFG on the cantilever\n"
     "beam and the plate with a hole (plane stress), next to the paper's rates; a patch test.\n"
     "  --problem  both (default) = beam and hole; all = beam, hole and patch test\n"
     "  --levels   refinements per problem (default 5; at least 2)\n"
+    "  --first    index of the coarsest level (default 0: beam 17x3, hole 118 nodes; 0..4)\n"
     "  --bc       essential conditions for every scheme; default auto = fe-layer (mfree's\n"
     "             finite-element blending layer, 000 Sect. 5.6, a mask per line); fe-nodal =\n"
     "             the example's nodal-quadrature build of the same layer; fe-gauss = the layer's\n"
@@ -93,6 +96,9 @@ static const char kUsage[] =
     "             Others: direct = rows u_J = g(x_J) on the parameters; rows =\n"
     "             mfree_assembler_add_dirichlet_nodes;\n"
     "             nitsche, penalty, lagrange = MFREE_BC_*\n"
+    "  --vci      variationally consistent integration of the test functions (not the paper's;\n"
+    "             mfree_assembler_set_consistent_integration on the whole boundary) for the\n"
+    "             schemes with test values (CD1, CD2, MLS, EFG); BC column '+v'\n"
     "Writes DIR/elastostatics_{beam,hole}.dat, DIR/elastostatics.gp (+ .png with gnuplot).\n";
 
 static int parse(int argc, char **argv, options_t *o) {
@@ -131,10 +137,24 @@ static int parse(int argc, char **argv, options_t *o) {
       if (es_bc_parse(v, &o->bc)) return 1;
     } else if (v && strcmp(a, "--scheme") == 0) {
       ++i;
-      o->only = -2;
-      for (int s = 0; s < ES_NSCHEMES; ++s)
-        if (strcmp(v, es_schemes[s].name) == 0) o->only = s;
-      if (o->only < 0) return 1;
+      o->only = 0;
+      for (const char *q = v; *q;) { /* NAME[,NAME...] */
+        const size_t len = strcspn(q, ",");
+        int hit = 0;
+        for (int s = 0; s < ES_NSCHEMES; ++s)
+          if (strlen(es_schemes[s].name) == len && strncmp(q, es_schemes[s].name, len) == 0) o->only |= 1 << s, hit = 1;
+        if (!hit) return 1;
+        q += len;
+        if (*q == ',') ++q;
+      }
+      if (!o->only) return 1;
+    } else if (v && strcmp(a, "--first") == 0) {
+      ++i;
+      char *end;
+      o->first = (int)strtol(v, &end, 10);
+      if (*end || o->first < 0 || o->first > 4) return 1;
+    } else if (strcmp(a, "--vci") == 0) {
+      o->vci = 1;
     } else {
       return 1;
     }
@@ -142,7 +162,9 @@ static int parse(int argc, char **argv, options_t *o) {
   return 0;
 }
 
-static int selected(const options_t *o, int s) { return o->only < 0 || o->only == s; }
+static int selected(const options_t *o, int s) { return o->only < 0 || (o->only >> s & 1); }
+/* --vci applies to the schemes whose test functions have values between the particles. */
+static int vci_for(const options_t *o, int s) { return o->vci && !es_schemes[s].particles_only; }
 
 static void set_problem(int kind, es_problem_t *p) {
   memset(p, 0, sizeof *p);
@@ -165,7 +187,7 @@ static int run_study(mfree_context_t *ctx, const options_t *o, int kind, study_t
   for (int s = 0; s < ES_NSCHEMES; ++s) S->sel[s] = S->ok[s] = selected(o, s);
   for (int k = 0; k < S->nl; ++k) {
     es_level_t lv;
-    if (es_level_build(&p, k, 5, &lv)) {
+    if (es_level_build(&p, o->first + k, 5, &lv)) {
       fprintf(stderr, "error: out of memory building level %d\n", k);
       return 1;
     }
@@ -178,7 +200,8 @@ static int run_study(mfree_context_t *ctx, const options_t *o, int kind, study_t
     for (int s = 0; s < ES_NSCHEMES; ++s) {
       if (!S->ok[s]) continue;
       const mfree_status_t st =
-          es_run(ctx, &p, &lv, &es_schemes[s], o->bc, 5, &S->r[s][k], S->err[s], sizeof S->err[s]);
+          es_run_vci(ctx, &p, &lv, &es_schemes[s], o->bc, vci_for(o, s), 5, &S->r[s][k], S->err[s],
+                     sizeof S->err[s]);
       S->seconds += S->r[s][k].seconds;
       if (st != MFREE_SUCCESS) {
         fprintf(stderr, "error: %s, %s level %d: %s\n", es_schemes[s].name,
@@ -212,7 +235,8 @@ static int run_patch(mfree_context_t *ctx, const options_t *o, patch_t *P) {
   char err[512];
   for (int s = 0; s < ES_NSCHEMES; ++s) {
     if (!selected(o, s)) continue;
-    P->ok[s] = es_run(ctx, &p, &lv, &es_schemes[s], o->bc, 5, &P->r[s], err, sizeof err) == MFREE_SUCCESS;
+    P->ok[s] = es_run_vci(ctx, &p, &lv, &es_schemes[s], o->bc, vci_for(o, s), 5, &P->r[s], err, sizeof err) ==
+               MFREE_SUCCESS;
     if (!P->ok[s]) fprintf(stderr, "error: %s, patch test: %s\n", es_schemes[s].name, err);
   }
   if (selected(o, 6))
@@ -260,8 +284,10 @@ static void print_study(const char *title, const char *setup, const study_t *S, 
     double t = 0;
     int warn = 0;
     for (int k = 0; k < S->nl; ++k) t += S->r[s][k].seconds, warn |= S->r[s][k].warn;
+    char bcn[16];
+    snprintf(bcn, sizeof bcn, "%s%s", es_bc_name(S->r[s][0].bc), S->r[s][0].vci ? "+v" : "");
     printf("%-4s %-8s | %6.2f %6s | %6.2f %6s | %6.2f %6.2f | %9.3e %9.3e %9.3e | %6.1f%s\n", es_schemes[s].name,
-           es_bc_name(S->r[s][0].bc), S->rate[s][0], pe, S->rate[s][1], pl, S->rate[s][2], S->rate[s][3], f->energy,
+           bcn, S->rate[s][0], pe, S->rate[s][1], pl, S->rate[s][2], S->rate[s][3], f->energy,
            f->L2, f->l2, t, warn ? " (warning)" : "");
   }
   printf("\nrelative errors per level (energy / L2 / l2):\n%-4s", "");
@@ -283,7 +309,9 @@ static void print_patch(const patch_t *P) {
   printf("%-4s %-8s | %9s %9s %9s\n", "", "BC", "energy", "L2", "l2");
   for (int s = 0; s < ES_NSCHEMES; ++s) {
     if (!P->ok[s]) continue;
-    printf("%-4s %-8s | %9.2e %9.2e %9.2e\n", es_schemes[s].name, es_bc_name(P->r[s].bc), P->r[s].energy,
+    char bcn[16];
+    snprintf(bcn, sizeof bcn, "%s%s", es_bc_name(P->r[s].bc), P->r[s].vci ? "+v" : "");
+    printf("%-4s %-8s | %9.2e %9.2e %9.2e\n", es_schemes[s].name, bcn, P->r[s].energy,
            P->r[s].L2, P->r[s].l2);
   }
   for (int v = 0; v < 2; ++v) {
@@ -302,9 +330,9 @@ static void json_study(const study_t *S) {
   printf("],\"seconds\":%.3f", S->seconds);
   for (int s = 0; s < ES_NSCHEMES; ++s) {
     if (!S->ok[s]) continue;
-    printf(",\"%s\":{\"bc\":\"%s\",\"energy_rate\":%.6f,\"L2_rate\":%.6f,\"l2_rate\":%.6f,"
+    printf(",\"%s\":{\"bc\":\"%s\",\"vci\":%s,\"energy_rate\":%.6f,\"L2_rate\":%.6f,\"l2_rate\":%.6f,"
            "\"energy_nodal_rate\":%.6f,\"errors\":[",
-           es_schemes[s].name, es_bc_name(S->r[s][0].bc), S->rate[s][0], S->rate[s][1], S->rate[s][2], S->rate[s][3]);
+           es_schemes[s].name, es_bc_name(S->r[s][0].bc), S->r[s][0].vci ? "true" : "false", S->rate[s][0], S->rate[s][1], S->rate[s][2], S->rate[s][3]);
     for (int k = 0; k < S->nl; ++k) {
       const es_result_t *r = &S->r[s][k];
       printf("%s{\"dx\":%.10g,\"energy\":%.6e,\"L2\":%.6e,\"l2\":%.6e,\"energy_nodal\":%.6e,\"seconds\":%.3f}",
@@ -402,7 +430,7 @@ static int on_path(const char *prog) {
 }
 
 int main(int argc, char **argv) {
-  options_t o = {0, 1, 5, 1, {1, 1, 0}, ".", ES_BC_AUTO, -1};
+  options_t o = {0, 1, 5, 1, {1, 1, 0}, ".", ES_BC_AUTO, -1, 0, 0};
   if (parse(argc, argv, &o)) {
     fputs(kUsage, stderr);
     return 2;

@@ -56,6 +56,10 @@ typedef struct {
   /* background Gauss points and weights (EFG on curved domains; error norms always) */
   int32_t nq;
   double *xq, *wq;
+  /* the whole boundary as Gauss points (4 per node interval, the exact arc on the
+   * hole) with weights and outward normals: mfree_assembler_set_consistent_integration */
+  int32_t nbp;
+  double *bpx, *bpw, *bpn;
   /* background cells aligned with the nodes (beam, patch): EFG uses
    * mfree_assembler_set_quadrature_cells on them; 0 when not available (hole). */
   int cells;
@@ -117,6 +121,7 @@ typedef struct {
   double rcond;          /* UMFPACK's pivot ratio */
   int32_t ndofs;
   es_bc_t bc;            /* the condition used */
+  int vci;               /* consistent integration of the test functions was used */
   int warn;              /* a positive (data-dependent) status was reported */
 } es_result_t;
 
@@ -126,6 +131,13 @@ typedef struct {
 mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_level_t *lv,
                       const es_scheme_t *s, es_bc_t bc, int efg_ngauss, es_result_t *r,
                       char *err, int errlen);
+/* The same with variationally consistent integration of the test functions
+ * (mfree_assembler_set_consistent_integration on the whole boundary) when vci is
+ * nonzero: not the paper's; for the schemes whose test functions have values (CD1,
+ * CD2, MLS, EFG). */
+mfree_status_t es_run_vci(mfree_context_t *ctx, const es_problem_t *p, const es_level_t *lv,
+                          const es_scheme_t *s, es_bc_t bc, int vci, int efg_ngauss,
+                          es_result_t *r, char *err, int errlen);
 
 /* Least-squares slope of log(e) against log(dx). */
 double es_rate(int n, const double *dx, const double *e);

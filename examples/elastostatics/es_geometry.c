@@ -283,6 +283,25 @@ static int hole_points(double a, double b, int32_t nxi, int32_t neta, int ng, gr
   return 0;
 }
 
+/* Gauss points (4 per interval) on the straight boundary line through the nodes of a
+ * sorted line, with outward normal (nx, ny). */
+static int boundary_line(const es_level_t *lv, const int32_t *idx, int np, double nx, double ny, grow_t *bx,
+                         grow_t *bw, grow_t *bn) {
+  double g[4], w[4];
+  gauss_rule(4, g, w);
+  const double nn[2] = {nx, ny};
+  for (int k = 0; k + 1 < np; ++k) {
+    const double *a = lv->x + 2 * idx[k], *b = lv->x + 2 * idx[k + 1];
+    const double len = hypot(b[0] - a[0], b[1] - a[1]);
+    for (int q = 0; q < 4; ++q) {
+      const double t = 0.5 * (1.0 + g[q]), pt[2] = {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])};
+      const double wt = 0.5 * len * w[q];
+      if (push(bx, pt) || push(bw, &wt) || push(bn, nn)) return 1;
+    }
+  }
+  return 0;
+}
+
 /* Deterministic uniform numbers in [0, 1) for the irregular patch cloud. */
 static double rnd(uint64_t *s) {
   *s ^= *s >> 12;
@@ -309,6 +328,7 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
   memset(lv, 0, sizeof *lv);
   grow_t X = {NULL, 0, 0, 2}, DS = {NULL, 0, 0, 4}, DN = {NULL, 0, 0, 2}, DM = {NULL, 0, 0, 1};
   grow_t TS = {NULL, 0, 0, 4}, TN = {NULL, 0, 0, 2}, XQ = {NULL, 0, 0, 2}, WQ = {NULL, 0, 0, 1};
+  grow_t BX = {NULL, 0, 0, 2}, BW = {NULL, 0, 0, 1}, BN = {NULL, 0, 0, 2};
   double lo[2], hi[2];
   int fail = 0;
   if (p->kind == ES_BEAM) {
@@ -386,8 +406,14 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
       if (fabs(lv->x[2 * i]) < tol) lv->dmask[i] = 3;
     np = line_nodes(lv, 1, 0.0, tol, line);
     fail |= add_chain(lv, &DS, &DN, &DM, line, np, -1.0, 0.0, 3) | add_dchain(lv, line, np, -1.0, 0.0, 3);
+    fail |= boundary_line(lv, line, np, -1.0, 0.0, &BX, &BW, &BN);
     np = line_nodes(lv, 1, p->L, tol, line);
     fail |= add_chain(lv, &TS, &TN, NULL, line, np, 1.0, 0.0, 0);
+    fail |= boundary_line(lv, line, np, 1.0, 0.0, &BX, &BW, &BN);
+    np = line_nodes(lv, 0, -0.5 * p->D, tol, line);
+    fail |= boundary_line(lv, line, np, 0.0, -1.0, &BX, &BW, &BN);
+    np = line_nodes(lv, 0, 0.5 * p->D, tol, line);
+    fail |= boundary_line(lv, line, np, 0.0, 1.0, &BX, &BW, &BN);
     fail |= cell_points(lo, hi, lv->ncells, ngauss, &XQ, &WQ);
   } else if (p->kind == ES_HOLE) {
     /* symmetry: u_y = 0 on y = 0, u_x = 0 on x = 0; Kirsch tractions on x = b, y = b */
@@ -397,12 +423,29 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
     }
     np = line_nodes(lv, 0, 0.0, tol, line);
     fail |= add_chain(lv, &DS, &DN, &DM, line, np, 0.0, -1.0, 2) | add_dchain(lv, line, np, 0.0, -1.0, 2);
+    fail |= boundary_line(lv, line, np, 0.0, -1.0, &BX, &BW, &BN);
     np = line_nodes(lv, 1, 0.0, tol, line);
     fail |= add_chain(lv, &DS, &DN, &DM, line, np, -1.0, 0.0, 1) | add_dchain(lv, line, np, -1.0, 0.0, 1);
+    fail |= boundary_line(lv, line, np, -1.0, 0.0, &BX, &BW, &BN);
     np = line_nodes(lv, 1, p->b, tol, line);
     fail |= add_chain(lv, &TS, &TN, NULL, line, np, 1.0, 0.0, 0);
+    fail |= boundary_line(lv, line, np, 1.0, 0.0, &BX, &BW, &BN);
     np = line_nodes(lv, 0, p->b, tol, line);
     fail |= add_chain(lv, &TS, &TN, NULL, line, np, 0.0, 1.0, 0);
+    fail |= boundary_line(lv, line, np, 0.0, 1.0, &BX, &BW, &BN);
+    {
+      /* the arc r = a, 4 Gauss points in the angle per arc interval of the nodes */
+      const int32_t narc = (int32_t)ceil(0.5 * M_PI * p->a / lv->dx);
+      double g[4], w[4];
+      gauss_rule(4, g, w);
+      for (int32_t q = 0; q < narc; ++q)
+        for (int k = 0; k < 4; ++k) {
+          const double t = 0.5 * M_PI * (q + 0.5 * (1.0 + g[k])) / narc;
+          const double pt[2] = {p->a * cos(t), p->a * sin(t)}, nn[2] = {-cos(t), -sin(t)};
+          const double wt = 0.5 * (0.5 * M_PI * p->a / narc) * w[k];
+          fail |= push(&BX, pt) || push(&BW, &wt) || push(&BN, nn);
+        }
+    }
     const int32_t nxi = (int32_t)lround(p->b / lv->dx), neta = (int32_t)lround((p->b - p->a) / lv->dx);
     fail |= hole_points(p->a, p->b, nxi, neta, ngauss, &XQ, &WQ);
   } else {
@@ -414,12 +457,16 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
     }
     np = line_nodes(lv, 0, 0.0, tol, line);
     fail |= add_chain(lv, &DS, &DN, &DM, line, np, 0.0, -1.0, 3) | add_dchain(lv, line, np, 0.0, -1.0, 3);
+    fail |= boundary_line(lv, line, np, 0.0, -1.0, &BX, &BW, &BN);
     np = line_nodes(lv, 0, 1.0, tol, line);
     fail |= add_chain(lv, &DS, &DN, &DM, line, np, 0.0, 1.0, 3) | add_dchain(lv, line, np, 0.0, 1.0, 3);
+    fail |= boundary_line(lv, line, np, 0.0, 1.0, &BX, &BW, &BN);
     np = line_nodes(lv, 1, 0.0, tol, line);
     fail |= add_chain(lv, &DS, &DN, &DM, line, np, -1.0, 0.0, 3) | add_dchain(lv, line, np, -1.0, 0.0, 3);
+    fail |= boundary_line(lv, line, np, -1.0, 0.0, &BX, &BW, &BN);
     np = line_nodes(lv, 1, 1.0, tol, line);
     fail |= add_chain(lv, &DS, &DN, &DM, line, np, 1.0, 0.0, 3) | add_dchain(lv, line, np, 1.0, 0.0, 3);
+    fail |= boundary_line(lv, line, np, 1.0, 0.0, &BX, &BW, &BN);
     fail |= cell_points(lo, hi, lv->ncells, ngauss, &XQ, &WQ);
   }
   free(line);
@@ -437,9 +484,13 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
   lv->nq = XQ.n;
   lv->xq = XQ.p;
   lv->wq = WQ.p;
+  lv->nbp = BX.n;
+  lv->bpx = BX.p;
+  lv->bpw = BW.p;
+  lv->bpn = BN.p;
   return 0;
 oom:
-  free(X.p), free(DM.p), free(TS.p), free(TN.p), free(XQ.p), free(WQ.p);
+  free(X.p), free(DM.p), free(TS.p), free(TN.p), free(XQ.p), free(WQ.p), free(BX.p), free(BW.p), free(BN.p);
   if (lv->dseg != DS.p) free(DS.p);
   if (lv->dnrm != DN.p) free(DN.p);
   es_level_free(lv);
@@ -449,5 +500,6 @@ oom:
 void es_level_free(es_level_t *lv) {
   free(lv->x), free(lv->vol), free(lv->dmask), free(lv->dseg), free(lv->dnrm), free(lv->dsmask);
   free(lv->tseg), free(lv->tnrm), free(lv->xq), free(lv->wq), free(lv->chain_nodes);
+  free(lv->bpx), free(lv->bpw), free(lv->bpn);
   memset(lv, 0, sizeof *lv);
 }

@@ -582,6 +582,12 @@ static int chk(chk_t *c, mfree_status_t st, const char *what) {
 mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_level_t *lv,
                       const es_scheme_t *s, es_bc_t bc, int efg_ngauss, es_result_t *r,
                       char *err, int errlen) {
+  return es_run_vci(ctx, p, lv, s, bc, 0, efg_ngauss, r, err, errlen);
+}
+
+mfree_status_t es_run_vci(mfree_context_t *ctx, const es_problem_t *p, const es_level_t *lv,
+                          const es_scheme_t *s, es_bc_t bc, int vci, int efg_ngauss,
+                          es_result_t *r, char *err, int errlen) {
   const double t0 = now();
   memset(r, 0, sizeof *r);
   if (err && errlen > 0) err[0] = '\0';
@@ -602,6 +608,7 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
 
   bc = es_bc_resolve(s, lv, bc);
   r->bc = bc;
+  r->vci = vci != 0;
   if ((s->efg || s->particles_only) && bc == ES_BC_FE_GAUSS) {
     st = MFREE_ERR_UNSUPPORTED;
     if (err) snprintf(err, (size_t)errlen, "%s: fe-gauss is for nodal quadrature of functions defined between "
@@ -611,6 +618,11 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
   if (s->efg && bc == ES_BC_FE_NODAL) {
     st = MFREE_ERR_UNSUPPORTED;
     if (err) snprintf(err, (size_t)errlen, "%s: the FE-layer emulation is for nodal quadrature", s->name);
+    goto done;
+  }
+  if (s->particles_only && vci) {
+    st = MFREE_ERR_UNSUPPORTED;
+    if (err) snprintf(err, (size_t)errlen, "%s: consistent integration needs test-function values", s->name);
     goto done;
   }
   if (s->particles_only && bc == ES_BC_NITSCHE) {
@@ -757,6 +769,9 @@ mfree_status_t es_run(mfree_context_t *ctx, const es_problem_t *p, const es_leve
             "FE layer");
     }
   }
+  if (vci)
+    CHECK(mfree_assembler_set_consistent_integration(as, lv->nbp, lv->bpx, MFREE_LAYOUT_AOS, 2, lv->bpw, lv->bpn),
+          "consistent integration");
   CHECK(mfree_assembler_setup(as), "assembler setup");
   int32_t ndofs = 0, nquad = 0;
   CHECK(mfree_assembler_get_size(as, &ndofs, &nquad), "sizes");

@@ -108,6 +108,12 @@ mfree_status_t mfree_assembler_set_fe_layer(mfree_assembler_t *as, int32_t nelem
 mfree_status_t mfree_assembler_set_penalty(mfree_assembler_t *as, double alpha) {
   MFREE_AS_SETTER("mfree_assembler_set_penalty", a.set_penalty(alpha));
 }
+mfree_status_t mfree_assembler_set_consistent_integration(mfree_assembler_t *as, int32_t npts, const double *x,
+                                                         mfree_layout_t layout, int64_t ld, const double *w,
+                                                         const double *normals) {
+  MFREE_AS_SETTER("mfree_assembler_set_consistent_integration",
+                  a.set_consistent_integration(npts, x, layout, ld, w, normals));
+}
 
 mfree_status_t mfree_assembler_setup(mfree_assembler_t *as) {
   return mfree::with_handle(as, "mfree_assembler_setup", [&](mfree::Assembler &a) {

@@ -293,6 +293,37 @@ void Assembler::add_dirichlet(int method, int32_t npts, const double *x, int lay
   setup_done_ = false;
 }
 
+void Assembler::set_consistent_integration(int32_t npts, const double *x, int layout, int64_t ld,
+                                           const double *w, const double *normals) {
+  if (collocation() || mass())
+    throw Error(MFREE_ERR_UNSUPPORTED, "consistent integration corrects test gradients of Galerkin stiffness forms");
+  if (is_particles_only(test_cfg_.method))
+    throw Error(MFREE_ERR_UNSUPPORTED, "consistent integration needs test-function values at boundary points, which "
+                                       "symmetrised SPH, Johnson-Beissel and Randles-Libersky do not define");
+  check_points(npts, x, w, "consistent integration");
+  if (npts > 0 && !w) throw Error(MFREE_ERR_NULL, "consistent integration: weights are NULL");
+  if (npts > 0 && !normals) throw Error(MFREE_ERR_NULL, "consistent integration: normals are NULL");
+  for (int32_t p = 0; p < npts; ++p) {
+    double len = 0.0;
+    for (int c = 0; c < dim_; ++c) len += normals[p * dim_ + c] * normals[p * dim_ + c];
+    if (!(std::isfinite(len) && std::fabs(len - 1.0) < 1e-6))
+      throw Error(MFREE_ERR_INPUT, "consistent integration: normal " + std::to_string(p) +
+                                       " is not a finite unit vector");
+  }
+  std::unique_ptr<PointSet> s;
+  if (npts > 0) {
+    s = std::make_unique<PointSet>();
+    s->kind = 5;
+    read_points(npts, x, layout, ld, s->x);
+    s->w.assign(w, w + npts);
+    s->normals.assign(normals, normals + static_cast<size_t>(npts) * dim_);
+  }
+  psets_.erase(std::remove_if(psets_.begin(), psets_.end(), [](const std::unique_ptr<PointSet> &q) { return q->kind == 5; }),
+               psets_.end());
+  if (s) psets_.push_back(std::move(s));
+  setup_done_ = false;
+}
+
 void Assembler::add_dirichlet_nodes(int32_t n, const int32_t *nodes, int32_t mask, mfree_field_fn g, void *user) {
   if (n < 0) throw Error(MFREE_ERR_ARG, "negative node count");
   if (n > 0 && !nodes) throw Error(MFREE_ERR_NULL, "nodes are NULL");
@@ -468,11 +499,19 @@ bool Assembler::fe_shape(int32_t e, const double *x, double *N, double *dN) cons
   return true;
 }
 
-void Assembler::fill_qtable(const Approximant &a, QTable &t, const std::vector<double> *w) const {
+void Assembler::fill_qtable(const Approximant &a, QTable &t, const std::vector<double> *w,
+                            const std::vector<double> *pts) const {
   const int dim = dim_;
   const int32_t nq = a.num_sites();
   t.w.resize(nq);
   for (int32_t q = 0; q < nq; ++q) t.w[q] = w ? (*w)[q] : ps_->volume(q);
+  if (pts) {
+    t.x = *pts;
+  } else {
+    t.x.resize(static_cast<size_t>(nq) * dim);
+    for (int32_t q = 0; q < nq; ++q)
+      for (int d = 0; d < dim; ++d) t.x[static_cast<size_t>(q) * dim + d] = ps_->x(q, d);
+  }
   t.rowptr = a.rowptr();
   t.cols = a.cols();
   const size_t nnz = t.cols.size();
@@ -493,8 +532,10 @@ void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
   std::vector<int32_t> cols;
   std::vector<double> val, grad, sgrad;
   const bool has_s = !t.sgrad.empty();
+  int32_t cur = 0;  // the input point being pushed
   auto push = [&](double w) {
     out.w.push_back(w);
+    out.x.insert(out.x.end(), t.x.begin() + 2 * static_cast<size_t>(cur), t.x.begin() + 2 * static_cast<size_t>(cur) + 2);
     out.cols.insert(out.cols.end(), cols.begin(), cols.end());
     out.val.insert(out.val.end(), val.begin(), val.end());
     out.grad.insert(out.grad.end(), grad.begin(), grad.end());
@@ -502,6 +543,7 @@ void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
     out.rowptr.push_back(static_cast<int64_t>(out.cols.size()));
   };
   for (int32_t q = 0; q < t.size(); ++q) {
+    cur = q;
     const int64_t k0 = t.rowptr[q], k1 = t.rowptr[q + 1];
     cols.assign(t.cols.begin() + k0, t.cols.begin() + k1);
     val.assign(t.val.begin() + k0, t.val.begin() + k1);
@@ -581,8 +623,8 @@ void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
 void Assembler::build_qtables() {
   if (collocation()) return;
   const bool nodal = quad_kind_ == 0;
-  fill_qtable(*trial_q_, qtrial_, nodal ? nullptr : &qw_);
-  if (test_q_) fill_qtable(*test_q_, qtest_, nodal ? nullptr : &qw_);
+  fill_qtable(*trial_q_, qtrial_, nodal ? nullptr : &qw_, nodal ? nullptr : &qx_);
+  if (test_q_) fill_qtable(*test_q_, qtest_, nodal ? nullptr : &qw_, nodal ? nullptr : &qx_);
   else qtest_ = QTable();
   auto shear = [&](const Approximant *a, QTable &t) {
     if (!a) return;
@@ -603,14 +645,112 @@ void Assembler::build_qtables() {
   for (size_t i = 0; i < psets_.size(); ++i) {
     PointSet &s = *psets_[i];
     if (s.test) {
-      fill_qtable(*s.test, ps_test_[i], &s.w);
+      fill_qtable(*s.test, ps_test_[i], &s.w, &s.x);
       if (fe_.npe) blend_qtable(ps_test_[i], &s.x);
     }
     if (s.trial) {
-      fill_qtable(*s.trial, ps_trial_[i], &s.w);
+      fill_qtable(*s.trial, ps_trial_[i], &s.w, &s.x);
       if (fe_.npe) blend_qtable(ps_trial_[i], &s.x);
     }
   }
+  // variationally consistent integration: the test gradients of the assembly corrected
+  own_test_table_ = test_q_ != nullptr;
+  for (size_t i = 0; i < psets_.size(); ++i) {
+    if (psets_[i]->kind != 5) continue;
+    if (!own_test_table_) {
+      qtest_ = qtrial_;
+      own_test_table_ = true;
+    }
+    correct_test_gradients(qtest_, ps_test_[i], psets_[i]->normals);
+  }
+}
+
+// Chen, Hillman and Rueter (IJNME 93, 2013): with the corrected gradients
+// grad Psi_J + C_J p(x) at the quadrature points of J's support, p = (1, (x - x_J) / h_J),
+// the quadrature satisfies the divergence theorem for Psi_J times every p_k,
+//   sum_q (grad Psi_J p_k + Psi_J grad p_k)(x_q) w_q = sum_b (Psi_J p_k n)(x_b) w_b,
+// so that trial functions that reproduce linear fields pass the linear patch test
+// whatever the quadrature (nodal, or the layer's strip sampled at its two edges), and
+// the integration error of linear stress fields is removed too. A support whose moment
+// matrix is singular (too few points) gets the constant correction only.
+void Assembler::correct_test_gradients(QTable &t, const QTable &b, const std::vector<double> &normals) const {
+  const int dim = dim_, np = 1 + dim;
+  const int32_t n = ps_->size();
+  std::vector<double> M(static_cast<size_t>(n) * np * np, 0.0), R(static_cast<size_t>(n) * np * dim, 0.0);
+  auto basis = [&](int32_t J, const double *x, double *P) {
+    const double h = ps_->h(J);
+    P[0] = 1.0;
+    for (int d = 0; d < dim; ++d) P[1 + d] = (x[d] - ps_->x(J, d)) / h;
+  };
+  double P[4];
+  for (int32_t p = 0; p < b.size(); ++p)
+    for (int64_t a = b.rowptr[p]; a < b.rowptr[p + 1]; ++a) {
+      const int32_t J = b.cols[a];
+      basis(J, &b.x[static_cast<size_t>(p) * dim], P);
+      for (int k = 0; k < np; ++k)
+        for (int i = 0; i < dim; ++i)
+          R[(static_cast<size_t>(J) * np + k) * dim + i] +=
+              b.w[p] * b.val[a] * P[k] * normals[static_cast<size_t>(p) * dim + i];
+    }
+  for (int32_t q = 0; q < t.size(); ++q)
+    for (int64_t a = t.rowptr[q]; a < t.rowptr[q + 1]; ++a) {
+      const int32_t J = t.cols[a];
+      const double w = t.w[q], hinv = 1.0 / ps_->h(J);
+      basis(J, &t.x[static_cast<size_t>(q) * dim], P);
+      double *m = &M[static_cast<size_t>(J) * np * np];
+      for (int k = 0; k < np; ++k)
+        for (int l = 0; l < np; ++l) m[k * np + l] += w * P[k] * P[l];
+      for (int k = 0; k < np; ++k)
+        for (int i = 0; i < dim; ++i)
+          R[(static_cast<size_t>(J) * np + k) * dim + i] -=
+              w * (t.grad[a * dim + i] * P[k] + (k == 1 + i ? t.val[a] * hinv : 0.0));
+    }
+  // C_J (np x dim) = M_J^-1 R_J by Gaussian elimination with partial pivoting
+  std::vector<double> Cc(static_cast<size_t>(n) * np * dim, 0.0);
+  for (int32_t J = 0; J < n; ++J) {
+    double A[4][4], B[4][3];
+    const double *m = &M[static_cast<size_t>(J) * np * np], *r = &R[static_cast<size_t>(J) * np * dim];
+    if (!(m[0] > 0.0)) continue;
+    int use = np;
+    for (int k = 0; k < np; ++k)
+      for (int l = 0; l < np; ++l) A[k][l] = m[k * np + l];
+    for (int k = 0; k < np; ++k)
+      for (int i = 0; i < dim; ++i) B[k][i] = r[k * dim + i];
+    for (int c = 0; c < use; ++c) {
+      int piv = c;
+      for (int k = c + 1; k < use; ++k)
+        if (std::fabs(A[k][c]) > std::fabs(A[piv][c])) piv = k;
+      if (std::fabs(A[piv][c]) < 1e-8 * m[0]) {  // singular: the constant correction only
+        use = 1;
+        A[0][0] = m[0];
+        for (int i = 0; i < dim; ++i) B[0][i] = r[i];
+        break;
+      }
+      std::swap(A[c], A[piv]);
+      std::swap(B[c], B[piv]);
+      for (int k = c + 1; k < use; ++k) {
+        const double f = A[k][c] / A[c][c];
+        for (int l = c; l < use; ++l) A[k][l] -= f * A[c][l];
+        for (int i = 0; i < dim; ++i) B[k][i] -= f * B[c][i];
+      }
+    }
+    double *cj = &Cc[static_cast<size_t>(J) * np * dim];
+    for (int k = use - 1; k >= 0; --k)
+      for (int i = 0; i < dim; ++i) {
+        double v = B[k][i];
+        for (int l = k + 1; l < use; ++l) v -= A[k][l] * cj[l * dim + i];
+        cj[k * dim + i] = v / A[k][k];
+      }
+  }
+  for (int32_t q = 0; q < t.size(); ++q)
+    for (int64_t a = t.rowptr[q]; a < t.rowptr[q + 1]; ++a) {
+      const int32_t J = t.cols[a];
+      basis(J, &t.x[static_cast<size_t>(q) * dim], P);
+      const double *cj = &Cc[static_cast<size_t>(J) * np * dim];
+      for (int i = 0; i < dim; ++i)
+        for (int k = 0; k < np; ++k) t.grad[a * dim + i] += cj[k * dim + i] * P[k];
+    }
+  t.sgrad.clear();  // particles-only test functions are rejected by set_consistent_integration
 }
 
 double Assembler::mean_h() const {
@@ -784,7 +924,7 @@ Report Assembler::build_tables() {
       merge(s->trial->setup(), "trial functions at Nitsche points");
       continue;
     }
-    if (s->kind == 1 || s->kind == 2) {
+    if (s->kind == 1 || s->kind == 2 || s->kind == 5) {
       s->test = make(values_config(test_cfg_), &s->x);
       merge(s->test->setup(), "test values at boundary points");
     }
@@ -810,7 +950,7 @@ void Assembler::build_pattern() {
     // sees: through the transpose of the test table, with a marker per node, so that
     // each row is collected without duplicates (background quadrature has many points
     // per node pair).
-    const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
+    const QTable &qa = qtrial_, &qb = test_table();
     std::vector<int64_t> tp(static_cast<size_t>(n) + 1, 0);
     for (int32_t J : qb.cols) ++tp[static_cast<size_t>(J) + 1];
     for (int32_t J = 0; J < n; ++J) tp[J + 1] += tp[J];
@@ -1007,7 +1147,7 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
         }
       }
   } else if (form_ == MFREE_FORM_MASS || form_ == MFREE_FORM_MASS_LUMPED) {
-    const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
+    const QTable &qa = qtrial_, &qb = test_table();
     const auto &Pv = qa.val, &Tv = qb.val;
     for (int32_t q = 0; q < qa.size(); ++q) {
       const double w = qa.w[q];
@@ -1024,7 +1164,7 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
     // Row by row (gather): for each test node J, the quadrature points its test
     // function sees (the transpose of the test table), with the positions of J's
     // columns in a scatter array, so that no entry is searched for.
-    const QTable &qa = qtrial_, &qb = test_q_ ? qtest_ : qtrial_;
+    const QTable &qa = qtrial_, &qb = test_table();
     const auto &Pg = qa.grad, &Tg = qb.grad;
     const auto &Ps = qa.sgrad.empty() ? qa.grad : qa.sgrad, &Ts = qb.sgrad.empty() ? qb.grad : qb.sgrad;
     const int32_t nn = ps_->size();
@@ -1211,6 +1351,7 @@ void Assembler::assemble_rhs(double *f) const {
     }
     for (size_t si = 0; si < psets_.size(); ++si) {
       auto &s = psets_[si];
+      if (s->kind == 5) continue;  // boundary of the consistent integration: no load
       const QView ts{ps_test_[si]};
       const int32_t np = static_cast<int32_t>(s->w.size());
       int32_t m = nbase + s->first_multiplier;
@@ -1236,7 +1377,7 @@ void Assembler::assemble_rhs(double *f) const {
               if (s->kind == 2 && !(s->mask & (1 << c))) continue;
               f[ts.cols()[a] * nc + c] += fac * ts.values()[a] * val[c];
             }
-        } else {
+        } else if (s->kind == 3) {
           for (int c = 0; c < nc; ++c)
             if (s->mask & (1 << c)) f[m++] = val[c];
         }

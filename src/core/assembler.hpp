@@ -35,6 +35,10 @@ class Assembler {
   void add_traction_nodes(int32_t n, const int32_t *nodes, const double *normals, mfree_field_fn t,
                           void *user);
   void set_penalty(double alpha);
+  // Variationally consistent integration (Chen, Hillman, Rueter 2013), first order: the
+  // whole boundary as points, weights and outward normals; npts = 0 switches it off.
+  void set_consistent_integration(int32_t npts, const double *x, int layout, int64_t ld, const double *w,
+                                  const double *normals);
   void set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, int32_t ngu, const int32_t *gu,
                     int32_t mask, mfree_field_fn g, void *user);
 
@@ -62,7 +66,7 @@ class Assembler {
 
  private:
   struct PointSet {  // boundary points with weights
-    int kind = 0;    // 1 traction, 2 penalty, 3 Lagrange, 4 Nitsche
+    int kind = 0;    // 1 traction, 2 penalty, 3 Lagrange, 4 Nitsche, 5 boundary for VCI
     std::vector<double> x, w, normals;
     int32_t mask = 0;
     mfree_field_fn fn = nullptr;
@@ -87,6 +91,7 @@ class Assembler {
     std::vector<int64_t> rowptr{0};
     std::vector<int32_t> cols;
     std::vector<double> val, grad;
+    std::vector<double> x;  // position of each point (dim per point)
     // Derivatives for the shear strains when they differ from grad (Johnson-Beissel,
     // paper 000 eqs 48-52: the shear keeps the symmetrised SPH derivatives); empty: grad.
     std::vector<double> sgrad;
@@ -109,8 +114,15 @@ class Assembler {
     std::vector<double> bmin, bmax;  // element bounding boxes
   };
   void build_qtables();
+  // First-order VCI of the test gradients in t from the boundary values b with normals.
+  void correct_test_gradients(QTable &t, const QTable &b, const std::vector<double> &normals) const;
+  // The test table of the assembly: its own when the test functions differ from the
+  // trial functions or their gradients were corrected, else the trial table.
+  const QTable &test_table() const { return own_test_table_ ? qtest_ : qtrial_; }
   // Copy an approximant's rows; weights w (NULL: the particle volumes).
-  void fill_qtable(const Approximant &a, QTable &t, const std::vector<double> *w) const;
+  // Positions pts (NULL: the particles).
+  void fill_qtable(const Approximant &a, QTable &t, const std::vector<double> *w,
+                   const std::vector<double> *pts = nullptr) const;
   // Blend rows at points pts (NULL: the particles, nodal quadrature) with the FE layer.
   void blend_qtable(QTable &t, const std::vector<double> *pts) const;
   // FE shape functions of layer element e at x (N[npe], dN[npe*2]); false if x is outside.
@@ -165,6 +177,7 @@ class Assembler {
   std::vector<int32_t> row_set_, row_node_;  // which node set / position replaces the row
   FeLayer fe_;
   QTable qtrial_, qtest_;
+  bool own_test_table_ = false;
   std::vector<QTable> ps_test_, ps_trial_;  // per point set (same order as psets_)
 };
 
