@@ -57,6 +57,7 @@ typedef struct {
   int only; /* -1 all schemes, else a bit mask of the selected ones */
   int vci;  /* mfree_assembler_set_consistent_integration for the schemes with test values */
   int first; /* index of the coarsest level (0: 17x3 beam, 118-node hole) */
+  int mapped; /* hole: the mapped-grid nodes (--hole-nodes mapped) */
 } options_t;
 
 typedef struct {
@@ -84,11 +85,14 @@ static const char kUsage[] =
     "                           [--out DIR] [--no-plot] [--bc auto|fe-layer|fe-nodal|fe-gauss|\n"
     "                           direct|rows|nitsche|penalty|lagrange]"
     " [--scheme NAME[,NAME..]] [--threads N] [--vci] [--first K]\n"
+    "                           [--hole-nodes grid|mapped]\n"
     "Paper 000 Table III: convergence of SPH, JB, RL, CD1, CD2, MLS and EFG on the cantilever\n"
     "beam and the plate with a hole (plane stress), next to the paper's rates; a patch test.\n"
     "  --problem  both (default) = beam and hole; all = beam, hole and patch test\n"
     "  --levels   refinements per problem (default 5; at least 2)\n"
     "  --first    index of the coarsest level (default 0: beam 17x3, hole 118 nodes; 0..4)\n"
+    "  --hole-nodes grid (default: regular grid cut by the hole, nodes on the arc) or mapped\n"
+    "             (the ruled map from the arc to the outer edges: non-uniform, dense at the hole)\n"
     "  --bc       essential conditions for every scheme; default auto = fe-layer (mfree's\n"
     "             finite-element blending layer, 000 Sect. 5.6, a mask per line); fe-nodal =\n"
     "             the example's nodal-quadrature build of the same layer; fe-gauss = the layer's\n"
@@ -148,6 +152,11 @@ static int parse(int argc, char **argv, options_t *o) {
         if (*q == ',') ++q;
       }
       if (!o->only) return 1;
+    } else if (v && strcmp(a, "--hole-nodes") == 0) {
+      ++i;
+      if (strcmp(v, "mapped") == 0) o->mapped = 1;
+      else if (strcmp(v, "grid") == 0) o->mapped = 0;
+      else return 1;
     } else if (v && strcmp(a, "--first") == 0) {
       ++i;
       char *end;
@@ -182,6 +191,7 @@ static void set_problem(int kind, es_problem_t *p) {
 static int run_study(mfree_context_t *ctx, const options_t *o, int kind, study_t *S) {
   es_problem_t p;
   set_problem(kind, &p);
+  p.mapped = o->mapped;
   memset(S, 0, sizeof *S);
   S->nl = o->levels;
   for (int s = 0; s < ES_NSCHEMES; ++s) S->sel[s] = S->ok[s] = selected(o, s);
@@ -430,7 +440,7 @@ static int on_path(const char *prog) {
 }
 
 int main(int argc, char **argv) {
-  options_t o = {0, 1, 5, 1, {1, 1, 0}, ".", ES_BC_AUTO, -1, 0, 0};
+  options_t o = {0, 1, 5, 1, {1, 1, 0}, ".", ES_BC_AUTO, -1, 0, 0, 0};
   if (parse(argc, argv, &o)) {
     fputs(kUsage, stderr);
     return 2;

@@ -23,6 +23,8 @@ typedef struct {
   double P, L, D;  /* beam: end load, length, depth (000 eqs 120-125) */
   double a, b;     /* hole: radius, outer size of the quarter model [0, b]^2 */
   double c[6];     /* patch: u_x = c0 + c1 x + c2 y, u_y = c3 + c4 x + c5 y */
+  int mapped;      /* hole: nodes of the mapped grid between the arc and the outer edges
+                      (non-uniform, dense at the hole) instead of the cut regular grid */
 } es_problem_t;
 
 /* Exact displacement u (2), strain eps (xx, yy, engineering gamma_xy) and stress sig

@@ -351,15 +351,34 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
     const int32_t m = 2 * (int32_t)lround(5.0 * pow(sqrt(2.0), k));
     const double dx = p->b / m, a = p->a, b = p->b;
     lv->dx = dx;
-    const int32_t narc = (int32_t)ceil(0.5 * M_PI * a / dx);
-    for (int32_t q = 0; q <= narc; ++q) {
+    const int32_t narc = p->mapped ? 0 : (int32_t)ceil(0.5 * M_PI * a / dx);
+    if (p->mapped) {
+      /* the ruled map of hole_points with m intervals along each outer edge and
+       * round(0.8 m) across: spacing dx at the outer edges, a pi / (4 m) along the hole */
+      const int32_t neta = (int32_t)lround((b - a) / dx);
+      for (int blk = 0; blk < 2; ++blk)
+        for (int32_t i = 0; i <= m - blk; ++i)
+          for (int32_t j = 0; j <= neta; ++j) {
+            const double t = 0.25 * M_PI * i / m, eta = (double)j / neta;
+            double q[2] = {(1.0 - eta) * a * cos(t) + eta * b, (1.0 - eta) * a * sin(t) + eta * b * tan(t)};
+            if (i == 0) q[1] = 0.0;
+            if (j == neta) q[0] = b;
+            if (i == m) q[1] = q[0];
+            if (blk) {
+              const double tmp = q[0];
+              q[0] = q[1], q[1] = tmp;
+            }
+            fail |= push(&X, q);
+          }
+    }
+    for (int32_t q = 0; q <= narc && !p->mapped; ++q) {
       const double t = 0.5 * M_PI * q / narc;
       double pt[2] = {a * cos(t), a * sin(t)};
       if (q == 0) pt[1] = 0.0; /* exactly on the symmetry lines */
       if (q == narc) pt[0] = 0.0;
       fail |= push(&X, pt);
     }
-    for (int32_t i = 0; i <= m; ++i)
+    for (int32_t i = 0; i <= m && !p->mapped; ++i)
       for (int32_t j = 0; j <= m; ++j) {
         const double q[2] = {i * dx, j * dx};
         if (hypot(q[0], q[1]) >= a + 0.5 * dx) fail |= push(&X, q);
