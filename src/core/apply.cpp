@@ -62,6 +62,59 @@ void gradient_rows(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *c
   }
 }
 
+// The hot cases (D and NC <= 3 fields compile-time, apply or apply_add): the NC * D
+// accumulators live in registers and the row is one branch-free streaming pass over
+// the columns and the gradient table. Same operations in the same order as
+// gradient_rows (each output summed over the row in row order, starting from 0), so the
+// results are bitwise those of the general loop.
+template <int D, int NC, bool Add>
+void gradient_rows_fixed(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols,
+                         const double *grad, const double *u, int64_t ju, int64_t cu, double *out,
+                         int64_t so, int64_t co) {
+  int64_t k = rowptr[b];
+  for (int64_t s = b; s < e; ++s) {
+    const int64_t k1 = rowptr[s + 1];
+    double acc[NC * D];
+#pragma GCC unroll 9
+    for (int q = 0; q < NC * D; ++q) acc[q] = 0.0;
+    for (; k < k1; ++k) {
+      const double *g = grad + k * D;
+      const double *uj = u + cols[k] * ju;
+#pragma GCC unroll 3
+      for (int c = 0; c < NC; ++c) {
+        const double v = uj[c * cu];
+#pragma GCC unroll 3
+        for (int d = 0; d < D; ++d) acc[c * D + d] += g[d] * v;
+      }
+    }
+    double *o = out + s * so;
+#pragma GCC unroll 9
+    for (int q = 0; q < NC * D; ++q) {
+      if (Add) o[q * co] += acc[q];
+      else o[q * co] = acc[q];
+    }
+  }
+}
+
+template <int D>
+void gradient_block(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
+                    int ncomp, const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co,
+                    bool add) {
+#define MFREE_GRAD_FIXED(NC)                                                                        \
+  case NC:                                                                                          \
+    if (add) gradient_rows_fixed<D, NC, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);    \
+    else gradient_rows_fixed<D, NC, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);       \
+    return;
+  switch (ncomp) {
+    MFREE_GRAD_FIXED(1)
+    MFREE_GRAD_FIXED(2)
+    MFREE_GRAD_FIXED(3)
+    default:
+      gradient_rows<D>(b, e, rowptr, cols, grad, ncomp, u, ju, cu, out, so, co, add);
+  }
+#undef MFREE_GRAD_FIXED
+}
+
 }  // namespace
 
 void Approximant::apply(int op, int ncomp, const double *u, int ulayout, int64_t uld, double *out,
@@ -76,9 +129,9 @@ void Approximant::apply(int op, int ncomp, const double *u, int ulayout, int64_t
   const int nt = num_threads(static_cast<int64_t>(cols_.size()) / 8);
   parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
     if (op == MFREE_OP_GRADIENT) {
-      if (dim == 1) gradient_rows<1>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
-      else if (dim == 2) gradient_rows<2>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
-      else gradient_rows<3>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
+      if (dim == 1) gradient_block<1>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
+      else if (dim == 2) gradient_block<2>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
+      else gradient_block<3>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
       return;
     }
     double acc[kBlock];

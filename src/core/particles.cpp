@@ -244,7 +244,8 @@ Report ParticleSet::setup() {
   }
   // A negative failure (periodic box too small, no memory) changes nothing: the old
   // statuses go back with the old lists.
-  std::vector<int32_t> before = site_status_;
+  prev_status_.reserve(static_cast<size_t>(n_));  // update swaps the two arrays
+  prev_status_.assign(site_status_.begin(), site_status_.end());
   Report rep = validate();
   Csr out;
   try {
@@ -266,7 +267,7 @@ Report ParticleSet::setup() {
       find_neighbors(*this, site_status_, out);
     }
   } catch (...) {
-    site_status_.swap(before);
+    site_status_.swap(prev_status_);
     throw;
   }
   nbr_ = std::move(out);
@@ -276,22 +277,25 @@ Report ParticleSet::setup() {
 
 Report ParticleSet::update() {
   if (!setup_done_) throw Error(MFREE_ERR_STATE, "update called before setup");
-  const std::vector<int32_t> before = site_status_;
+  // No allocation here (t430): both status arrays have n entries since setup, and a
+  // particle that turned invalid is dropped from the rows in place.
+  prev_status_.swap(site_status_);
   Report rep = validate();
-  // A particle that turned invalid since setup must not stay in anybody's row.
   bool changed = false;
   for (int32_t i = 0; i < n_; ++i)
-    if (site_status_[i] != 0 && before[i] == 0) changed = true;
+    if (site_status_[i] != 0 && prev_status_[i] == 0) changed = true;
   if (changed) {
-    Csr out;
-    out.rowptr.assign(static_cast<size_t>(num_owned()) + 1, 0);
+    // A particle that turned invalid since setup must not stay in anybody's row.
+    int64_t w = 0, r0 = 0;
     for (int32_t i = 0; i < num_owned(); ++i) {
+      const int64_t r1 = nbr_.rowptr[i + 1];
       if (site_status_[i] == 0)
-        for (int64_t k = nbr_.rowptr[i]; k < nbr_.rowptr[i + 1]; ++k)
-          if (site_status_[nbr_.cols[k]] == 0) out.cols.push_back(nbr_.cols[k]);
-      out.rowptr[i + 1] = static_cast<int64_t>(out.cols.size());
+        for (int64_t k = r0; k < r1; ++k)
+          if (site_status_[nbr_.cols[k]] == 0) nbr_.cols[w++] = nbr_.cols[k];
+      r0 = r1;
+      nbr_.rowptr[i + 1] = w;
     }
-    nbr_ = std::move(out);
+    nbr_.cols.resize(static_cast<size_t>(w));
   }
   return rep;
 }

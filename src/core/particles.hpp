@@ -118,6 +118,9 @@ class ParticleSet {
   bool setup_done_ = false;
   Csr nbr_;
   std::vector<int32_t> site_status_;
+  // The statuses before the running setup/update, kept as a member (sized at setup) so
+  // that update allocates nothing.
+  std::vector<int32_t> prev_status_;
 };
 
 // Cell-list search over the valid particles of ps (valid[i] != 0); fills rows for the
