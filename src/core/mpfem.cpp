@@ -482,6 +482,19 @@ double KernelProfile::G(double t, double h) const { return Gq(t / h); }
 
 namespace {
 
+// sin(x) / x, accurate also near 0.
+double sinc(double x) {
+  if (std::fabs(x) < 1e-4) return 1.0 - x * x / 6.0;
+  return std::sin(x) / x;
+}
+
+// Exact integrals over s in [sa, sb] of cos(c0 + c1 s) and sin(c0 + c1 s).
+void trig_integrals(double c0, double c1, double sa, double sb, double &ic, double &is) {
+  const double L = sb - sa, ph = c0 + c1 * 0.5 * (sa + sb), f = L * sinc(0.5 * c1 * L);
+  ic = f * std::cos(ph);
+  is = f * std::sin(ph);
+}
+
 struct ElemWeight {
   double W = 0.0, dW[3] = {0, 0, 0}, d2W[6] = {0, 0, 0, 0, 0, 0};
 };
@@ -559,6 +572,35 @@ void element_weight(const MeshGeometry &geo, const KernelProfile &K, int32_t e, 
       if (std::fabs(m1) > Rh) continue;            // g(t2) = 0 on the whole piece
       const bool out1 = std::fabs(m0) > Rh;
       if (out1 && m0 < 0.0) continue;              // G(t1) = 0 and g(t1) = 0
+      if (K.cosine()) {
+        // alpha = k t1, beta = k t2 along the piece; with g = (k/2) cos, G = (1 + sin)/2,
+        // g' = -(k^2/2) sin, every product below is a sum of sin / cos of alpha +- beta.
+        const double k = 0.5 * kPi / Rh;
+        double cb, sb_;
+        trig_integrals(k * P0[1], k * dx[1], sa, sb, cb, sb_);
+        if (out1) {
+          out.W += 0.5 * k * cb * dx[1];
+          continue;
+        }
+        double cp, sp, cm, sm_;
+        trig_integrals(k * (P0[0] + P0[1]), k * (dx[0] + dx[1]), sa, sb, cp, sp);
+        trig_integrals(k * (P0[0] - P0[1]), k * (dx[0] - dx[1]), sa, sb, cm, sm_);
+        out.W += (0.25 * k * cb + 0.125 * k * (sp + sm_)) * dx[1];
+        if (d1 || d2) {
+          const double gg = 0.125 * k * k * (cp + cm);  // int g1 g2
+          out.dW[0] -= gg * dx[1];
+          out.dW[1] += gg * dx[0];
+        }
+        if (d2) {
+          const double k3 = 0.125 * k * k * k;
+          const double p1 = -k3 * (sp + sm_), p2 = -k3 * (sp - sm_);  // int g1' g2, int g1 g2'
+          H[0][0] += p1 * dx[1];
+          H[0][1] += p2 * dx[1];
+          H[1][0] -= p1 * dx[0];
+          H[1][1] -= p2 * dx[0];
+        }
+        continue;
+      }
       for (size_t j = 0; j < xg.size(); ++j) {
         const double sj = sm + 0.5 * (sb - sa) * xg[j], wt = 0.5 * (sb - sa) * wg[j];
         const double t1 = P0[0] + sj * dx[0], t2 = P0[1] + sj * dx[1];
@@ -862,7 +904,9 @@ Report Approximant::compute_mpfem() {
       const int n = geo.nn(e);
       double xr[3] = {0, 0, 0}, N[8], dN[24], d2N[48];
       for (int c = 0; c < dim; ++c) xr[c] = -dfirst[3 * i + c];
-      geo.shape(e, xr, N, dN, d2N);
+      // only the derivatives asked for (the Hessians of the general shape functions
+      // are needed for the Hessian table only)
+      geo.shape(e, xr, N, (fg || fh) ? dN : nullptr, fh ? d2N : nullptr);
       for (int I = 0; I < n; ++I) {
         const int32_t node = geo.nodes[geo.ptr[e] + I];
         size_t slot = 0;
@@ -874,8 +918,10 @@ Report Approximant::compute_mpfem() {
           rh.insert(rh.end(), 6, 0.0);
         }
         rv[slot] += om * N[I];
+        if (!(fg || fh)) continue;
         for (int a = 0; a < dim; ++a)
           rg[3 * slot + a] += (full ? dom[a] * N[I] : 0.0) + om * dN[3 * I + a];
+        if (!fh) continue;
         for (int a = 0; a < dim; ++a)
           for (int b = a; b < dim; ++b) {
             const int k = hessian_index(dim, a, b);

@@ -83,6 +83,9 @@ class KernelProfile {
   // Knots in units of h where g or g' may jump (the support edges, 0, spline knots).
   const std::vector<double> &knots() const { return knots_; }
   bool continuous() const { return id_ != MFREE_KERNEL_HAAR; }
+  // The cosine kernel g = (k/2) cos(k t), k = pi / (2 R h): edge integrals of products of
+  // g, G and g' are sums of sines and cosines of linear functions, integrated exactly.
+  bool cosine() const { return id_ == MFREE_KERNEL_COSINE; }
 
  private:
   double Gq(double q) const;  // cumulative in units of h

@@ -1,7 +1,8 @@
 /* 2D Poisson problem -lap u = f on the unit square, u = g on the boundary, exact
  * solution u = sin(pi x) sin(pi y) + x y / 2, on structured QUAD4 or TRI3 meshes of
  * n x n cells, by MPFEM through mfree's assembler (cosine kernel, eq 21 derivatives,
- * nodal values imposed on the boundary nodes, Gauss quadrature of the mesh) and UMFPACK.
+ * nodal values imposed on the boundary nodes, Gauss quadrature of the mesh with a given
+ * number of points per direction) and UMFPACK.
  * FEM is the same code with a kernel support far inside the elements (1e-6 of the
  * spacing): at the Gauss points the MPFEM functions are then exactly the FE functions
  * (reduction to FEM, checked against hand-written FE functions in t471). Errors in L2
@@ -33,10 +34,12 @@ typedef struct {
   double L2, H1, H1_22; /* H1 semi-norm with eq 21 (Galerkin) and eq 22 derivatives */
 } p2_err_t;
 
-/* Solve on an n x n grid; tri != 0: TRI3 (two per cell). hk_rel: kernel support half
- * width in units of the spacing. Returns the setup status of the assembler (positive
- * statuses are failures here). */
-static mfree_status_t p2_solve(mfree_context_t *ctx, int32_t n, int tri, double hk_rel, p2_err_t *err) {
+/* Solve on an n x n grid; tri != 0: TRI3 (two per cell, one diagonal). hk_rel: kernel
+ * support half width in units of the spacing; ngauss: points per direction of the
+ * assembly's Gauss rule (mfree_mesh_get_quadrature). Returns the setup status of the
+ * assembler (positive statuses are failures here). */
+static mfree_status_t p2_solve(mfree_context_t *ctx, int32_t n, int tri, double hk_rel, int32_t ngauss,
+                               p2_err_t *err) {
   const int32_t nn = (n + 1) * (n + 1), ne = tri ? 2 * n * n : n * n;
   const double h = 1.0 / n, hk = hk_rel * h;
   double *gs = malloc(sizeof(double) * (size_t)(n + 1)), *x = malloc(sizeof(double) * 2 * (size_t)nn);
@@ -56,9 +59,9 @@ static mfree_status_t p2_solve(mfree_context_t *ctx, int32_t n, int tri, double 
   mfree_assembler_t *as = NULL;
   assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_LAPLACE, &as));
   int32_t nq = 0;
-  assert_ok(ctx, mfree_mesh_get_quadrature(m, 3, &nq, NULL, NULL));
+  assert_ok(ctx, mfree_mesh_get_quadrature(m, ngauss, &nq, NULL, NULL));
   double *qx = malloc(sizeof(double) * 2 * (size_t)nq), *qw = malloc(sizeof(double) * (size_t)nq);
-  assert_ok(ctx, mfree_mesh_get_quadrature(m, 3, &nq, qx, qw));
+  assert_ok(ctx, mfree_mesh_get_quadrature(m, ngauss, &nq, qx, qw));
   assert_ok(ctx, mfree_assembler_set_quadrature_points(as, nq, qx, MFREE_LAYOUT_AOS, 2, qw));
   assert_ok(ctx, mfree_assembler_set_body_force(as, p2_f_fn, NULL));
   int32_t *bn = malloc(sizeof(int32_t) * 4 * (size_t)(n + 1)), nb = 0;
