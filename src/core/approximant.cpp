@@ -178,11 +178,12 @@ void Approximant::set_points(int32_t npts, const double *x, int layout, int64_t 
 
 void Approximant::validate_config() const {
   const int k = kernel_id_, m = method_;
-  const std::string mn = method_name(m);
+  // the name is built on failure only (update allocates nothing; "Randles-Libersky" outgrows SSO)
+  auto mn = [m] { return std::string(method_name(m)); };
   if (!ps_->has_support())
     throw Error(MFREE_ERR_STATE, "the particle set has no support sizes (the kernel needs h)");
   if (needs_volumes(m) && !ps_->has_volumes())
-    throw Error(MFREE_ERR_STATE, mn + " needs particle volumes (or masses and densities)");
+    throw Error(MFREE_ERR_STATE, mn() + " needs particle volumes (or masses and densities)");
   if (!ps_->host_neighbors() && kernel_->radius() > ps_->kappa() * (1.0 + 1e-12)) {
     std::ostringstream s;
     s << "kernel support radius " << kernel_->radius() << " h exceeds the search radius kappa = "
@@ -190,22 +191,22 @@ void Approximant::validate_config() const {
     throw Error(MFREE_ERR_MISMATCH, s.str());
   }
   if (points_ && particles_only(m))
-    throw Error(MFREE_ERR_UNSUPPORTED, mn + " is defined at the particles only");
+    throw Error(MFREE_ERR_UNSUPPORTED, mn() + " is defined at the particles only");
   const bool grad = flags_ & MFREE_DERIV_GRADIENT, hess = flags_ & MFREE_DERIV_HESSIAN;
   const bool uses_dw = (grad && gradient_needs_dw(m)) || m == MFREE_METHOD_MSPH ||
                        m == MFREE_METHOD_JOHNSON_BEISSEL || m == MFREE_METHOD_RANDLES_LIBERSKY ||
                        m == MFREE_METHOD_KB_METHOD1 || m == MFREE_METHOD_KB_METHOD3;
   if (k == MFREE_KERNEL_LINEAR && uses_dw)
     throw Error(MFREE_ERR_UNSUPPORTED,
-                mn + " differentiates the kernel; the linear kernel's derivative is constant "
+                mn() + " differentiates the kernel; the linear kernel's derivative is constant "
                      "(paper 001 Sect. 6.2): use SSPH or another kernel");
   const bool uses_d2w = (hess && hessian_needs_d2w(m)) || (m == MFREE_METHOD_MSPH && order_ >= 2);
   if ((k == MFREE_KERNEL_LINEAR || k == MFREE_KERNEL_QUADRATIC) && uses_d2w)
     throw Error(MFREE_ERR_UNSUPPORTED,
-                mn + " needs the kernel's second derivative, constant for the linear and "
+                mn() + " needs the kernel's second derivative, constant for the linear and "
                      "quadratic kernels (paper 001 Sect. 6.2)");
   if (hess && !provides_hessian(m, order_))
-    throw Error(MFREE_ERR_UNSUPPORTED, mn + " of order " + std::to_string(order_) +
+    throw Error(MFREE_ERR_UNSUPPORTED, mn() + " of order " + std::to_string(order_) +
                                            " provides no second derivatives");
 }
 
@@ -308,56 +309,79 @@ void Approximant::build_pattern() {
     period[c] = ps_->box_hi(c) - ps_->box_lo(c);
   }
   const int conv = ps_->search_convention();
+  const bool any_periodic = per[0] || per[1] || per[2];
   const double tol = 1.0 + kEdgeTol2;
-  auto row = [&](int32_t s, auto &&emit) {
-    const int32_t me = site_particle(s);
-    if (me >= 0 && pst[me] != 0) return;
-    const double hs = SH[s];
-    const double xs[3] = {SX[0][s], dim > 1 ? SX[1][s] : 0.0, dim > 2 ? SX[2][s] : 0.0};
-    bool have_self = false;
-    for (int64_t k = src->rowptr[s]; k < src->rowptr[s + 1]; ++k) {
-      const int32_t j = src->cols[k];
-      if (j == me) {
-        have_self = true;
-        emit(j, true);
-        continue;
-      }
-      double r2 = 0.0;
-      for (int c = 0; c < dim; ++c) {
-        double v = X[c][j] - xs[c];
-        if (per[c]) v -= period[c] * std::nearbyint(v / period[c]);
-        r2 += v * v;
-      }
-      const double hp = conv == MFREE_SEARCH_SYMMETRIC_MAX    ? std::max(hs, H[j])
-                        : conv == MFREE_SEARCH_SYMMETRIC_MEAN ? 0.5 * (hs + H[j])
-                                                              : hs;
-      const double rad = R * hp;
-      if (r2 <= rad * rad * tol) emit(j, false);
-    }
-    if (me >= 0 && !have_self) emit(me, true);
-  };
-  const int nt = num_threads(src->nnz());
-  int64_t *rp = rowptr_.data();
-  parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
-    for (int64_t s = b; s < e; ++s) {
-      int64_t cnt = 0;
-      row(static_cast<int32_t>(s), [&](int32_t, bool) { ++cnt; });
-      rp[s + 1] = cnt;
-    }
-  });
-  for (int32_t s = 0; s < nsites_; ++s) rp[s + 1] += rp[s];
-  cols_.resize(static_cast<size_t>(rp[nsites_]));
+  // One pass over static blocks of sites (the pattern is the same for any thread count):
+  // row s is written at src->rowptr[s] + s (room for every candidate and an appended
+  // self), then the rows are moved down to their final offsets.
+  const int64_t *srp = src->rowptr.data();
+  const int32_t *scl = src->cols.data();
+  cols_.resize(static_cast<size_t>(src->nnz()) + static_cast<size_t>(nsites_));
   int32_t *cl = cols_.data();
   int32_t *self = self_.data();
+  int64_t *rp = rowptr_.data();
+  const int nt = num_threads(src->nnz());
   parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
     for (int64_t s = b; s < e; ++s) {
-      int64_t k = rp[s];
-      row(static_cast<int32_t>(s), [&](int32_t j, bool is_self) {
-        if (is_self) self[s] = static_cast<int32_t>(k - rp[s]);
-        cl[k++] = j;
-      });
+      const int32_t me = site_particle(static_cast<int32_t>(s));
+      const int64_t base = srp[s] + s;
+      int64_t k = base;
+      if (me >= 0 && pst[me] != 0) {
+        rp[s + 1] = 0;
+        continue;
+      }
+      const double hs = SH[s];
+      const double xs[3] = {SX[0][s], dim > 1 ? SX[1][s] : 0.0, dim > 2 ? SX[2][s] : 0.0};
+      int64_t at_self = -1;
+      if (conv == MFREE_SEARCH_GATHER && !any_periodic) {
+        // the common case, branch-free: keep j when within R hs (or j is the site)
+        const double lim = R * hs, lim2 = lim * lim * tol;
+        for (int64_t q = srp[s]; q < srp[s + 1]; ++q) {
+          const int32_t j = scl[q];
+          double r2 = 0.0;
+          for (int c = 0; c < dim; ++c) {
+            const double v = X[c][j] - xs[c];
+            r2 += v * v;
+          }
+          if (j == me) at_self = k;
+          cl[k] = j;
+          k += (r2 <= lim2) | (j == me);
+        }
+      } else {
+        for (int64_t q = srp[s]; q < srp[s + 1]; ++q) {
+          const int32_t j = scl[q];
+          if (j == me) {
+            at_self = k;
+            cl[k++] = j;
+            continue;
+          }
+          double r2 = 0.0;
+          for (int c = 0; c < dim; ++c) {
+            double v = X[c][j] - xs[c];
+            if (per[c]) v -= period[c] * std::nearbyint(v / period[c]);
+            r2 += v * v;
+          }
+          const double hp = conv == MFREE_SEARCH_SYMMETRIC_MAX    ? std::max(hs, H[j])
+                            : conv == MFREE_SEARCH_SYMMETRIC_MEAN ? 0.5 * (hs + H[j])
+                                                                  : hs;
+          const double rad = R * hp;
+          if (r2 <= rad * rad * tol) cl[k++] = j;
+        }
+      }
+      if (me >= 0 && at_self < 0) {  // host lists may omit the particle itself
+        at_self = k;
+        cl[k++] = me;
+      }
+      self[s] = at_self < 0 ? -1 : static_cast<int32_t>(at_self - base);
+      rp[s + 1] = k - base;
     }
   });
+  for (int32_t s = 0; s < nsites_; ++s) {
+    const int64_t base = srp[s] + s, cnt = rp[s + 1];
+    rp[s + 1] = rp[s] + cnt;
+    if (rp[s] != base) std::copy(cl + base, cl + base + cnt, cl + rp[s]);  // moves down
+  }
+  cols_.resize(static_cast<size_t>(rp[nsites_]));
 }
 
 Report Approximant::compute(const char *what) {

@@ -11,6 +11,7 @@
 #include "kernel.hpp"
 #include "local.hpp"
 #include "particles.hpp"
+#include "shape_fast.hpp"
 
 namespace mfree {
 
@@ -84,6 +85,9 @@ class Approximant {
   void validate_config() const;
   void build_pattern();
   Report compute(const char *what);
+  // Particle (and point) data as SoA arrays for the pattern and the fast path, re-read
+  // from the (possibly borrowed) host arrays at every setup and update.
+  void pack();
   Report compute_mpfem();
   double site_x(int32_t s, int c) const;
   double site_h(int32_t s) const;
@@ -125,8 +129,12 @@ class Approximant {
   struct SiteScratch {
     HVec<double> d, v, h;
     LocalWork work;
+    FastScratch fast;
   };
   HVec<SiteScratch> scratch_;
+  // SoA copies: particles (dim coordinates, volumes, supports) and host points (dim
+  // coordinates, supports)
+  HVec<double> pack_, spack_;
 };
 
 // Neighbours among the particles of ps for each host point (site support hp, the set's
