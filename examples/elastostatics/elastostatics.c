@@ -85,7 +85,7 @@ static const char kUsage[] =
     "                           [--out DIR] [--no-plot] [--bc auto|fe-layer|fe-nodal|fe-gauss|\n"
     "                           direct|rows|nitsche|penalty|lagrange]"
     " [--scheme NAME[,NAME..]] [--threads N] [--vci] [--first K]\n"
-    "                           [--hole-nodes grid|mapped]\n"
+    "                           [--hole-nodes grid|mapped|graded]\n"
     "Paper 000 Table III: convergence of SPH, JB, RL, CD1, CD2, MLS and EFG on the cantilever\n"
     "beam and the plate with a hole (plane stress), next to the paper's rates; a patch test.\n"
     "  --problem  both (default) = beam and hole; all = beam, hole and patch test\n"
@@ -93,6 +93,7 @@ static const char kUsage[] =
     "  --first    index of the coarsest level (default 0: beam 17x3, hole 118 nodes; 0..4)\n"
     "  --hole-nodes grid (default: regular grid cut by the hole, nodes on the arc) or mapped\n"
     "             (the ruled map from the arc to the outer edges: non-uniform, dense at the hole)\n"
+    "             or graded (the same map, rings graded to square cells, per-node s)\n"
     "  --bc       essential conditions for every scheme; default auto = fe-layer (mfree's\n"
     "             finite-element blending layer, 000 Sect. 5.6, a mask per line); fe-nodal =\n"
     "             the example's nodal-quadrature build of the same layer; fe-gauss = the layer's\n"
@@ -155,6 +156,7 @@ static int parse(int argc, char **argv, options_t *o) {
     } else if (v && strcmp(a, "--hole-nodes") == 0) {
       ++i;
       if (strcmp(v, "mapped") == 0) o->mapped = 1;
+      else if (strcmp(v, "graded") == 0) o->mapped = 2;
       else if (strcmp(v, "grid") == 0) o->mapped = 0;
       else return 1;
     } else if (v && strcmp(a, "--first") == 0) {

@@ -23,8 +23,10 @@ typedef struct {
   double P, L, D;  /* beam: end load, length, depth (000 eqs 120-125) */
   double a, b;     /* hole: radius, outer size of the quarter model [0, b]^2 */
   double c[6];     /* patch: u_x = c0 + c1 x + c2 y, u_y = c3 + c4 x + c5 y */
-  int mapped;      /* hole: nodes of the mapped grid between the arc and the outer edges
-                      (non-uniform, dense at the hole) instead of the cut regular grid */
+  int mapped;      /* hole: 1 = nodes of the mapped grid between the arc and the outer
+                      edges (non-uniform, dense at the hole), 2 = the same map with rings
+                      graded to square cells and per-node supports; 0 = the cut regular
+                      grid */
 } es_problem_t;
 
 /* Exact displacement u (2), strain eps (xx, yy, engineering gamma_xy) and stress sig
@@ -37,6 +39,7 @@ enum { ES_MAXCHAIN = 4 };
 typedef struct {
   double dx;          /* nominal nodal spacing (the abscissa of the rates) */
   double h;           /* smoothing length s of the cubic spline (support 2h) */
+  double *hn, *hq;    /* graded hole: per-node s and per-background-point s; else NULL */
   int32_t n;          /* nodes */
   double *x;          /* 2n, AoS */
   double *vol;        /* n: Voronoi areas clipped to the domain (sum = area) */

@@ -261,22 +261,24 @@ static int cell_points(const double *lo, const double *hi, const int32_t *nc, in
  * split by the diagonal, each the ruled map between the arc and the outer edge,
  * x(xi, eta) = (1 - eta) a (cos t, sin t) + eta (b, b tan t), t = xi pi/4 (block A,
  * next to x = b; block B is its mirror image in the diagonal). The arc is exact. */
-static int hole_points(double a, double b, int32_t nxi, int32_t neta, int ng, grow_t *xq,
-                       grow_t *wq) {
+static int hole_points(double a, double b, int32_t nxi, int32_t neta, const double *etas, int ng,
+                       grow_t *xq, grow_t *wq) {
   double g[32], w[32];
   gauss_rule(ng, g, w);
   for (int32_t ci = 0; ci < nxi; ++ci)
     for (int32_t cj = 0; cj < neta; ++cj)
       for (int qa = 0; qa < ng; ++qa)
         for (int qb = 0; qb < ng; ++qb) {
-          const double xi = (ci + 0.5 * (1.0 + g[qa])) / nxi, eta = (cj + 0.5 * (1.0 + g[qb])) / neta;
+          /* eta from the cell edges etas (NULL: uniform) */
+          const double e0 = etas ? etas[cj] : (double)cj / neta, e1 = etas ? etas[cj + 1] : (cj + 1.0) / neta;
+          const double xi = (ci + 0.5 * (1.0 + g[qa])) / nxi, eta = e0 + 0.5 * (1.0 + g[qb]) * (e1 - e0);
           const double t = xi * M_PI / 4.0, ct = cos(t), st = sin(t), tt = tan(t);
           const double X = (1.0 - eta) * a * ct + eta * b, Y = (1.0 - eta) * a * st + eta * b * tt;
           const double x_xi = M_PI / 4.0 * (-(1.0 - eta) * a * st);
           const double y_xi = M_PI / 4.0 * ((1.0 - eta) * a * ct + eta * b / (ct * ct));
           const double x_eta = b - a * ct, y_eta = b * tt - a * st;
           const double J = fabs(x_xi * y_eta - x_eta * y_xi);
-          const double wt = J * 0.25 * w[qa] * w[qb] / ((double)nxi * neta);
+          const double wt = J * 0.25 * w[qa] * w[qb] * (e1 - e0) / (double)nxi;
           const double pa[2] = {X, Y}, pb[2] = {Y, X};
           if (push(xq, pa) || push(wq, &wt) || push(xq, pb) || push(wq, &wt)) return 1;
         }
@@ -329,6 +331,9 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
   grow_t X = {NULL, 0, 0, 2}, DS = {NULL, 0, 0, 4}, DN = {NULL, 0, 0, 2}, DM = {NULL, 0, 0, 1};
   grow_t TS = {NULL, 0, 0, 4}, TN = {NULL, 0, 0, 2}, XQ = {NULL, 0, 0, 2}, WQ = {NULL, 0, 0, 1};
   grow_t BX = {NULL, 0, 0, 2}, BW = {NULL, 0, 0, 1}, BN = {NULL, 0, 0, 2};
+  grow_t HN = {NULL, 0, 0, 1};
+  double *etas = NULL;
+  int32_t mblk = 0, nring = 0;
   double lo[2], hi[2];
   int fail = 0;
   if (p->kind == ES_BEAM) {
@@ -352,7 +357,54 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
     const double dx = p->b / m, a = p->a, b = p->b;
     lv->dx = dx;
     const int32_t narc = p->mapped ? 0 : (int32_t)ceil(0.5 * M_PI * a / dx);
-    if (p->mapped) {
+    if (p->mapped == 2) {
+      /* graded: mblk = m / 2 intervals along the hole per block (dtheta = pi / (4 mblk)),
+       * rings growing geometrically from a dtheta on the axes so that the cells stay
+       * about square (r_{k+1} ~ r_k (1 + dtheta)); supports s_I = sqrt(2) times the
+       * larger local spacing (000 eq 130 read locally) */
+      mblk = m / 2;
+      const double dth = 0.25 * M_PI / mblk;
+      nring = 1 + (int32_t)lround(log(b / a) / log(1.0 + dth));
+      etas = malloc(sizeof(double) * (size_t)nring);
+      if (!etas) goto oom;
+      double lo_g = 1.0 + 1e-9, hi_g = 3.0;
+      for (int it = 0; it < 200; ++it) { /* a dth (g^(nring-1) - 1) / (g - 1) = b - a */
+        const double gg = 0.5 * (lo_g + hi_g);
+        if (a * dth * (pow(gg, nring - 1) - 1.0) / (gg - 1.0) > b - a) hi_g = gg;
+        else lo_g = gg;
+      }
+      const double gg = 0.5 * (lo_g + hi_g);
+      etas[0] = 0.0;
+      for (int32_t j = 1; j < nring; ++j) etas[j] = etas[j - 1] + a * dth * pow(gg, j - 1) / (b - a);
+      for (int32_t j = 1; j < nring; ++j) etas[j] /= etas[nring - 1];
+      etas[nring - 1] = 1.0;
+      for (int blk = 0; blk < 2; ++blk)
+        for (int32_t i = 0; i <= mblk - blk; ++i)
+          for (int32_t j = 0; j < nring; ++j) {
+            double q[2], r[2];
+            for (int di = 0; di <= 1; ++di) { /* the node and its neighbour along the ring */
+              const double t = 0.25 * M_PI * (i + di) / mblk, eta = etas[j];
+              double *o = di ? r : q;
+              o[0] = (1.0 - eta) * a * cos(t) + eta * b;
+              o[1] = (1.0 - eta) * a * sin(t) + eta * b * tan(t);
+            }
+            double hh = hypot(r[0] - q[0], r[1] - q[1]);
+            {
+              const double t = 0.25 * M_PI * i / mblk, len = hypot(b - a * cos(t), b * tan(t) - a * sin(t));
+              const double dr = len * (j == 0 ? etas[1] : j == nring - 1 ? 1.0 - etas[j - 1]
+                                                                        : 0.5 * (etas[j + 1] - etas[j - 1]));
+              hh = sqrt(2.0) * fmax(hh, dr);
+            }
+            if (i == 0) q[1] = 0.0;
+            if (j == nring - 1) q[0] = b;
+            if (i == mblk) q[1] = q[0];
+            if (blk) {
+              const double tmp = q[0];
+              q[0] = q[1], q[1] = tmp;
+            }
+            fail |= push(&X, q) || push(&HN, &hh);
+          }
+    } else if (p->mapped) {
       /* the ruled map of hole_points with m intervals along each outer edge and
        * round(0.8 m) across: spacing dx at the outer edges, a pi / (4 m) along the hole */
       const int32_t neta = (int32_t)lround((b - a) / dx);
@@ -466,7 +518,10 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
         }
     }
     const int32_t nxi = (int32_t)lround(p->b / lv->dx), neta = (int32_t)lround((p->b - p->a) / lv->dx);
-    fail |= hole_points(p->a, p->b, nxi, neta, ngauss, &XQ, &WQ);
+    if (etas) /* graded: cells = the node grid of each block */
+      fail |= hole_points(p->a, p->b, mblk, nring - 1, etas, ngauss, &XQ, &WQ);
+    else
+      fail |= hole_points(p->a, p->b, nxi, neta, NULL, ngauss, &XQ, &WQ);
   } else {
     /* the whole boundary is essential */
     for (int32_t i = 0; i < lv->n; ++i) {
@@ -507,8 +562,26 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
   lv->bpx = BX.p;
   lv->bpw = BW.p;
   lv->bpn = BN.p;
+  free(etas);
+  if (HN.p) {
+    /* per-node supports; each background point takes its nearest node's */
+    lv->hn = HN.p;
+    lv->hq = malloc(sizeof(double) * (size_t)(lv->nq ? lv->nq : 1));
+    if (!lv->hq) {
+      es_level_free(lv);
+      return 1;
+    }
+    for (int32_t q = 0; q < lv->nq; ++q) {
+      double best = HUGE_VAL;
+      for (int32_t i = 0; i < lv->n; ++i) {
+        const double d = hypot(lv->xq[2 * q] - lv->x[2 * i], lv->xq[2 * q + 1] - lv->x[2 * i + 1]);
+        if (d < best) best = d, lv->hq[q] = lv->hn[i];
+      }
+    }
+  }
   return 0;
 oom:
+  free(etas), free(HN.p);
   free(X.p), free(DM.p), free(TS.p), free(TN.p), free(XQ.p), free(WQ.p), free(BX.p), free(BW.p), free(BN.p);
   if (lv->dseg != DS.p) free(DS.p);
   if (lv->dnrm != DN.p) free(DN.p);
@@ -520,5 +593,6 @@ void es_level_free(es_level_t *lv) {
   free(lv->x), free(lv->vol), free(lv->dmask), free(lv->dseg), free(lv->dnrm), free(lv->dsmask);
   free(lv->tseg), free(lv->tnrm), free(lv->xq), free(lv->wq), free(lv->chain_nodes);
   free(lv->bpx), free(lv->bpw), free(lv->bpn);
+  free(lv->hn), free(lv->hq);
   memset(lv, 0, sizeof *lv);
 }

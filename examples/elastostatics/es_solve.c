@@ -238,14 +238,17 @@ static int32_t layer_elements(const es_level_t *lv, int chain, int32_t *conn, ch
       const int32_t P[2] = {lv->chain_nodes[k], lv->chain_nodes[k + 1]};
       int32_t Q[2];
       for (int e = 0; e < 2; ++e) {
-        const double tx = lv->x[2 * P[e]] - lv->dx * nrm[0], ty = lv->x[2 * P[e] + 1] - lv->dx * nrm[1];
+        /* the inner node: the nearest one to P - d n, d the local spacing (graded hole:
+         * the node's s / sqrt 2) */
+        const double d = lv->hn ? lv->hn[P[e]] / sqrt(2.0) : lv->dx;
+        const double tx = lv->x[2 * P[e]] - d * nrm[0], ty = lv->x[2 * P[e] + 1] - d * nrm[1];
         double best = 1e300;
         Q[e] = -1;
         for (int32_t j = 0; j < lv->n; ++j) {
-          const double d = hypot(lv->x[2 * j] - tx, lv->x[2 * j + 1] - ty);
-          if (d < best) best = d, Q[e] = j;
+          const double dd = hypot(lv->x[2 * j] - tx, lv->x[2 * j + 1] - ty);
+          if (dd < best) best = dd, Q[e] = j;
         }
-        if (best > 0.6 * lv->dx) {
+        if (best > 0.6 * d) {
           if (err) snprintf(err, (size_t)errlen, "FE layer: no inner node next to boundary node %d", (int)P[e]);
           return -1;
         }
@@ -634,7 +637,7 @@ mfree_status_t es_run_vci(mfree_context_t *ctx, const es_problem_t *p, const es_
   CHECK(mfree_particles_create(ctx, 2, n, &ps), "particles");
   CHECK(mfree_particles_set_positions(ps, lv->x, MFREE_LAYOUT_AOS, 2, MFREE_COPY), "positions");
   CHECK(mfree_particles_set_volumes(ps, lv->vol, 1, MFREE_COPY), "volumes");
-  CHECK(mfree_particles_set_support(ps, &lv->h, 0, MFREE_COPY), "support");
+  CHECK(mfree_particles_set_support(ps, lv->hn ? lv->hn : &lv->h, lv->hn ? 1 : 0, MFREE_COPY), "support");
   CHECK(mfree_particles_setup(ps), "particle setup");
   CHECK(mfree_approximant_create(ctx, ps, s->trial, &trial), "trial approximant");
   if (s->order) CHECK(mfree_approximant_set_order(trial, s->order), "trial order");
@@ -850,7 +853,8 @@ mfree_status_t es_run_vci(mfree_context_t *ctx, const es_problem_t *p, const es_
     const mfree_method_t em = s->particles_only ? MFREE_METHOD_MLS : s->trial;
     CHECK(mfree_approximant_create(ctx, ps, em, &ev), "error approximant");
     if (s->particles_only || s->order) CHECK(mfree_approximant_set_order(ev, s->order ? s->order : 1), "order");
-    CHECK(mfree_approximant_set_points(ev, lv->nq, lv->xq, MFREE_LAYOUT_AOS, 2, &lv->h, 0, MFREE_BORROW),
+    CHECK(mfree_approximant_set_points(ev, lv->nq, lv->xq, MFREE_LAYOUT_AOS, 2, lv->hq ? lv->hq : &lv->h,
+                                       lv->hq ? 1 : 0, MFREE_BORROW),
           "error points");
     CHECK(mfree_approximant_setup(ev), "error approximant setup");
     CHECK(mfree_approximant_apply(ev, MFREE_OP_VALUE, 2, u, MFREE_LAYOUT_AOS, 2, uq, MFREE_LAYOUT_AOS, 2),
