@@ -17,6 +17,20 @@
 
 #include "local.hpp"
 
+// Loops over the neighbours of a site: vectorised even at -O2 when OpenMP is on (the
+// simd loops carry no dependence between neighbours); loops of compile-time length over
+// monomials and small matrices: unrolled, so that their indices fold and the
+// accumulators stay in registers.
+#ifdef _OPENMP
+#define MFREE_SIMD _Pragma("omp simd")
+#define MFREE_SIMD_SUM(v) _Pragma(MFREE_STR(omp simd reduction(+ : v)))
+#else
+#define MFREE_SIMD
+#define MFREE_SIMD_SUM(v)
+#endif
+#define MFREE_STR(x) #x
+#define MFREE_UNROLL _Pragma("GCC unroll 64")
+
 namespace mfree {
 
 namespace {
@@ -81,6 +95,7 @@ constexpr Tab<D, K> make_tab() {
     for (int b = 0; b < Tab<D, K>::L; ++b) {
       const int e0 = t.e[a][0] + t.e[b][0], e1 = t.e[a][1] + t.e[b][1], e2 = t.e[a][2] + t.e[b][2];
       t.mw[a][b] = find_mono(t, e0, e1, e2);
+      MFREE_UNROLL
       for (int i = 0; i < D; ++i) t.mg[i][a][b] = find_mono(t, e0 + (i == 0), e1 + (i == 1), e2 + (i == 2));
     }
   return t;
@@ -94,7 +109,9 @@ template <int D, int K, int N, int P>
 inline void monomials(const double *s, double *mo) {
   constexpr const Tab<D, K> &T = kTab<D, K>;
   mo[0] = 1.0;
+  MFREE_UNROLL
   for (int m = 1; m < N; ++m) mo[m] = mo[T.parent[m]] * s[T.var[m]];
+  MFREE_UNROLL
   for (int m = N; m < P; ++m) mo[m] = 0.0;
 }
 
@@ -105,8 +122,10 @@ inline void monomials(const double *s, double *mo) {
 template <int L>
 double norm1(const double (&A)[L][L]) {
   double big = 0.0;
+  MFREE_UNROLL
   for (int b = 0; b < L; ++b) {
     double s = 0.0;
+    MFREE_UNROLL
     for (int a = 0; a < L; ++a) s += std::fabs(A[a][b]);
     big = std::max(big, s);
   }
@@ -126,33 +145,53 @@ bool accept(const double (&A)[L][L], const double (&X)[L][L], double &cond) {
 // system is ill-conditioned.
 template <int L>
 bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
-  double Lw[L][L] = {}, iD[L];
+  // fixed loop bounds with guards: fully unrolled, the guards fold away
+  double Lw[L][L] = {}, Dg[L] = {}, iD[L] = {};
+  MFREE_UNROLL
   for (int k = 0; k < L; ++k) {
     double dk = A[k][k];
-    for (int m = 0; m < k; ++m) dk -= Lw[k][m] * Lw[k][m] / iD[m];
+    MFREE_UNROLL
+    for (int m = 0; m < L; ++m)
+      if (m < k) dk -= Lw[k][m] * Lw[k][m] * Dg[m];
     if (!(dk > 0.0)) return false;
+    Dg[k] = dk;
     iD[k] = 1.0 / dk;
-    for (int i = k + 1; i < L; ++i) {
+    MFREE_UNROLL
+    for (int i = 0; i < L; ++i) {
+      if (i <= k) continue;
       double v = A[i][k];
-      for (int m = 0; m < k; ++m) v -= Lw[i][m] * Lw[k][m] / iD[m];
+      MFREE_UNROLL
+      for (int m = 0; m < L; ++m)
+        if (m < k) v -= Lw[i][m] * Lw[k][m] * Dg[m];
       Lw[i][k] = v * iD[k];
     }
   }
   double Y[L][L] = {};  // L^-1, unit lower triangular
+  MFREE_UNROLL
   for (int c = 0; c < L; ++c) {
     Y[c][c] = 1.0;
-    for (int i = c + 1; i < L; ++i) {
+    MFREE_UNROLL
+    for (int i = 0; i < L; ++i) {
+      if (i <= c) continue;
       double v = 0.0;
-      for (int m = c; m < i; ++m) v -= Lw[i][m] * Y[m][c];
+      MFREE_UNROLL
+      for (int m = 0; m < L; ++m)
+        if (m >= c && m < i) v -= Lw[i][m] * Y[m][c];
       Y[i][c] = v;
     }
   }
-  for (int a = 0; a < L; ++a)
-    for (int b = a; b < L; ++b) {
+  MFREE_UNROLL
+  for (int a = 0; a < L; ++a) {
+    MFREE_UNROLL
+    for (int b = 0; b < L; ++b) {
+      if (b < a) continue;
       double v = 0.0;
-      for (int k = b; k < L; ++k) v += Y[k][a] * Y[k][b] * iD[k];
+      MFREE_UNROLL
+      for (int k = 0; k < L; ++k)
+        if (k >= b) v += Y[k][a] * Y[k][b] * iD[k];
       X[a][b] = X[b][a] = v;
     }
+  }
   return accept(A, X, cond);
 }
 
@@ -160,30 +199,37 @@ bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
 template <int L>
 bool gen_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
   double W[L][L];
+  MFREE_UNROLL
   for (int a = 0; a < L; ++a)
     for (int b = 0; b < L; ++b) {
       W[a][b] = A[a][b];
       X[a][b] = a == b ? 1.0 : 0.0;
     }
+  MFREE_UNROLL
   for (int k = 0; k < L; ++k) {
     int p = k;
+    MFREE_UNROLL
     for (int i = k + 1; i < L; ++i)
       if (std::fabs(W[i][k]) > std::fabs(W[p][k])) p = i;
     if (!(std::fabs(W[p][k]) > 0.0)) return false;
     if (p != k)
+      MFREE_UNROLL
       for (int b = 0; b < L; ++b) {
         std::swap(W[p][b], W[k][b]);
         std::swap(X[p][b], X[k][b]);
       }
     const double ip = 1.0 / W[k][k];
+    MFREE_UNROLL
     for (int b = 0; b < L; ++b) {
       W[k][b] *= ip;
       X[k][b] *= ip;
     }
+    MFREE_UNROLL
     for (int i = 0; i < L; ++i) {
       if (i == k) continue;
       const double f = W[i][k];
       if (f == 0.0) continue;
+      MFREE_UNROLL
       for (int b = 0; b < L; ++b) {
         W[i][b] -= f * W[k][b];
         X[i][b] -= f * X[k][b];
@@ -200,16 +246,24 @@ bool gen_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
 
 struct CubicSpline {
   explicit CubicSpline(const Kernel &) {}
-  void operator()(double q, double &f, double &df) const {
-    if (q < 1.0) {
-      f = 1.0 - 1.5 * q * q + 0.75 * q * q * q;
-      df = -3.0 * q + 2.25 * q * q;
-    } else {
-      double t = 2.0 - q;
-      if (!(t > 0.0)) t = 0.0;
-      f = 0.25 * t * t * t;
-      df = -0.75 * t * t;
-    }
+  // both pieces and a select: neighbours fall on either side of q = 1 at random, and
+  // a branch would be mispredicted half the time
+  static constexpr bool kVector = true;
+  // Both pieces blended with a 0/1 mask (equal to selecting one: the other is multiplied
+  // by zero, t = max(2 - q, 0) written with fabs): neighbours fall on either side of
+  // q = 1 at random, so a branch would be mispredicted half the time, and the blend
+  // lets the neighbour loop vectorise.
+  static double f(double q) {
+    const double m = q < 1.0 ? 1.0 : 0.0, t0 = 2.0 - q, t = 0.5 * (t0 + std::fabs(t0));
+    return m * (1.0 - 1.5 * q * q + 0.75 * q * q * q) + (1.0 - m) * (0.25 * t * t * t);
+  }
+  static double df(double q) {
+    const double m = q < 1.0 ? 1.0 : 0.0, t0 = 2.0 - q, t = 0.5 * (t0 + std::fabs(t0));
+    return m * (-3.0 * q + 2.25 * q * q) + (1.0 - m) * (-0.75 * t * t);
+  }
+  void operator()(double q, double &fv, double &dfv) const {
+    fv = f(q);
+    dfv = df(q);
   }
 };
 
@@ -219,6 +273,7 @@ struct AnyShape {
     double d2f;
     k_->shape(q, f, df, d2f);
   }
+  static constexpr bool kVector = false;
   const Kernel *k_;
 };
 
@@ -229,6 +284,7 @@ int gather(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, i
   const int32_t *cl = t.cols + t.rowptr[s];
   const double hs = t.sh[s];
   double *d[3] = {w.d(0), w.d(1), w.d(2)};
+  MFREE_UNROLL
   for (int c = 0; c < D; ++c) {
     const double *X = t.x[c], x0 = t.sx[c][s];
     double *dc = d[c];
@@ -244,8 +300,44 @@ int gather(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, i
   const double c0 = fp.kernel().norm();
   double *wt = w.w(), *gf = w.gf();
   int support = 0;
-  auto pair = [&](int j, double ih, double sw) {
+  if constexpr (Kern::kVector) {
+    if (t.convention == MFREE_SEARCH_GATHER) {
+      const double ih = 1.0 / hs;
+      double sw = c0;
+      MFREE_UNROLL
+      for (int c = 0; c < D; ++c) sw *= ih;
+      const double swih = sw * ih;
+      const double *d0 = d[0], *d1 = d[D > 1 ? 1 : 0], *d2 = d[D > 2 ? 2 : 0];
+      double nz = 0.0;  // a double count, so that the loop has one lane width
+      MFREE_SIMD_SUM(nz)
+      for (int j = 0; j < n; ++j) {
+        double r2 = d0[j] * d0[j];
+        if (D > 1) r2 += d1[j] * d1[j];
+        if (D > 2) r2 += d2[j] * d2[j];
+        const double r = std::sqrt(r2), q = r * ih;
+        const double wv = sw * Kern::f(q), df = Kern::df(q);
+        wt[j] = wv;
+        nz += wv != 0.0 ? 1.0 : 0.0;
+        if (G) {
+          const double rs = r > 0.0 ? r : 1.0;
+          gf[j] = r > 0.0 ? -(swih * df) / rs : 0.0;
+        }
+      }
+      return static_cast<int>(nz);
+    }
+  }
+  const int conv = t.convention;
+  for (int j = 0; j < n; ++j) {
+    const double hj = t.h[cl[j]];
+    const double h = conv == MFREE_SEARCH_SYMMETRIC_MAX    ? std::max(hs, hj)
+                     : conv == MFREE_SEARCH_SYMMETRIC_MEAN ? 0.5 * (hs + hj)
+                                                           : hs;
+    const double ih = 1.0 / h;
+    double sw = c0;
+    MFREE_UNROLL
+    for (int c = 0; c < D; ++c) sw *= ih;
     double r2 = 0.0;
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) r2 += d[c][j] * d[c][j];
     const double r = std::sqrt(r2);
     double f, df;
@@ -254,20 +346,6 @@ int gather(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, i
     wt[j] = wv;
     support += wv != 0.0;
     if (G) gf[j] = r > 0.0 ? -(sw * ih * df) / r : 0.0;
-  };
-  if (t.convention == MFREE_SEARCH_GATHER) {
-    const double ih = 1.0 / hs;
-    double sw = c0;
-    for (int c = 0; c < D; ++c) sw *= ih;
-    for (int j = 0; j < n; ++j) pair(j, ih, sw);
-  } else {
-    const bool mx = t.convention == MFREE_SEARCH_SYMMETRIC_MAX;
-    for (int j = 0; j < n; ++j) {
-      const double hj = t.h[cl[j]], h = mx ? std::max(hs, hj) : 0.5 * (hs + hj), ih = 1.0 / h;
-      double sw = c0;
-      for (int c = 0; c < D; ++c) sw *= ih;
-      pair(j, ih, sw);
-    }
   }
   return support;
 }
@@ -283,7 +361,9 @@ void close_difference(double *grad, int n, int self) {
   double sum[D] = {};
   for (int j = 0; j < n; ++j)
     if (j != self)
+      MFREE_UNROLL
       for (int c = 0; c < D; ++c) sum[c] += grad[j * D + c];
+  MFREE_UNROLL
   for (int c = 0; c < D; ++c) grad[self * D + c] = -sum[c];
 }
 
@@ -295,6 +375,7 @@ int sph(FastScratch &w, int n, Rows o, int self) {
   if (o.grad) {
     for (int j = 0; j < n; ++j) {
       const double gv = gf[j] * v[j];
+      MFREE_UNROLL
       for (int c = 0; c < D; ++c) o.grad[j * D + c] = gv * w.d(c)[j];
     }
     if (self >= 0) close_difference<D>(o.grad, n, self);
@@ -309,12 +390,14 @@ int shepard(FastScratch &w, int n) {
   double S = 0.0, gS[D] = {};
   for (int j = 0; j < n; ++j) {
     S += wt[j];
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) gS[c] += gf[j] * w.d(c)[j];
   }
   if (!(S > 0.0)) return MFREE_FAIL_NEIGHBORS;
   const double iS = 1.0 / S;
   double *phi = w.a();
   for (int j = 0; j < n; ++j) phi[j] = wt[j] * iS;
+  MFREE_UNROLL
   for (int c = 0; c < D; ++c) {
     const double *dc = w.d(c);
     double *g = w.b(c);
@@ -328,6 +411,7 @@ void write_shepard(FastScratch &w, int n, Rows o) {
   if (o.val) std::copy(w.a(), w.a() + n, o.val);
   if (o.grad)
     for (int j = 0; j < n; ++j)
+      MFREE_UNROLL
       for (int c = 0; c < D; ++c) o.grad[j * D + c] = w.b(c)[j];
 }
 
@@ -338,6 +422,7 @@ int corrected(FastScratch &w, int n, Rows o, int self, bool rl, double &cond) {
   double *q[3];
   if (rl) {
     const double *gf = w.gf(), *v = w.v();
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) {
       q[c] = w.b(c);
       const double *dc = w.d(c);
@@ -346,10 +431,12 @@ int corrected(FastScratch &w, int n, Rows o, int self, bool rl, double &cond) {
   } else {
     const int st = shepard<D>(w, n);
     if (st) return st;
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) q[c] = w.b(c);
   }
   double acc[D][D] = {};
   for (int j = 0; j < n; ++j)
+    MFREE_UNROLL
     for (int a = 0; a < D; ++a)
       for (int b = 0; b < D; ++b) acc[a][b] += w.d(a)[j] * q[b][j];
   double X[D][D];
@@ -363,9 +450,12 @@ int corrected(FastScratch &w, int n, Rows o, int self, bool rl, double &cond) {
   if (o.grad) {
     for (int j = 0; j < n; ++j) {
       double qj[D];
+      MFREE_UNROLL
       for (int b = 0; b < D; ++b) qj[b] = q[b][j];
+      MFREE_UNROLL
       for (int c = 0; c < D; ++c) {
         double g = 0.0;
+        MFREE_UNROLL
         for (int b = 0; b < D; ++b) g += X[b][c] * qj[b];
         o.grad[j * D + c] = g;
       }
@@ -381,6 +471,7 @@ int johnson_beissel(FastScratch &w, int n, Rows o, int self) {
   const double *wt = w.w(), *gf = w.gf(), *v = w.v();
   double beta[D];
   if (o.grad)
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) {
       const double *dc = w.d(c);
       double den = 0.0;
@@ -392,6 +483,7 @@ int johnson_beissel(FastScratch &w, int n, Rows o, int self) {
     for (int j = 0; j < n; ++j) o.val[j] = wt[j] * v[j];
   if (o.grad) {
     for (int j = 0; j < n; ++j)
+      MFREE_UNROLL
       for (int c = 0; c < D; ++c) o.grad[j * D + c] = beta[c] * gf[j] * w.d(c)[j] * v[j];
     close_difference<D>(o.grad, n, self);
   }
@@ -420,50 +512,65 @@ int mls(FastScratch &w, int n, int support, double hs, Rows o, bool rkpm, double
   double aw[T::PM] = {}, ag[T::PM] = {};
   for (int j = 0; j < n; ++j) {
     double s[D];
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) s[c] = d[c][j] * ih;
     double mo[T::PM];
     if (deriv) {
       monomials<D, K, T::NM, T::PM>(s, mo);
       const double wj = wt[j], gj = gf[j];
+      MFREE_UNROLL
       for (int m = 0; m < T::PW; ++m) aw[m] += wj * mo[m];
+      MFREE_UNROLL
       for (int m = 0; m < T::PM; ++m) ag[m] += gj * mo[m];
     } else {
       monomials<D, K, T::NW, T::PW>(s, mo);
       const double wj = wt[j];
+      MFREE_UNROLL
       for (int m = 0; m < T::PW; ++m) aw[m] += wj * mo[m];
     }
   }
   double M[L][L], X[L][L];
+  MFREE_UNROLL
   for (int a = 0; a < L; ++a)
     for (int b = 0; b < L; ++b) M[a][b] = aw[tab.mw[a][b]];
   if (!spd_inverse<L>(M, X, cond)) return MFREE_FAIL_SINGULAR;
   double g[L], gi[D][L];
+  MFREE_UNROLL
   for (int a = 0; a < L; ++a) g[a] = X[a][0];
   if (deriv)
+    MFREE_UNROLL
     for (int i = 0; i < D; ++i) {
       double rhs[L];
+      MFREE_UNROLL
       for (int a = 0; a < L; ++a) {
         double t = 0.0;
+        MFREE_UNROLL
         for (int b = 0; b < L; ++b) t += ag[tab.mg[i][a][b]] * g[b];
         rhs[a] = -hs * t;
       }
       if (1 + i < L) rhs[1 + i] += ih;
+      MFREE_UNROLL
       for (int a = 0; a < L; ++a) {
         double t = 0.0;
+        MFREE_UNROLL
         for (int b = 0; b < L; ++b) t += X[a][b] * rhs[b];
         gi[i][a] = t;
       }
     }
   for (int j = 0; j < n; ++j) {
     double s[D], p[L];
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) s[c] = d[c][j] * ih;
     monomials<D, K, L, L>(s, p);
     double gp = 0.0;
+    MFREE_UNROLL
     for (int a = 0; a < L; ++a) gp += g[a] * p[a];
     if (o.val) o.val[j] = wt[j] * gp;
     if (deriv)
+      MFREE_UNROLL
       for (int i = 0; i < D; ++i) {
         double t = 0.0;
+        MFREE_UNROLL
         for (int a = 0; a < L; ++a) t += gi[i][a] * p[a];
         o.grad[j * D + i] = wt[j] * t + gf[j] * d[i][j] * gp;
       }
@@ -487,27 +594,34 @@ int ssph(FastScratch &w, int n, int support, double hs, Rows o, double &cond) {
   double aw[T::PW] = {};
   for (int j = 0; j < n; ++j) {
     double s[D], mo[T::PW];
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) s[c] = d[c][j] * ih;
     monomials<D, K, T::NW, T::PW>(s, mo);
     const double oj = om[j];
+    MFREE_UNROLL
     for (int m = 0; m < T::PW; ++m) aw[m] += oj * mo[m];
   }
   double M[L][L], X[L][L];
+  MFREE_UNROLL
   for (int a = 0; a < L; ++a)
     for (int b = 0; b < L; ++b) M[a][b] = aw[tab.mw[a][b]];
   if (!spd_inverse<L>(M, X, cond)) return MFREE_FAIL_SINGULAR;
   for (int j = 0; j < n; ++j) {
     double s[D], p[L];
+    MFREE_UNROLL
     for (int c = 0; c < D; ++c) s[c] = d[c][j] * ih;
     monomials<D, K, L, L>(s, p);
     if (o.val) {
       double t = 0.0;
+      MFREE_UNROLL
       for (int a = 0; a < L; ++a) t += X[0][a] * p[a];
       o.val[j] = om[j] * t;
     }
     if (o.grad)
+      MFREE_UNROLL
       for (int i = 0; i < D; ++i) {
         double t = 0.0;
+        MFREE_UNROLL
         for (int a = 0; a < L; ++a) t += X[1 + i][a] * p[a];
         o.grad[j * D + i] = ih * om[j] * t;
       }
