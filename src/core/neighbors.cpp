@@ -101,6 +101,7 @@ class CellGrid {
 
   int dim_;
   double lo_[3] = {0, 0, 0}, cell_[3] = {1, 1, 1}, L_[3] = {0, 0, 0};
+  double margin_[3] = {0, 0, 0};  // slack of the geometric cell bounds (query)
   int64_t nc_[3] = {1, 1, 1};
   bool periodic_[3] = {false, false, false};
   bool any_periodic_ = false;
@@ -179,6 +180,10 @@ CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : 
   }
   int64_t ncells = 1;
   for (int c = 0; c < dim_; ++c) ncells *= nc_[c];
+  // A particle's cell index floor((x - lo) / cell) may be off by one for x within a few
+  // ulps of a cell face; 1e-10 of the grid's scale covers that with room to spare.
+  for (int c = 0; c < dim_; ++c)
+    margin_[c] = 1e-10 * (std::fabs(lo_[c]) + static_cast<double>(nc_[c]) * cell_[c]);
 
   // Counting sort of the valid particles by cell (stable: ascending index in a cell).
   std::vector<int64_t> cell(n, -1);
@@ -235,9 +240,12 @@ void CellGrid::query(const double *xq, double ri, const Rule &rule, std::vector<
                      size_t &cnt) const {
   if (nvalid_ == 0) return;
   const double R = rule.query(ri) * (1.0 + 1e-12);  // closed supports (kEdgeTol)
+  const double R2 = R * R;
   // Cell ranges per axis: [k(x - R), k(x + R)] clamped, [k - m, k + m] on a periodic
-  // axis, or all cells once where that stencil would wrap onto itself.
+  // axis, or all cells once where that stencil would wrap onto itself (`full`: no
+  // geometric pruning along that axis, the pair test takes the nearest image).
   int64_t kmin[3] = {0, 0, 0}, kmax[3] = {0, 0, 0};
+  bool full[3] = {false, false, false};
   for (int c = 0; c < dim_; ++c) {
     if (periodic_[c]) {
       const int64_t kc = coord(xq[c], c);
@@ -245,6 +253,7 @@ void CellGrid::query(const double *xq, double ri, const Rule &rule, std::vector<
       if (2 * m + 1 >= nc_[c]) {
         kmin[c] = 0;
         kmax[c] = nc_[c] - 1;
+        full[c] = true;
       } else {
         kmin[c] = kc - m;
         kmax[c] = kc + m;
@@ -254,8 +263,19 @@ void CellGrid::query(const double *xq, double ri, const Rule &rule, std::vector<
       kmax[c] = coord(xq[c] + R, c);
     }
   }
-  // Along axis 0 the cells [kmin, kmax] are one member range, or two where a periodic
-  // range wraps.
+  // Squared distance from xq to the slab of (image) cell k along axis c, a lower bound
+  // for every particle stored in it: shrunk by a margin far above the rounding of the
+  // cell index, so that no pair at the closed edge is lost.
+  auto gap2 = [&](int c, int64_t k) {
+    if (full[c]) return 0.0;
+    const double a = lo_[c] + static_cast<double>(k) * cell_[c], b = a + cell_[c];
+    double g = std::max(a - xq[c], xq[c] - b) - margin_[c];
+    g = g > 0.0 ? g : 0.0;
+    return g * g;
+  };
+  // Along axis 0 the stencil's cells are one member range per row of cells, or two
+  // where a periodic range wraps. (Trimming them to the sphere's chord per row costs a
+  // square root and two divisions, more than the few candidates it saves.)
   int64_t seg[2][2] = {{kmin[0], kmax[0]}, {0, -1}};
   if (periodic_[0]) {
     if (kmin[0] < 0) {
@@ -268,22 +288,21 @@ void CellGrid::query(const double *xq, double ri, const Rule &rule, std::vector<
       seg[1][1] = kmax[0] - nc_[0];
     }
   }
-  int64_t k[3];
-  for (k[2] = kmin[2]; k[2] <= kmax[2]; ++k[2])
-    for (k[1] = kmin[1]; k[1] <= kmax[1]; ++k[1]) {
-      int64_t kw[3] = {0, k[1], k[2]};
-      for (int c = 1; c < dim_; ++c)
-        if (periodic_[c]) kw[c] = ((kw[c] % nc_[c]) + nc_[c]) % nc_[c];
-      for (int s = 0; s < 2; ++s) {
-        if (seg[s][1] < seg[s][0]) continue;
-        kw[0] = seg[s][0];
-        const int64_t c0 = index(kw);
-        kw[0] = seg[s][1];
-        const int64_t c1 = index(kw);
-        const int64_t p0 = start_[c0], p1 = start_[c1 + 1];
-        scan_range(xq, ri, rule, p0, p1, row, cnt);
-      }
+  const int nseg = seg[1][1] >= seg[1][0] ? 2 : 1;
+  // rows of cells whose slab misses the query's sphere are skipped (the corners of the
+  // 5^dim stencil)
+  for (int64_t k2 = kmin[2]; k2 <= kmax[2]; ++k2) {
+    const double gz = dim_ > 2 ? gap2(2, k2) : 0.0;
+    if (gz > R2) continue;
+    const int64_t w2 = periodic_[2] ? ((k2 % nc_[2]) + nc_[2]) % nc_[2] : k2;
+    for (int64_t k1 = kmin[1]; k1 <= kmax[1]; ++k1) {
+      if (dim_ > 1 && gz + gap2(1, k1) > R2) continue;
+      const int64_t w1 = periodic_[1] ? ((k1 % nc_[1]) + nc_[1]) % nc_[1] : k1;
+      const int64_t base = (w2 * nc_[1] + w1) * nc_[0];
+      for (int sg = 0; sg < nseg; ++sg)
+        scan_range(xq, ri, rule, start_[base + seg[sg][0]], start_[base + seg[sg][1] + 1], row, cnt);
     }
+  }
 }
 
 // Rows are short (tens) and, for particles stored in lattice or cell order, nearly
@@ -304,9 +323,18 @@ void sort_row(int32_t *b, int32_t *e) {
 // site s and returns its search radius, or a negative value for a site without a row.
 // Each thread searches a static block of `order` into its own buffer; the rows are
 // then placed by site index, so the result does not depend on the thread count.
+//
+// Sorting: rows arrive in cell order. For a symmetric relation (j in row i iff i in row
+// j: uniform radii under gather, or a symmetric convention, every valid particle owning
+// a row) the sorted rows are the transpose of the unsorted ones: visiting the sources i
+// in ascending order and appending i to the row of each of its neighbours j writes
+// every row in ascending order without a comparison (the pair test is bitwise
+// symmetric: x_i - x_j = -(x_j - x_i) in IEEE arithmetic, also after the periodic
+// shift). Each thread fills a static block of rows, visiting the sources that can reach
+// it. Otherwise each row is sorted where it was found.
 template <class Site>
 void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const std::vector<int32_t> &order,
-                 Site &&site, Csr &out) {
+                 bool symmetric, Site &&site, Csr &out) {
   out.rowptr.assign(static_cast<size_t>(nsites) + 1, 0);
   out.cols.clear();
   if (grid.empty() || order.empty()) return;
@@ -326,27 +354,83 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
       if (r < 0.0) continue;
       const size_t r0 = cnt;
       grid.query(x, r, rule, cols, cnt);
-      sort_row(cols.data() + r0, cols.data() + cnt);
+      if (!symmetric) sort_row(cols.data() + r0, cols.data() + cnt);
     }
     cols.resize(cnt);
   });
   // row lengths by site, then prefix sums; each block knows its own buffer's end
+  std::vector<const int32_t *> src(symmetric ? static_cast<size_t>(nsites) : 0, nullptr);
   for (int t = 0; t < nt; ++t) {
     int64_t b, e;
     thread_block(nq, t, nt, b, e);
     for (int64_t q = b; q < e; ++q) {
       const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(buf[t].size());
       out.rowptr[order[q] + 1] = end - first[q];
+      if (symmetric) src[order[q]] = buf[t].data() + first[q];
     }
   }
   for (int32_t s = 0; s < nsites; ++s) out.rowptr[s + 1] += out.rowptr[s];
   out.cols.resize(static_cast<size_t>(out.rowptr[nsites]));
-  parallel_blocks(nq, nt, [&](int t, int64_t b, int64_t e) {
-    for (int64_t q = b; q < e; ++q) {
-      const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(buf[t].size());
-      std::copy(buf[t].begin() + first[q], buf[t].begin() + end, out.cols.begin() + out.rowptr[order[q]]);
+  auto place = [&]() {
+    parallel_blocks(nq, nt, [&](int t, int64_t b, int64_t e) {
+      for (int64_t q = b; q < e; ++q) {
+        const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(buf[t].size());
+        int32_t *o = out.cols.data() + out.rowptr[order[q]];
+        std::copy(buf[t].begin() + first[q], buf[t].begin() + end, o);
+        if (symmetric) sort_row(o, o + (end - first[q]));
+      }
+    });
+  };
+  if (!symmetric) {
+    place();
+    return;
+  }
+  // Transpose. slot[j] = {next free position of row j, end of row j}; a source that
+  // would overfill a row or leave one short (an asymmetric pair, which the conditions
+  // above exclude: a safety net, not a proof) sets `bad`, and the rows are then placed
+  // and sorted instead.
+  const int64_t *rp = out.rowptr.data();
+  struct Slot {
+    int64_t next, end;
+  };
+  std::vector<Slot> slot(static_cast<size_t>(nsites));
+  for (int32_t j = 0; j < nsites; ++j) slot[j] = Slot{rp[j], rp[j + 1]};
+  std::vector<char> bad(static_cast<size_t>(nt), 0);
+  const int ntt = num_threads(nsites) < nt ? num_threads(nsites) : nt;
+  parallel_blocks(nsites, ntt, [&](int t, int64_t jb, int64_t je) {
+    if (jb >= je) return;
+    // sources that reach rows [jb, je): by symmetry, the members of those rows
+    int64_t imin = nsites, imax = -1;
+    for (int64_t j = jb; j < je; ++j)
+      for (int64_t k = 0; k < rp[j + 1] - rp[j]; ++k) {
+        const int32_t i = src[j][k];
+        imin = i < imin ? i : imin;
+        imax = i > imax ? i : imax;
+      }
+    int32_t *cols = out.cols.data();
+    Slot *sl = slot.data();
+    const uint64_t span = static_cast<uint64_t>(je - jb);
+    const bool all = jb == 0 && je == nsites;
+    bool over = false;
+    for (int64_t i = imin; i <= imax; ++i) {
+      const int32_t *r = src[i];
+      const int64_t len = rp[i + 1] - rp[i];
+      for (int64_t k = 0; k < len; ++k) {
+        const int64_t j = r[k];
+        if (!all && static_cast<uint64_t>(j - jb) >= span) continue;
+        Slot &q = sl[j];
+        if (q.next < q.end) cols[q.next++] = static_cast<int32_t>(i);
+        else over = true;
+      }
     }
+    for (int64_t j = jb; j < je; ++j) over = over || sl[j].next != sl[j].end;
+    bad[t] = over;
   });
+  for (int t = 0; t < ntt; ++t)
+    if (bad[t]) {
+      place();
+      return;
+    }
 }
 
 }  // namespace
@@ -361,7 +445,16 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, C
   for (int32_t i : grid.members())
     if (i < rows) order.push_back(i);
   const int dim = ps.dim();
-  run_queries(grid, rule, rows, order,
+  // symmetric relation (see run_queries): every valid particle has a row (no ghosts), and
+  // a symmetric convention or one radius for all
+  bool symmetric = rows == ps.size();
+  if (symmetric && rule.conv == MFREE_SEARCH_GATHER)
+    for (int32_t i : grid.members())
+      if (grid.radius(i) != grid.rmax()) {
+        symmetric = false;
+        break;
+      }
+  run_queries(grid, rule, rows, order, symmetric,
               [&](int32_t i, double *x) {
                 for (int c = 0; c < dim; ++c) x[c] = grid.wrap(ps.x(i, c), c);
                 return grid.radius(i);
@@ -392,7 +485,7 @@ void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &sta
     for (int64_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
     for (int32_t s = 0; s < npts; ++s) order[start[cell[s]]++] = s;
   }
-  run_queries(grid, rule, npts, order, site, out);
+  run_queries(grid, rule, npts, order, false, site, out);
 }
 
 }  // namespace mfree
