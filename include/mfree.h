@@ -148,7 +148,8 @@ typedef MFREE_ENUM(mfree_kernel) {
 typedef MFREE_ENUM(mfree_method) {
   MFREE_METHOD_SPH = 1,               /**< kernel sum and kernel gradient, 000 eqs 21, 29 */
   MFREE_METHOD_SPH_SYMMETRIC = 2,     /**< symmetrised (difference) gradient, 000 eq 47;
-                                           particles only */
+                                           particles only; the assembler's loads use
+                                           the kernel values W dV (000 eq 21) */
   MFREE_METHOD_SHEPARD = 3,           /**< Shepard functions, 000 eqs 38-39 */
   MFREE_METHOD_MLS = 4,               /**< moving least squares, order 0..3, shifted and
                                            scaled basis, 000 eqs 43-46 */
@@ -156,9 +157,11 @@ typedef MFREE_ENUM(mfree_method) {
                                            001 Sect. 4 (weights W V; true derivatives) */
   MFREE_METHOD_JOHNSON_BEISSEL = 6,   /**< 000 eqs 49, 52; particles only; under an
                                            elasticity form the assembler keeps the
-                                           symmetrised SPH shear strain (eqs 48-52) */
+                                           symmetrised SPH shear strain (eqs 48-52)
+                                           and its loads use the kernel values W dV */
   MFREE_METHOD_RANDLES_LIBERSKY = 7,  /**< renormalised gradient, 000 eqs 68-69;
-                                           particles only */
+                                           particles only; the assembler's loads use
+                                           Shepard values (000 eq 70) */
   MFREE_METHOD_KB_METHOD1 = 8,        /**< Krongauz-Belytschko corrected derivatives,
                                            000 eqs 55-61 (alpha = A^-T) */
   MFREE_METHOD_KB_METHOD2 = 9,        /**< corrected derivatives Method 2 (diffuse MLS
@@ -1002,6 +1005,42 @@ MFREE_API mfree_status_t mfree_system_set_box(mfree_system_t *sys, const double 
  */
 MFREE_API mfree_status_t mfree_system_set_shepard_condition(mfree_system_t *sys,
                                                             double max_cond);
+
+/**
+ * Dummy wall particles (not in paper 003; Adami, Hu & Adams 2012, J. Comput. Phys. 231,
+ * 7057): fixed particles that fill the solid past the walls, at least 2h deep (three
+ * layers at the fluid spacing for h = 1.5 d). They are nodes of the MLS approximation
+ * with zero velocity parameters (walls at rest, no-slip) and quadrature points of the
+ * momentum equation, with the pressure extrapolated from the fluid at every evaluation,
+ * p_w = sum_f W_wf (p_f + rho_f g.(x_w - x_f)) / sum_f W_wf (fluid neighbours f within
+ * the support), their density from the inverse equation of state, their mass
+ * rho_w V_w feeling gravity. So a fluid node next to a wall sees a full support, and the
+ * dummy region supplies the wall traction that the paper's force (mfree_system_set_walls,
+ * active only on approaching particles) cannot: it holds a still column (t702). The
+ * Galerkin lumped mass of a fluid node becomes sum_k N_i(x_k) M_k / sum_j N_j(x_k) over
+ * the fluid particles k and fluid nodes j, so that the fluid nodes carry the whole mass;
+ * interpolation and mass matrices keep the fluid rows and columns. May be combined with
+ * the wall force. n = 0 removes them (the default).
+ * @param[in] x        positions, dim per particle (AoS; copied)
+ * @param[in] volumes  volumes V_w > 0 (stride 0 = one value; copied), typically d^dim
+ */
+MFREE_API mfree_status_t mfree_system_set_dummy_particles(mfree_system_t *sys, int32_t n,
+                                                          const double *x,
+                                                          const double *volumes,
+                                                          int64_t stride);
+/**
+ * Density diffusion (not in paper 003; delta-SPH of Molteni & Colagrossi 2009 with the
+ * correction of Antuono et al. 2010): d rho_i/dt gains
+ * delta h c0_i sum_j psi_ji . grad_i W_ij V_j, psi_ji = 2 (rho_j - rho_i) x_ji / |x_ji|^2 -
+ * (grad rho_i + grad rho_j), c0_i = sqrt(gamma kappa / rho0_i), W the cubic spline, the
+ * gradients those of the MLS functions (so a linear, e.g. hydrostatic, density field is
+ * left unchanged, free surface included). It damps the odd-even density modes that nodal
+ * integration does not see. Particle masses stay constant. Usual delta: 0.1.
+ * Default 0 (off).
+ * @param[in] delta  finite, >= 0
+ */
+MFREE_API mfree_status_t mfree_system_set_density_diffusion(mfree_system_t *sys,
+                                                            double delta);
 
 /** Length of the state vector. */
 MFREE_API mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq);

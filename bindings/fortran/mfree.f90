@@ -1078,6 +1078,23 @@ module mfree
       real(c_double), value :: strength
     end function mfree_system_set_walls_c
 
+    integer(c_int) function mfree_system_set_dummy_particles_c(sys, n, x, volumes, stride) &
+        bind(C, name="mfree_system_set_dummy_particles")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: n
+      real(c_double), intent(in) :: x(*)
+      real(c_double), intent(in) :: volumes(*)
+      integer(c_int64_t), value :: stride
+    end function mfree_system_set_dummy_particles_c
+
+    integer(c_int) function mfree_system_set_density_diffusion_c(sys, delta) &
+        bind(C, name="mfree_system_set_density_diffusion")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), value :: delta
+    end function mfree_system_set_density_diffusion_c
+
     integer(c_int) function mfree_system_set_box_c(sys, lo, hi) &
         bind(C, name="mfree_system_set_box")
       import :: c_int, c_double, c_ptr
@@ -1247,6 +1264,7 @@ module mfree
   public :: mfree_system_set_masses_c, mfree_system_set_smoothing_c
   public :: mfree_system_set_gravity_c, mfree_system_set_lumping_c
   public :: mfree_system_set_walls_c, mfree_system_set_box_c, mfree_system_get_size_c
+  public :: mfree_system_set_dummy_particles_c, mfree_system_set_density_diffusion_c
   public :: mfree_system_rhs_c, mfree_system_assemble_mass_c
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
@@ -1325,6 +1343,7 @@ module mfree
   public :: mfree_system_create_fluid, mfree_system_destroy, mfree_system_set_fluid
   public :: mfree_system_set_masses, mfree_system_set_smoothing, mfree_system_set_gravity
   public :: mfree_system_set_lumping, mfree_system_set_walls, mfree_system_set_box
+  public :: mfree_system_set_dummy_particles, mfree_system_set_density_diffusion
   public :: mfree_system_get_size, mfree_system_rhs, mfree_system_assemble_mass
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
@@ -2474,6 +2493,23 @@ contains
     real(c_double), intent(in) :: r0, strength
     st = mfree_system_set_walls_c(sys%ptr, nwall, x, normals, r0, strength)
   end function mfree_system_set_walls
+
+  !> Dummy wall particles x(dim, n) with volumes (stride 0: one value), copied; n = 0 removes them.
+  integer(c_int) function mfree_system_set_dummy_particles(sys, n, x, volumes, stride) &
+      result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: n
+    real(c_double), intent(in) :: x(*), volumes(*)
+    integer(c_int64_t), intent(in) :: stride
+    st = mfree_system_set_dummy_particles_c(sys%ptr, n, x, volumes, stride)
+  end function mfree_system_set_dummy_particles
+
+  !> delta-SPH density diffusion coefficient (default 0 = off; usual 0.1).
+  integer(c_int) function mfree_system_set_density_diffusion(sys, delta) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: delta
+    st = mfree_system_set_density_diffusion_c(sys%ptr, delta)
+  end function mfree_system_set_density_diffusion
 
   integer(c_int) function mfree_system_set_box(sys, lo, hi) result(st)
     type(mfree_system), intent(in) :: sys

@@ -127,6 +127,14 @@ mfree_status_t mfree_system_set_shepard_condition(mfree_system_t *sys, double ma
   MFREE_SYS_SETTER("mfree_system_set_shepard_condition", f.set_shepard_condition(max_cond));
 }
 
+mfree_status_t mfree_system_set_dummy_particles(mfree_system_t *sys, int32_t n, const double *x,
+                                               const double *volumes, int64_t stride) {
+  MFREE_SYS_SETTER("mfree_system_set_dummy_particles", f.set_dummy_particles(n, x, volumes, stride));
+}
+mfree_status_t mfree_system_set_density_diffusion(mfree_system_t *sys, double delta) {
+  MFREE_SYS_SETTER("mfree_system_set_density_diffusion", f.set_density_diffusion(delta));
+}
+
 mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
   return mfree::with_handle(sys, "mfree_system_get_size", [&](const mfree::System &f) {
     MFREE_REQUIRE(neq, MFREE_ERR_NULL, "output pointer is NULL");

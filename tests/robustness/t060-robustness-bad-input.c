@@ -857,6 +857,17 @@ static void rows_system(void) {
   ROW(MFREE_ERR_ARG, mfree_system_set_shepard_condition(F.sys, 0.5));
   ROW(MFREE_ERR_ARG, mfree_system_set_shepard_condition(F.sys, NAN));
 #endif
+  /* issue 5: dummy wall particles and density diffusion (failures change nothing) */
+  ROW0(MFREE_ERR_NULL, mfree_system_set_dummy_particles(NULL, 2, wx, &one, 0));
+  ROW(MFREE_ERR_ARG, mfree_system_set_dummy_particles(F.sys, -1, wx, &one, 0));
+  ROW(MFREE_ERR_NULL, mfree_system_set_dummy_particles(F.sys, 2, NULL, &one, 0));
+  ROW(MFREE_ERR_NULL, mfree_system_set_dummy_particles(F.sys, 2, wx, NULL, 0));
+  ROW(MFREE_ERR_ARG, mfree_system_set_dummy_particles(F.sys, 2, wx, &one, -1));
+  ROW(MFREE_ERR_INPUT, mfree_system_set_dummy_particles(F.sys, 2, wx, &zero, 0));
+  ROW(MFREE_ERR_INPUT, mfree_system_set_dummy_particles(F.sys, 1, gnan, &one, 0));
+  ROW0(MFREE_ERR_NULL, mfree_system_set_density_diffusion(NULL, 0.1));
+  ROW(MFREE_ERR_ARG, mfree_system_set_density_diffusion(F.sys, -0.1));
+  ROW(MFREE_ERR_ARG, mfree_system_set_density_diffusion(F.sys, NAN));
   ROW0(MFREE_ERR_NULL, mfree_system_set_box(NULL, lo, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, NULL, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, lo, NULL));
