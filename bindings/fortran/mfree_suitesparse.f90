@@ -47,6 +47,13 @@ module mfree_suitesparse
       integer(c_int32_t), value :: bits
     end function mfree_suitesparse_set_index_width_c
 
+    integer(c_int) function mfree_suitesparse_set_rcond_threshold_c(s, threshold) &
+        bind(C, name="mfree_suitesparse_set_rcond_threshold")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: s
+      real(c_double), value :: threshold
+    end function mfree_suitesparse_set_rcond_threshold_c
+
     integer(c_int) function mfree_suitesparse_setup_c(s, A) &
         bind(C, name="mfree_suitesparse_setup")
       import :: c_int, c_ptr
@@ -84,11 +91,12 @@ module mfree_suitesparse
   public :: mfree_suitesparse_create_c, mfree_suitesparse_destroy_c
   public :: mfree_suitesparse_set_index_width_c, mfree_suitesparse_setup_c
   public :: mfree_suitesparse_update_c, mfree_suitesparse_solve_c
-  public :: mfree_suitesparse_get_info_c
+  public :: mfree_suitesparse_get_info_c, mfree_suitesparse_set_rcond_threshold_c
 
   public :: mfree_suitesparse_create, mfree_suitesparse_destroy
   public :: mfree_suitesparse_set_index_width, mfree_suitesparse_setup
   public :: mfree_suitesparse_update, mfree_suitesparse_solve, mfree_suitesparse_get_info
+  public :: mfree_suitesparse_set_rcond_threshold
 
 contains
 
@@ -110,6 +118,13 @@ contains
     integer(c_int32_t), intent(in) :: bits
     st = mfree_suitesparse_set_index_width_c(s%ptr, bits)
   end function mfree_suitesparse_set_index_width
+
+  !> Singularity threshold on the reciprocal condition estimate, in [0, 1); 0 disables.
+  integer(c_int) function mfree_suitesparse_set_rcond_threshold(s, threshold) result(st)
+    type(mfree_solver), intent(in) :: s
+    real(c_double), intent(in) :: threshold
+    st = mfree_suitesparse_set_rcond_threshold_c(s%ptr, threshold)
+  end function mfree_suitesparse_set_rcond_threshold
 
   integer(c_int) function mfree_suitesparse_setup(s, A) result(st)
     type(mfree_solver), intent(in) :: s

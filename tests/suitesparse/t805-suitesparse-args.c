@@ -1,6 +1,9 @@
-/* t805: every NULL or bad argument (g), the frozen enumerator values, and the states
+/* t805: every NULL or bad argument (g) (the rcond threshold's too), the frozen
+ * enumerator values, and the states
  * in which each call is refused. Each failure returns its status, leaves a message on
  * the context (when there is one to leave it on) and calls the handler once. */
+#include <float.h>
+#include <math.h>
 #include <string.h>
 
 #include "sstest.h"
@@ -71,7 +74,16 @@ static void bad_arguments(void **state) {
     assert_int_equal(mfree_suitesparse_update(NULL, A), MFREE_ERR_NULL);
     assert_int_equal(mfree_suitesparse_solve(NULL, 1, b, n, x, n), MFREE_ERR_NULL);
     assert_int_equal(mfree_suitesparse_get_info(NULL, NULL, NULL, NULL), MFREE_ERR_NULL);
+    assert_int_equal(mfree_suitesparse_set_rcond_threshold(NULL, 0.0), MFREE_ERR_NULL);
     assert_int_equal(errs.calls, 0);
+
+    /* singularity threshold: [0, 1) */
+    assert_error(ctx, mfree_suitesparse_set_rcond_threshold(s, -1e-12), MFREE_ERR_ARG, "threshold");
+    assert_error(ctx, mfree_suitesparse_set_rcond_threshold(s, 1.0), MFREE_ERR_ARG, "[0, 1)");
+    assert_error(ctx, mfree_suitesparse_set_rcond_threshold(s, NAN), MFREE_ERR_ARG, "threshold");
+    assert_error(ctx, mfree_suitesparse_set_rcond_threshold(s, INFINITY), MFREE_ERR_ARG, "threshold");
+    assert_ok(ctx, mfree_suitesparse_set_rcond_threshold(s, 0.0));
+    assert_ok(ctx, mfree_suitesparse_set_rcond_threshold(s, 1e3 * DBL_EPSILON));
 
     /* index width */
     assert_error(ctx, mfree_suitesparse_set_index_width(s, 16), MFREE_ERR_ARG, "16");
@@ -108,7 +120,7 @@ static void bad_arguments(void **state) {
     int32_t w = 0;
     assert_ok(ctx, mfree_suitesparse_get_info(s, NULL, NULL, &w));
     assert_int_equal(w, 32);
-    assert_int_equal(errs.calls, 20);
+    assert_int_equal(errs.calls, 24);
     mfree_suitesparse_destroy(&s);
   }
   mfree_matrix_destroy(&A);

@@ -67,7 +67,9 @@ typedef struct mfree_suitesparse mfree_suitesparse_t;
  * Create a solver of the given kind. Its failures are recorded on ctx, which the
  * solver keeps alive until it is destroyed (so teardown order does not matter). A
  * solver is used from one thread at a time; different solvers are independent.
- * Defaults: automatic index width (see mfree_suitesparse_set_index_width).
+ * Defaults: automatic index width (see mfree_suitesparse_set_index_width), singularity
+ * threshold 1e-10 on the reciprocal condition estimate (see
+ * mfree_suitesparse_set_rcond_threshold).
  * @param[in]  ctx   context for error messages
  * @param[in]  kind  an mfree_solver_kind_t (anything else: MFREE_ERR_ARG)
  * @param[out] s     the new solver (NULL on failure)
@@ -98,11 +100,39 @@ MFREE_SUITESPARSE_API mfree_status_t mfree_suitesparse_set_index_width(mfree_sui
                                                                        int32_t bits);
 
 /**
+ * Singularity threshold on the reciprocal condition estimate (the rcond of
+ * mfree_suitesparse_get_info). UMFPACK and KLU report a matrix as singular only when a
+ * pivot is exactly zero, and round-off usually leaves a tiny nonzero pivot instead, so a
+ * singular system (e.g. a stiffness with a zero-energy mode) would otherwise be solved
+ * silently, with garbage amplified by 1/rcond. After every numeric factorisation (setup
+ * and update, all three solvers) an estimate below the threshold makes the call return
+ * MFREE_FAIL_SINGULAR with a message giving the estimate and the threshold; the solver
+ * is then in the state documented for singular matrices (solve refuses until a
+ * factorisation passes), and get_info still reports the rejected estimate.
+ * Default 1e-10, chosen from measurements: singular matrices leave round-off estimates
+ * that grow roughly like n * DBL_EPSILON (the MPFEM Haar ring of test t474, n = 40:
+ * 1.7e-15; singular grid Laplacians of t807: 1.3e-13 at n = 2500, 6.8e-12 at
+ * n = 160000, so singular systems of a few million unknowns may pass unnoticed), while
+ * the smallest estimate of a legitimate system in mfree's tests and examples was 6.4e-8
+ * (the penalty-constrained Table III systems; Lagrange multipliers 1.0e-7, Laplacians,
+ * Nitsche, collocation and MPFEM systems 1e-5 and above). The estimate is min/max |pivot|
+ * (CHOLMOD: squared), not a bound on the condition number: a host with badly scaled but
+ * solvable systems (large penalty factors) may lower the threshold or disable the check.
+ * Takes effect at the next setup / update.
+ * @param[in] threshold  in [0, 1); 0 disables the check (anything else, NaN included:
+ *                       MFREE_ERR_ARG, nothing changed)
+ */
+MFREE_SUITESPARSE_API mfree_status_t mfree_suitesparse_set_rcond_threshold(mfree_suitesparse_t *s,
+                                                                           double threshold);
+
+/**
  * Symbolic analysis (fill-reducing ordering) and numeric factorisation of A. Replaces
  * any previous factorisation. A is read through its views during the call only.
  * @param[in] A  square matrix (else MFREE_ERR_MISMATCH); for MFREE_SOLVER_CHOLMOD also
  *               symmetric (mfree_matrix_get_symmetric == 1, else MFREE_ERR_MISMATCH)
- * @return MFREE_SUCCESS; MFREE_FAIL_SINGULAR (positive) when A is singular or, for
+ * @return MFREE_SUCCESS; MFREE_FAIL_SINGULAR (positive) when A is singular (an exactly
+ *         zero pivot, or a reciprocal condition estimate below the threshold of
+ *         mfree_suitesparse_set_rcond_threshold) or, for
  *         CHOLMOD, not positive definite: the symbolic analysis is kept (update with
  *         better values of the same pattern works), but solve returns MFREE_ERR_STATE
  *         until a factorisation succeeds; MFREE_FAIL_NONFINITE (positive) when A holds
@@ -158,8 +188,10 @@ MFREE_SUITESPARSE_API mfree_status_t mfree_suitesparse_solve(mfree_suitesparse_t
  *                          factorisation, min/max |pivot|: UMFPACK and KLU take the
  *                          diagonal of U of the row-scaled matrix they factor (their
  *                          default scaling), CHOLMOD the diagonal of L, squared (so
- *                          1/cond for a diagonal matrix); 0 when it failed. A small value
- *                          warns of ill-conditioning; it is not a bound.
+ *                          1/cond for a diagonal matrix); 0 when it failed, the
+ *                          rejected estimate when it was below the singularity
+ *                          threshold. A small value warns of ill-conditioning; it is
+ *                          not a bound.
  * @param[out] factor_nnz   entries in the factors: nnz(L) + nnz(U) (+ the off-diagonal
  *                          blocks for KLU), diagonals included; nnz(L) for CHOLMOD
  * @param[out] index_width  32 or 64: the SuiteSparse variant in use
