@@ -245,14 +245,18 @@ void Approximant::pack() {
   const int32_t np = ps_->size();
   const bool have_vol = ps_->has_volumes();
   const size_t N = static_cast<size_t>(np);
-  pack_.resize((static_cast<size_t>(dim) + 2) * N);
+  // AoS, one record per particle (coordinates, volume, support): the data of a
+  // neighbour come in one cache line
+  const size_t S = static_cast<size_t>(dim) + 2;
+  pack_.resize(S * N);
   double *P = pack_.data();
   parallel_blocks(np, num_threads(np), [&](int, int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) {
       const int32_t j = static_cast<int32_t>(i);
-      for (int c = 0; c < dim; ++c) P[c * N + i] = ps_->x(j, c);
-      P[dim * N + i] = have_vol ? ps_->volume(j) : 1.0;
-      P[(dim + 1) * N + i] = ps_->h(j);
+      double *r = P + S * static_cast<size_t>(i);
+      for (int c = 0; c < dim; ++c) r[c] = ps_->x(j, c);
+      r[dim] = have_vol ? ps_->volume(j) : 1.0;
+      r[dim + 1] = ps_->h(j);
     }
   });
   if (!points_) {
@@ -260,10 +264,11 @@ void Approximant::pack() {
     return;
   }
   const size_t M = static_cast<size_t>(npts_);
-  spack_.resize((static_cast<size_t>(dim) + 1) * M);
+  const size_t T = static_cast<size_t>(dim) + 1;
+  spack_.resize(T * M);
   for (int32_t s = 0; s < npts_; ++s) {
-    for (int c = 0; c < dim; ++c) spack_[c * M + s] = px_(s, c);
-    spack_[dim * M + s] = ph_(s);
+    for (int c = 0; c < dim; ++c) spack_[T * s + c] = px_(s, c);
+    spack_[T * s + dim] = ph_(s);
   }
 }
 
@@ -294,14 +299,10 @@ void Approximant::build_pattern() {
   // the order of the neighbour list, the particle itself always (appended when a host
   // list omits it). Counted in a first pass and written in a second, both over static
   // blocks of sites, so that the pattern is the same for any thread count.
-  const size_t N = static_cast<size_t>(ps_->size()), M = static_cast<size_t>(nsites_);
-  const double *X[3] = {nullptr, nullptr, nullptr}, *SX[3] = {nullptr, nullptr, nullptr};
-  for (int c = 0; c < dim; ++c) {
-    X[c] = pack_.data() + c * N;
-    SX[c] = points_ ? spack_.data() + c * M : X[c];
-  }
-  const double *H = pack_.data() + (dim + 1) * N;
-  const double *SH = points_ ? spack_.data() + dim * M : H;
+  // records of pack() (particles: coordinates, volume, support) and of the sites
+  const int64_t PS = dim + 2, SS = points_ ? dim + 1 : PS;
+  const double *P = pack_.data(), *SP = points_ ? spack_.data() : P;
+  const int SHO = points_ ? dim : dim + 1;  // support within a site record
   bool per[3] = {false, false, false};
   double period[3] = {0, 0, 0};
   for (int c = 0; c < dim; ++c) {
@@ -330,8 +331,9 @@ void Approximant::build_pattern() {
         rp[s + 1] = 0;
         continue;
       }
-      const double hs = SH[s];
-      const double xs[3] = {SX[0][s], dim > 1 ? SX[1][s] : 0.0, dim > 2 ? SX[2][s] : 0.0};
+      const double *sr = SP + s * SS;
+      const double hs = sr[SHO];
+      const double xs[3] = {sr[0], dim > 1 ? sr[1] : 0.0, dim > 2 ? sr[2] : 0.0};
       int64_t at_self = -1;
       if (conv == MFREE_SEARCH_GATHER && !any_periodic) {
         // the common case, branch-free: keep j when within R hs (or j is the site)
@@ -340,7 +342,7 @@ void Approximant::build_pattern() {
           const int32_t j = scl[q];
           double r2 = 0.0;
           for (int c = 0; c < dim; ++c) {
-            const double v = X[c][j] - xs[c];
+            const double v = P[j * PS + c] - xs[c];
             r2 += v * v;
           }
           if (j == me) at_self = k;
@@ -357,12 +359,13 @@ void Approximant::build_pattern() {
           }
           double r2 = 0.0;
           for (int c = 0; c < dim; ++c) {
-            double v = X[c][j] - xs[c];
+            double v = P[j * PS + c] - xs[c];
             if (per[c]) v -= period[c] * std::nearbyint(v / period[c]);
             r2 += v * v;
           }
-          const double hp = conv == MFREE_SEARCH_SYMMETRIC_MAX    ? std::max(hs, H[j])
-                            : conv == MFREE_SEARCH_SYMMETRIC_MEAN ? 0.5 * (hs + H[j])
+          const double hj = P[j * PS + dim + 1];
+          const double hp = conv == MFREE_SEARCH_SYMMETRIC_MAX    ? std::max(hs, hj)
+                            : conv == MFREE_SEARCH_SYMMETRIC_MEAN ? 0.5 * (hs + hj)
                                                                   : hs;
           const double rad = R * hp;
           if (r2 <= rad * rad * tol) cl[k++] = j;
@@ -431,19 +434,20 @@ Report Approximant::compute(const char *what) {
   const FastPath fast(dim, method_, order_, *kernel_, flags_);
   FastTables ft;
   if (fast.ok()) {
-    const size_t N = static_cast<size_t>(ps_->size()), M = static_cast<size_t>(nsites_);
     ft.rowptr = rowptr_.data();
     ft.cols = cols_.data();
     ft.self = self_.data();
     for (int c = 0; c < dim; ++c) {
-      ft.x[c] = pack_.data() + c * N;
-      ft.sx[c] = points_ ? spack_.data() + c * M : ft.x[c];
+      ft.x[c] = pack_.data() + c;
+      ft.sx[c] = points_ ? spack_.data() + c : ft.x[c];
       ft.periodic[c] = ps_->periodic(c);
       ft.period[c] = ps_->box_hi(c) - ps_->box_lo(c);
     }
-    ft.vol = pack_.data() + dim * N;
-    ft.h = pack_.data() + (dim + 1) * N;
-    ft.sh = points_ ? spack_.data() + dim * M : ft.h;
+    ft.vol = pack_.data() + dim;
+    ft.h = pack_.data() + dim + 1;
+    ft.sh = points_ ? spack_.data() + dim : ft.h;
+    ft.stride = dim + 2;
+    ft.sstride = points_ ? dim + 1 : dim + 2;
     ft.convention = ps_->search_convention();
     ft.val = fv ? val_.data() : nullptr;
     ft.grad = fg ? grad_.data() : nullptr;

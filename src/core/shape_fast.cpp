@@ -282,20 +282,28 @@ struct AnyShape {
 template <int D, class Kern, bool G>
 int gather(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, int n) {
   const int32_t *cl = t.cols + t.rowptr[s];
-  const double hs = t.sh[s];
+  const double hs = t.sh[s * t.sstride];
+  const int64_t ps = t.stride;
   double *d[3] = {w.d(0), w.d(1), w.d(2)};
+  // one pass over the neighbours' records (coordinates and volume in one cache line)
+  double xs[D];
   MFREE_UNROLL
-  for (int c = 0; c < D; ++c) {
-    const double *X = t.x[c], x0 = t.sx[c][s];
-    double *dc = d[c];
-    for (int j = 0; j < n; ++j) dc[j] = X[cl[j]] - x0;
+  for (int c = 0; c < D; ++c) xs[c] = t.sx[c][s * t.sstride];
+  const double *P = t.x[0], *PV = t.vol;
+  double *v = w.v();
+  for (int j = 0; j < n; ++j) {
+    const int64_t r = cl[j] * ps;
+    MFREE_UNROLL
+    for (int c = 0; c < D; ++c) d[c][j] = P[r + c] - xs[c];
+    v[j] = PV[r];
+  }
+  MFREE_UNROLL
+  for (int c = 0; c < D; ++c)
     if (t.periodic[c]) {
       const double L = t.period[c];
+      double *dc = d[c];
       for (int j = 0; j < n; ++j) dc[j] -= L * std::nearbyint(dc[j] / L);
     }
-  }
-  double *v = w.v();
-  for (int j = 0; j < n; ++j) v[j] = t.vol[cl[j]];
   const Kern K(fp.kernel());
   const double c0 = fp.kernel().norm();
   double *wt = w.w(), *gf = w.gf();
@@ -319,8 +327,8 @@ int gather(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, i
         wt[j] = wv;
         nz += wv != 0.0 ? 1.0 : 0.0;
         if (G) {
-          const double rs = r > 0.0 ? r : 1.0;
-          gf[j] = r > 0.0 ? -(swih * df) / rs : 0.0;
+          const double rs = r > 0.0 ? r : 1.0, rm = r > 0.0 ? 1.0 : 0.0;
+          gf[j] = rm * (-(swih * df) / rs);
         }
       }
       return static_cast<int>(nz);
@@ -328,7 +336,7 @@ int gather(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, i
   }
   const int conv = t.convention;
   for (int j = 0; j < n; ++j) {
-    const double hj = t.h[cl[j]];
+    const double hj = t.h[cl[j] * ps];
     const double h = conv == MFREE_SEARCH_SYMMETRIC_MAX    ? std::max(hs, hj)
                      : conv == MFREE_SEARCH_SYMMETRIC_MEAN ? 0.5 * (hs + hj)
                                                            : hs;
@@ -419,48 +427,79 @@ void write_shepard(FastScratch &w, int n, Rows o) {
 // Method 1 (q_j = grad phi^S_j): A_ab = sum_j d_ja q_jb, corrected gradient A^-T q_j.
 template <int D>
 int corrected(FastScratch &w, int n, Rows o, int self, bool rl, double &cond) {
-  double *q[3];
+  const double *d[3] = {w.d(0), w.d(1), w.d(2)};
+  const double *gf = w.gf(), *v = w.v();
+  double *gv = w.a();  // RL: q_j = gv_j d_j with gv = gf V
+  const double *q[3] = {w.b(0), w.b(1), w.b(2)};
+  double acc[D][D] = {};
   if (rl) {
-    const double *gf = w.gf(), *v = w.v();
+    // A_ab = sum_j gv_j d_ja d_jb is symmetric
+    double s[D * D] = {};
+    for (int j = 0; j < n; ++j) {
+      const double g = gf[j] * v[j];
+      gv[j] = g;
+      MFREE_UNROLL
+      for (int a = 0; a < D; ++a) {
+        const double ga = g * d[a][j];
+        MFREE_UNROLL
+        for (int b = 0; b < D; ++b)
+          if (b <= a) s[a * D + b] += ga * d[b][j];
+      }
+    }
     MFREE_UNROLL
-    for (int c = 0; c < D; ++c) {
-      q[c] = w.b(c);
-      const double *dc = w.d(c);
-      for (int j = 0; j < n; ++j) q[c][j] = gf[j] * v[j] * dc[j];
+    for (int a = 0; a < D; ++a) {
+      MFREE_UNROLL
+      for (int b = 0; b < D; ++b) acc[a][b] = b <= a ? s[a * D + b] : s[b * D + a];
     }
   } else {
     const int st = shepard<D>(w, n);
     if (st) return st;
+    double s[D * D] = {};
+    for (int j = 0; j < n; ++j) {
+      MFREE_UNROLL
+      for (int a = 0; a < D; ++a) {
+        MFREE_UNROLL
+        for (int b = 0; b < D; ++b) s[a * D + b] += d[a][j] * q[b][j];
+      }
+    }
     MFREE_UNROLL
-    for (int c = 0; c < D; ++c) q[c] = w.b(c);
+    for (int a = 0; a < D; ++a) {
+      MFREE_UNROLL
+      for (int b = 0; b < D; ++b) acc[a][b] = s[a * D + b];
+    }
   }
-  double acc[D][D] = {};
-  for (int j = 0; j < n; ++j)
-    MFREE_UNROLL
-    for (int a = 0; a < D; ++a)
-      for (int b = 0; b < D; ++b) acc[a][b] += w.d(a)[j] * q[b][j];
   double X[D][D];
   if (!gen_inverse<D>(acc, X, cond)) return MFREE_FAIL_SINGULAR;
   if (o.val) {
     if (rl)
-      for (int j = 0; j < n; ++j) o.val[j] = w.w()[j] * w.v()[j];
+      for (int j = 0; j < n; ++j) o.val[j] = w.w()[j] * v[j];
     else
       std::copy(w.a(), w.a() + n, o.val);
   }
   if (o.grad) {
-    for (int j = 0; j < n; ++j) {
-      double qj[D];
-      MFREE_UNROLL
-      for (int b = 0; b < D; ++b) qj[b] = q[b][j];
-      MFREE_UNROLL
-      for (int c = 0; c < D; ++c) {
-        double g = 0.0;
+    double *g = o.grad;
+    if (rl) {
+      for (int j = 0; j < n; ++j) {
         MFREE_UNROLL
-        for (int b = 0; b < D; ++b) g += X[b][c] * qj[b];
-        o.grad[j * D + c] = g;
+        for (int c = 0; c < D; ++c) {
+          double t = 0.0;
+          MFREE_UNROLL
+          for (int b = 0; b < D; ++b) t += X[b][c] * d[b][j];
+          g[j * D + c] = gv[j] * t;
+        }
+      }
+      close_difference<D>(g, n, self);
+    } else {
+      for (int j = 0; j < n; ++j) {
+        MFREE_UNROLL
+        for (int c = 0; c < D; ++c) {
+          double t = 0.0;
+          MFREE_UNROLL
+          for (int b = 0; b < D; ++b) t += X[b][c] * q[b][j];
+          g[j * D + c] = t;
+        }
       }
     }
-    if (rl) close_difference<D>(o.grad, n, self);
   }
   return 0;
 }
@@ -649,7 +688,7 @@ int site_fn(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, 
   const bool need_grad = m != MFREE_METHOD_SSPH && (o.grad || corr);
   support = need_grad ? gather<D, Kern, true>(fp, t, s, w, n) : gather<D, Kern, false>(fp, t, s, w, n);
   cond = 1.0;
-  const double hs = t.sh[s];
+  const double hs = t.sh[s * t.sstride];
   const int self = t.self[s];
   switch (m) {
     case MFREE_METHOD_SPH:

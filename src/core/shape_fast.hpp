@@ -20,13 +20,16 @@ struct FastTables {
   const int64_t *rowptr = nullptr;
   const int32_t *cols = nullptr;
   const int32_t *self = nullptr;  // position of the site in its row, -1 at host points
-  // particles, SoA: coordinates, volumes (1 when the set has none), supports
+  // particles: coordinate c of particle j at x[c][j * stride], volume (1 when the set
+  // has none) vol[j * stride], support h[j * stride]
   const double *x[3] = {nullptr, nullptr, nullptr};
   const double *vol = nullptr;
   const double *h = nullptr;
-  // sites (the particles themselves or host points), SoA
+  int64_t stride = 1;
+  // sites (the particles themselves or host points), likewise with sstride
   const double *sx[3] = {nullptr, nullptr, nullptr};
   const double *sh = nullptr;
+  int64_t sstride = 1;
   int convention = MFREE_SEARCH_GATHER;
   bool periodic[3] = {false, false, false};
   double period[3] = {0, 0, 0};
