@@ -5,6 +5,19 @@
 #include <sstream>
 
 #include "kernel.hpp"
+#include "parallel.hpp"
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
+// Loops over a row's neighbours written for the vectoriser (any OpenMP: omp simd).
+#define FLUID_PRAGMA(x) _Pragma(#x)
+#ifdef _OPENMP
+#define FLUID_SIMD(...) FLUID_PRAGMA(omp simd __VA_ARGS__)
+#else
+#define FLUID_SIMD(...)
+#endif
 
 namespace mfree {
 
@@ -108,207 +121,577 @@ void FluidSystem::check_ready() const {
   if (!(h_ > 0.0)) throw Error(MFREE_ERR_STATE, "the smoothing length is not set");
 }
 
-Report FluidSystem::check_state(const double *y, const char *when) const {
+Report FluidSystem::check_state(const double *y, int64_t step) const {
   Report rep;
   const double *x = y, *v = y + static_cast<size_t>(dim_) * n_, *rho = y + 2 * static_cast<size_t>(dim_) * n_;
+  // messages are formatted only on failure (this runs twice per step)
+  auto fail = [&](mfree_status_t status, int32_t i, const char *what, double value, int c) {
+    std::ostringstream s;
+    if (step >= 0) s << "step " << step << ": ";
+    s << "particle " << i << what;
+    if (c >= 0) s << c << " = " << value << ")";
+    else if (status == MFREE_FAIL_INVALID_DATA) s << value << " <= 0";
+    rep.fail(status, s.str());
+    return rep;
+  };
   for (int32_t i = 0; i < n_; ++i) {
     bool finite = std::isfinite(rho[i]);
     for (int c = 0; c < dim_; ++c) finite = finite && std::isfinite(x[i * dim_ + c]) && std::isfinite(v[i * dim_ + c]);
-    std::ostringstream s;
-    if (!finite) {
-      s << when << "particle " << i << " has a non-finite position, velocity or density";
-      rep.fail(MFREE_FAIL_NONFINITE, s.str());
-      return rep;
-    }
-    if (!(rho[i] > 0.0)) {
-      s << when << "particle " << i << " has density " << rho[i] << " <= 0";
-      rep.fail(MFREE_FAIL_INVALID_DATA, s.str());
-      return rep;
-    }
+    if (!finite) return fail(MFREE_FAIL_NONFINITE, i, " has a non-finite position, velocity or density", 0.0, -1);
+    if (!(rho[i] > 0.0)) return fail(MFREE_FAIL_INVALID_DATA, i, " has density ", rho[i], -1);
     if (box_)
       for (int c = 0; c < dim_; ++c)
-        if (x[i * dim_ + c] < lo_[c] || x[i * dim_ + c] > hi_[c]) {
-          s << when << "particle " << i << " left the box (coordinate " << c << " = " << x[i * dim_ + c] << ")";
-          rep.fail(MFREE_FAIL_DOMAIN, s.str());
-          return rep;
-        }
+        if (x[i * dim_ + c] < lo_[c] || x[i * dim_ + c] > hi_[c])
+          return fail(MFREE_FAIL_DOMAIN, i, " left the box (coordinate ", x[i * dim_ + c], c);
   }
   return rep;
 }
 
-Report FluidSystem::prepare(const double *y) {
-  check_ready();
-  Report rep = check_state(y, "");
-  if (!rep.ok()) return rep;
-  const double *rho = y + 2 * static_cast<size_t>(dim_) * n_;
-  for (int32_t i = 0; i < n_; ++i) vol_[i] = mass_[i] / rho[i];
-  ps_.set_positions(y, MFREE_LAYOUT_AOS, dim_, MFREE_BORROW);
+double FluidSystem::tait(double rho, double rho0) const {
+  const double r = rho / rho0;
+  if (gamma_ == 7.0) {  // the usual exponent: no pow per particle
+    const double r2 = r * r;
+    return r2 * r2 * r2 * r;
+  }
+  return std::pow(r, gamma_);
+}
+
+namespace {
+
+// Cubic B-spline of support 2h (the model's kernel, 003) as f(q) and f'(q), q = r/h,
+// without the normalisation constant sigma / h^dim: MLS and Shepard functions and the
+// moment-matrix condition number do not change when all weights are scaled alike.
+inline void cubic_spline(double q, double &f, double &df) {
+  if (q < 1.0) {
+    f = 1.0 - 1.5 * q * q + 0.75 * q * q * q;
+    df = -3.0 * q + 2.25 * q * q;
+  } else {
+    const double t = 2.0 - q;
+    f = 0.25 * t * t * t;
+    df = -0.75 * t * t;
+  }
+}
+
+// a[m] = sqrt(a[m]), m < n, two at a time where SSE2 is there (compilers vectorise sqrt
+// only without errno, which the library does not switch off); correctly rounded either way.
+inline void sqrt_n(double *a, int n) {
+  int m = 0;
+#ifdef __SSE2__
+  for (; m + 2 <= n; m += 2) _mm_storeu_pd(a + m, _mm_sqrt_pd(_mm_loadu_pd(a + m)));
+#endif
+  for (; m < n; ++m) a[m] = std::sqrt(a[m]);
+}
+
+// The approximants' singularity threshold on 1 / cond (local.cpp, shape_fast.cpp).
+constexpr double kMinRcond = 1e-12;
+
+// X = A^-1 for a symmetric positive definite A by A = U^T D U (unit upper U, built
+// column by column) and its exact 1-norm condition number ||A||_1 ||X||_1; false when a
+// pivot is not positive or the system is singular to kMinRcond.
+template <int L>
+bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
+  double U[L][L] = {}, D[L];
+  for (int j = 0; j < L; ++j) {
+    for (int i = 0; i < j; ++i) {
+      double v = A[i][j];
+      for (int m = 0; m < i; ++m) v -= U[m][i] * D[m] * U[m][j];
+      U[i][j] = v / D[i];
+    }
+    double dj = A[j][j];
+    for (int m = 0; m < j; ++m) dj -= U[m][j] * D[m] * U[m][j];
+    if (!(dj > 0.0)) return false;
+    D[j] = dj;
+  }
+  // X = U^-1 D^-1 U^-T with V = U^-1 (unit upper)
+  double V[L][L] = {};
+  for (int i = L - 1; i >= 0; --i) {
+    V[i][i] = 1.0;
+    for (int j = i + 1; j < L; ++j) {
+      double v = 0.0;
+      for (int m = i + 1; m <= j; ++m) v -= U[i][m] * V[m][j];
+      V[i][j] = v;
+    }
+  }
+  for (int a = 0; a < L; ++a)
+    for (int b = a; b < L; ++b) {
+      double v = 0.0;
+      for (int m = b; m < L; ++m) v += V[a][m] * V[b][m] / D[m];
+      X[a][b] = X[b][a] = v;
+    }
+  double na = 0.0, nx = 0.0;
+  for (int b = 0; b < L; ++b) {
+    double sa = 0.0, sx = 0.0;
+    for (int a = 0; a < L; ++a) {
+      sa += std::fabs(A[a][b]);
+      sx += std::fabs(X[a][b]);
+    }
+    na = std::max(na, sa);
+    nx = std::max(nx, sx);
+  }
+  cond = na * nx;
+  return std::isfinite(cond) && cond > 0.0 && 1.0 / cond >= kMinRcond;
+}
+
+}  // namespace
+
+Report FluidSystem::candidates(const double *xn) {
+  const int dim = dim_;
+  const int32_t nall = nq();
+  const size_t nx = static_cast<size_t>(nall) * dim;
+  bool rebuild = !lists_valid_ || xref_.size() != nx || href_ != h_;
+  if (!rebuild) {
+    // 2 max |x - x_ref| < skin: pairs now closer than 2h were closer than 2h + skin at
+    // the build (a tenth of the skin kept back for rounding)
+    const double lim = 0.45 * skin_ * h_, lim2 = lim * lim;
+    for (size_t q = 0; q < nx && !rebuild; q += dim) {
+      double d2 = 0.0;
+      for (int c = 0; c < dim; ++c) d2 += (xn[q + c] - xref_[q + c]) * (xn[q + c] - xref_[q + c]);
+      rebuild = !(d2 <= lim2);
+    }
+  }
+  if (!rebuild) {
+    if (xn != xbound_) {  // same lists, positions from another buffer (ps_ is read by fluid_wall)
+      ps_.set_positions(xn, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
+      xbound_ = xn;
+    }
+    return Report();
+  }
+  lists_valid_ = false;
+  const double hs = h_ * (1.0 + 0.5 * skin_);  // gather radius 2 hs = 2h + skin
+  ps_.set_positions(xn, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
+  xbound_ = xn;
   ps_.set_volumes(vol_.data(), 1, MFREE_BORROW);
+  ps_.set_support(&hs, 0, MFREE_COPY);
   Report r = ps_.setup();
   if (!r.ok()) return r;
-  if (!approx_) {
-    ApproxConfig cfg;
-    cfg.method = MFREE_METHOD_MLS;
-    cfg.kernel = MFREE_KERNEL_CUBIC_SPLINE;
-    cfg.order = 1;
-    cfg.flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
-    cfg.fallback = MFREE_FALLBACK_LOWER_ORDER;  // Shepard at degenerate sites (003 Sect. 2.2)
-    approx_ = std::make_unique<Approximant>(&ps_, cfg);
-  }
-  r = approx_->setup();
-  if (!r.ok()) return r;
-  shepard_ill_conditioned();
+  const Csr &nb = ps_.neighbors();
+  cand_.rowptr.assign(nb.rowptr.begin(), nb.rowptr.end());
+  cand_.cols.assign(nb.cols.begin(), nb.cols.end());
+  const int64_t cnnz = cand_.nnz();
+  // transposed entries: rows are sorted, so the rows i < j that hold j are met in the
+  // order of row j (next[j] walks it); a missing partner (an asymmetric pair at the
+  // edge of the lists) is -1 and may not become a pair of the tables
+  ctrans_.assign(cnnz, -1);
+  cpos_.assign(cnnz, -1);
+  std::vector<int64_t> next(cand_.rowptr.begin(), cand_.rowptr.end() - 1);
+  for (int32_t i = 0; i < nall; ++i)
+    for (int64_t e = cand_.rowptr[i]; e < cand_.rowptr[i + 1]; ++e) {
+      const int32_t j = cand_.cols[e];
+      int64_t &p = next[j];
+      while (p < cand_.rowptr[j + 1] && cand_.cols[p] < i) ++p;
+      if (p < cand_.rowptr[j + 1] && cand_.cols[p] == i) ctrans_[e] = p;
+    }
+  // the tables never outgrow the candidates: no allocation until the next rebuild
+  cols_.reserve(cnnz);
+  N_.reserve(cnnz);
+  G_.reserve(cnnz * dim);
+  NT_.reserve(cnnz * (dim + 1));
+  rp_.resize(static_cast<size_t>(nall) + 1);
+  cond_.resize(nall);
+  maxrow_ = 0;
+  for (int32_t i = 0; i < nall; ++i)
+    maxrow_ = std::max<int64_t>(maxrow_, cand_.rowptr[i + 1] - cand_.rowptr[i]);
+  xref_.assign(xn, xn + nx);
+  href_ = h_;
+  ++rebuilds_;
   if (walls_) {
     VectorArray xa;
-    xa.ptr = y;
-    xa.ld = dim_;
+    xa.ptr = xn;
+    xa.ld = dim;
     xa.layout = MFREE_LAYOUT_AOS;
     ScalarArray ha;
-    const double hw = 0.5 * r0_;
+    const double hw = 0.5 * (r0_ + 0.5 * skin_ * h_);  // walls stand still: skin / 2 is enough
     ha.ptr = &hw;
     ha.stride = 0;
     find_point_neighbors(*walls_, walls_->site_status(), n_, xa, ha, wall_nbr_);
   }
+  lists_valid_ = true;
+  return Report();
+}
+
+// Shepard functions N_j = o_j / S, S = sum o, of the weights o = w (the approximants'
+// fallback where the moment matrix is singular or the row too short), or of o = w V_j
+// where it is ill-conditioned, not only singular (003 Sect. 6: a lattice node has a
+// condition number of 10-15, a free edge or corner 30-60; a particle left in a thin sheet
+// or strand climbs past 1e3 within a few steps, and its gradients then drive the density
+// negative in one step (dam break along the wall, T ~ 2.2, at every resolution and CFL
+// number tried). Hence the default threshold 100 (mfree_system_set_shepard_condition).
+template <int D>
+void FluidSystem::shepard_row(int n, const double *w, const double *gf, double *const *s, double ih,
+                              bool volumes, const int64_t *js, double *Nk, double *Gk) const {
+  double S = 0.0, dS[D] = {};
+  for (int m = 0; m < n; ++m) {
+    const double V = volumes ? vol_[js[m]] : 1.0;
+    Nk[m] = w[m] * V;
+    S += Nk[m];
+    for (int c = 0; c < D; ++c) {
+      Gk[m * D + c] = gf[m] * s[c][m] * ih * V;
+      dS[c] += Gk[m * D + c];
+    }
+  }
+  for (int m = 0; m < n; ++m) {
+    Nk[m] /= S;
+    for (int c = 0; c < D; ++c) Gk[m * D + c] = (Gk[m * D + c] - Nk[m] * dS[c]) / S;
+  }
+}
+
+template <int D>
+bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch) {
+  constexpr int L = D + 1;
+  const double ih = 1.0 / h_, tol = shepard_cond_;
+  const int64_t *crp = cand_.rowptr.data();
+  const int32_t *ccols = cand_.cols.data();
+  const int32_t *cpos = cpos_.data();
+  const int64_t *ctr = ctrans_.data();
+  const int64_t *rp = rp_.data();
+  bool one_way = false;
+  for (int32_t k = k0; k < k1; ++k) {
+    const double *xk = xn + static_cast<size_t>(k) * D;
+    const int64_t o = rp[k];
+    const int n = static_cast<int>(rp[k + 1] - o);
+    double *Nk = N_.data() + o, *Gk = G_.data() + o * D;
+    // the row's neighbours in structure-of-arrays scratch: scaled offsets s = (x_j - x) / h,
+    // weights w = f(|s|) and gf = -f'(|s|) / |s|, so that grad_x w_j = gf s / h; the
+    // columns and transposed candidates. Candidates out of range are written and then
+    // overwritten (no branch).
+    double *s[D], *w = scratch + D * static_cast<size_t>(maxrow_), *gf = w + maxrow_;
+    for (int c = 0; c < D; ++c) s[c] = scratch + c * static_cast<size_t>(maxrow_);
+    int64_t *js = iscratch, *ts = iscratch + maxrow_;
+    int q = 0;
+    for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
+      const int32_t j = ccols[e];
+      js[q] = j;
+      ts[q] = ctr[e];
+      for (int c = 0; c < D; ++c) s[c][q] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
+      q += cpos[e] >= 0;
+    }
+    const double *s0 = s[0], *s1 = s[1], *s2 = s[D - 1];
+    for (int m = 0; m < n; ++m) w[m] = s0[m] * s0[m] + s1[m] * s1[m] + (D == 3 ? s2[m] * s2[m] : 0.0);
+    sqrt_n(w, n);  // |x_j - x| / h < 2
+    FLUID_SIMD()
+    for (int m = 0; m < n; ++m) {
+      // the cubic spline as B-spline pieces, f = (2 - r)_+^3 / 4 - (1 - r)_+^3, with
+      // (x)_+ = (x + |x|) / 2 (exact): no comparison, which the vectoriser would not
+      // if-convert under trapping math
+      const double r = w[m], a0 = 1.0 - r, b0 = 2.0 - r;
+      const double a = 0.5 * (a0 + std::fabs(a0)), b = 0.5 * (b0 + std::fabs(b0));
+      w[m] = 0.25 * b * b * b - a * a * a;
+      const double df = 3.0 * a * a - 0.75 * b * b;  // exactly 0 at r = 0
+      gf[m] = -df / (r + 1e-300);                    // r + 1e-300 = r unless r < 1e-284
+    }
+    // moments: M = sum w p p^T and M_,c = sum w_,c p p^T, p = (1, s), w_,c = gf s_c / h
+    // (the 1/h is applied after the sums)
+    double m0[L][L] = {}, mc[D][L][L] = {};
+    if (D == 2) {
+      double a0 = 0, a1 = 0, a2 = 0, a11 = 0, a12 = 0, a22 = 0;
+      double b1 = 0, b2 = 0, b11 = 0, b12 = 0, b22 = 0, b111 = 0, b112 = 0, b122 = 0, b222 = 0;
+      FLUID_SIMD(reduction(+ : a0, a1, a2, a11, a12, a22, b1, b2, b11, b12, b22, b111, b112, b122, b222))
+      for (int m = 0; m < n; ++m) {
+        const double x1 = s0[m], x2 = s1[m], wm = w[m], gm = gf[m];
+        a0 += wm;
+        a1 += wm * x1;
+        a2 += wm * x2;
+        a11 += wm * x1 * x1;
+        a12 += wm * x1 * x2;
+        a22 += wm * x2 * x2;
+        const double g1 = gm * x1, g2 = gm * x2;
+        b1 += g1;
+        b2 += g2;
+        b11 += g1 * x1;
+        b12 += g1 * x2;
+        b22 += g2 * x2;
+        b111 += g1 * x1 * x1;
+        b112 += g1 * x1 * x2;
+        b122 += g1 * x2 * x2;
+        b222 += g2 * x2 * x2;
+      }
+      const double M[3][3] = {{a0, a1, a2}, {a1, a11, a12}, {a2, a12, a22}};
+      // w_,1 p p^T: gf s1 (1, s1, s2)(1, s1, s2)^T, likewise for s2
+      const double M1[3][3] = {{b1, b11, b12}, {b11, b111, b112}, {b12, b112, b122}};
+      const double M2[3][3] = {{b2, b12, b22}, {b12, b112, b122}, {b22, b122, b222}};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          m0[a][b] = M[a][b];
+          mc[0][a][b] = M1[a][b] * ih;
+          mc[D - 1][a][b] = M2[a][b] * ih;
+        }
+    } else {
+      double acc[L][L] = {}, accc[D][L][L] = {};
+      for (int m = 0; m < n; ++m) {
+        double p[L];
+        p[0] = 1.0;
+        for (int c = 0; c < D; ++c) p[1 + c] = s[c][m];
+        for (int a = 0; a < L; ++a)
+          for (int b = 0; b <= a; ++b) {
+            const double pp = p[a] * p[b];
+            acc[a][b] += w[m] * pp;
+            for (int c = 0; c < D; ++c) accc[c][a][b] += gf[m] * s[c][m] * pp;
+          }
+      }
+      for (int a = 0; a < L; ++a)
+        for (int b = 0; b <= a; ++b) {
+          m0[a][b] = m0[b][a] = acc[a][b];
+          for (int c = 0; c < D; ++c) mc[c][a][b] = mc[c][b][a] = accc[c][a][b] * ih;
+        }
+    }
+    double X[L][L], cond = 1.0;
+    // too few neighbours or a singular moment matrix: Shepard functions of the weights
+    // (the approximants' lower-order fallback, whose condition number is 1)
+    const bool mls = n >= L && spd_inverse<L>(m0, X, cond);
+    if (!mls) cond = 1.0;
+    cond_[k] = cond;
+    if (mls && !(cond > tol)) {
+      // 003 eqs 27-31 (MLS, basis shifted to the node and scaled by h): M g = p(0),
+      // M g_,c = e_c / h - M_,c g; N_j = w_j g.p_j, N_j,c = w_j g_,c.p_j + w_j,c g.p_j
+      double g[L], gc[D][L];
+      for (int a = 0; a < L; ++a) g[a] = X[a][0];
+      for (int c = 0; c < D; ++c) {
+        double rhs[L];
+        for (int a = 0; a < L; ++a) {
+          double t = 0.0;
+          for (int b = 0; b < L; ++b) t += mc[c][a][b] * g[b];
+          rhs[a] = -t;
+        }
+        rhs[1 + c] += ih;
+        for (int a = 0; a < L; ++a) {
+          double t = 0.0;
+          for (int b = 0; b < L; ++b) t += X[a][b] * rhs[b];
+          gc[c][a] = t;
+        }
+      }
+      // g.p_j and g_,c.p_j with the coefficients in scalars, for the vectoriser
+      const double g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[L - 1];
+      const double c00 = gc[0][0], c01 = gc[0][1], c02 = gc[0][2], c03 = gc[0][L - 1];
+      const double c10 = gc[1][0], c11 = gc[1][1], c12 = gc[1][2], c13 = gc[1][L - 1];
+      const double c20 = gc[D - 1][0], c21 = gc[D - 1][1], c22 = gc[D - 1][2], c23 = gc[D - 1][L - 1];
+      FLUID_SIMD()
+      for (int m = 0; m < n; ++m) {
+        const double x1 = s0[m], x2 = s1[m], x3 = D == 3 ? s2[m] : 0.0;
+        const double gp = g0 + g1 * x1 + g2 * x2 + (D == 3 ? g3 * x3 : 0.0);
+        const double wm = w[m], gq = gf[m] * ih * gp;
+        Nk[m] = wm * gp;
+        Gk[m * D] = wm * (c00 + c01 * x1 + c02 * x2 + (D == 3 ? c03 * x3 : 0.0)) + gq * x1;
+        Gk[m * D + 1] = wm * (c10 + c11 * x1 + c12 * x2 + (D == 3 ? c13 * x3 : 0.0)) + gq * x2;
+        if (D == 3) Gk[m * D + D - 1] = wm * (c20 + c21 * x1 + c22 * x2 + c23 * x3) + gq * x3;
+      }
+    } else {
+      shepard_row<D>(n, w, gf, s, ih, mls, js, Nk, Gk);
+    }
+    // columns, and the transposed copy: N_k(x_j) is entry (j, k) of the transpose
+    int32_t *ck = cols_.data() + o;
+    for (int m = 0; m < n; ++m) {
+      const int32_t j = static_cast<int32_t>(js[m]);
+      ck[m] = j;
+      const int64_t t = ts[m];
+      if (t < 0 || cpos[t] < 0) {
+        one_way = true;
+        continue;
+      }
+      double *nt = NT_.data() + (rp[j] + cpos[t]) * (D + 1);  // one cache line per entry
+      nt[0] = Nk[m];
+      for (int c = 0; c < D; ++c) nt[1 + c] = Gk[m * D + c];
+    }
+  }
+  return one_way;
+}
+
+Report FluidSystem::prepare(const double *y) {
+  check_ready();
+  Report rep = check_state(y, -1);
+  if (!rep.ok()) return rep;
+  const int dim = dim_;
+  const int32_t nall = nq();
+  const double *rho = y + 2 * static_cast<size_t>(dim) * n_;
+  for (int32_t i = 0; i < n_; ++i) vol_[i] = mass_[i] / rho[i];
+  const double *xn = node_positions(y);  // + dummies (fluid_wall.cpp)
+  Report r = candidates(xn);
+  if (!r.ok()) return r;
+  // rows: the candidates closer than 2h (a symmetric test: |x_j - x_k| is computed
+  // alike from both ends), counted, then filled
+  const double R2 = 4.0 * h_ * h_;
+  const int nt = num_threads(nall);
+  const int64_t *crp = cand_.rowptr.data();
+  const int32_t *ccols = cand_.cols.data();
+  parallel_blocks(nall, nt, [&](int, int64_t b, int64_t e) {
+    for (int64_t k = b; k < e; ++k) {
+      const double *xk = xn + k * dim;
+      int32_t cnt = 0;
+      for (int64_t q = crp[k]; q < crp[k + 1]; ++q) {
+        const double *xj = xn + static_cast<size_t>(ccols[q]) * dim;
+        double r2 = 0.0;
+        for (int c = 0; c < dim; ++c) r2 += (xj[c] - xk[c]) * (xj[c] - xk[c]);
+        const int32_t keep = r2 < R2;  // no branch: a quarter of the candidates fall out
+        cpos_[q] = keep ? cnt : -1;
+        cnt += keep;
+      }
+      rp_[k + 1] = cnt;
+    }
+  });
+  rp_[0] = 0;
+  for (int32_t k = 0; k < nall; ++k) rp_[k + 1] += rp_[k];
+  const size_t nnz = static_cast<size_t>(rp_[nall]);
+  cols_.resize(nnz);
+  N_.resize(nnz);
+  G_.resize(nnz * dim);
+  NT_.resize(nnz * (dim + 1));
+  const size_t per_thread = static_cast<size_t>(dim + 2) * maxrow_, iper_thread = 2 * static_cast<size_t>(maxrow_);
+  if (rows_scratch_.size() < per_thread * nt) rows_scratch_.resize(per_thread * nt);
+  if (rows_iscratch_.size() < iper_thread * nt) rows_iscratch_.resize(iper_thread * nt);
+  bool one_way[64] = {};  // parallel_blocks runs at most 64 threads
+  parallel_blocks(nall, nt, [&](int t, int64_t b, int64_t e) {
+    double *scratch = rows_scratch_.data() + per_thread * t;
+    int64_t *iscratch = rows_iscratch_.data() + iper_thread * t;
+    const int32_t k0 = static_cast<int32_t>(b), k1 = static_cast<int32_t>(e);
+    one_way[t] = dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch) : table_rows<3>(k0, k1, xn, scratch, iscratch);
+  });
+  if (std::any_of(one_way, one_way + 64, [](bool f) { return f; })) {
+    // cannot happen with lists from one search radius; a failure rather than a wrong sum
+    rep.fail(MFREE_FAIL_NEIGHBORS, "the neighbour lists of the fluid are not symmetric");
+    lists_valid_ = false;
+    return rep;
+  }
+  fluid_share();
+  vci_setup();  // optional, fluid_wall.cpp
   return rep;
 }
 
-void FluidSystem::shepard_ill_conditioned() {
-  // 003 Sect. 6: where the linear-basis moment matrix is ill-conditioned, not only
-  // singular, the constant basis is used: Shepard functions N_j = W_j V_j / sum W V. The
-  // paper gives no tolerance. A lattice site has a condition estimate of 10-15, a free
-  // edge or corner 30-60; a particle left in a thin sheet or strand climbs past 1e3 within
-  // a few steps, and its gradients then drive the density negative in one step (dam
-  // break along the wall, T ~ 2.2, at every resolution and CFL number tried). Hence the
-  // default threshold 100 (mfree_system_set_shepard_condition).
-  N_.assign(approx_->values().begin(), approx_->values().end());  // reuses N_'s storage
-  G_.assign(approx_->gradients().begin(), approx_->gradients().end());
-  const auto &cond = approx_->site_cond();
-  const auto &rp = approx_->rowptr();
-  const auto &cols = approx_->cols();
-  const double tol = shepard_cond_;
-  const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim_, 0.0);
-  for (int32_t k = 0; k < n_; ++k) {
-    if (!(cond[k] > tol)) continue;
-    double S = 0.0, dS[3] = {0, 0, 0};
-    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
-      const int32_t j = cols[e];
-      double r2 = 0.0, dx[3] = {0, 0, 0};
-      for (int c = 0; c < dim_; ++c) {
-        dx[c] = ps_.x(k, c) - ps_.x(j, c);
-        r2 += dx[c] * dx[c];
-      }
-      const double r = std::sqrt(r2);
-      double w, dw, d2w;
-      kern.eval(r, h_, w, dw, d2w);
-      N_[e] = w * vol_[j];
-      S += N_[e];
-      for (int c = 0; c < dim_; ++c) {
-        G_[e * dim_ + c] = r > 0.0 ? dw * dx[c] / r * vol_[j] : 0.0;
-        dS[c] += G_[e * dim_ + c];
-      }
-    }
-    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
-      N_[e] /= S;
-      for (int c = 0; c < dim_; ++c) G_[e * dim_ + c] = (G_[e * dim_ + c] - N_[e] * dS[c]) / S;
-    }
-  }
-}
-
 void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, double *drho) const {
-  const auto &rp = approx_->rowptr();
-  const auto &cols = approx_->cols();
-  const auto &N = N_;
-  const auto &G = G_;
-  for (int32_t k = 0; k < n_; ++k) {
-    double vh[3] = {0, 0, 0}, div = 0.0;
-    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
-      const int32_t j = cols[e];
-      for (int c = 0; c < dim_; ++c) {
-        vh[c] += N[e] * v[j * dim_ + c];
-        div += v[j * dim_ + c] * G[e * dim_ + c];
+  v = node_velocities(v);
+  const int dim = dim_;
+  const int64_t *rp = rp_.data();
+  const int32_t *cols = cols_.data();
+  const double *N = N_.data(), *G = G_.data();
+  parallel_blocks(n_, num_threads(n_), [&](int, int64_t b, int64_t e) {
+    for (int64_t k = b; k < e; ++k) {
+      double vh[3] = {0, 0, 0}, div = 0.0;
+      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+        const double *vj = v + static_cast<size_t>(cols[q]) * dim;
+        for (int c = 0; c < dim; ++c) {
+          vh[c] += N[q] * vj[c];
+          div += vj[c] * G[q * dim + c];
+        }
       }
+      if (vhat)
+        for (int c = 0; c < dim; ++c) vhat[k * dim + c] = vh[c];
+      if (drho) drho[k] = -rho[k] * div;  // 003 eq 70, nodal parameters v_j
     }
-    if (vhat)
-      for (int c = 0; c < dim_; ++c) vhat[k * dim_ + c] = vh[c];
-    if (drho) drho[k] = -rho[k] * div;  // 003 eq 70, nodal parameters v_j
-  }
+  });
+  if (drho) density_diffusion(rho, drho);  // optional, fluid_wall.cpp
 }
 
 Report FluidSystem::accel(const double *v, const double *rho, double *a) {
+  return dim_ == 2 ? accel_dim<2>(v, rho, a) : accel_dim<3>(v, rho, a);
+}
+
+// 003 eqs 56, 61, 67-68 with nodal quadrature: the force on node i is
+//   f_i = sum_k [-sigma_k grad N_i(x_k) V_k + N_i(x_k) M_k g],  m_i = sum_k N_i(x_k) M_k,
+// over the quadrature points k whose row holds i. Pass 1 computes per point k the stress
+// (times V_k), the interpolated velocity and the wall force; pass 2 gathers for each node
+// over its own row through trans_, so that both passes are split over threads and every
+// sum is taken in the same order whatever their number.
+template <int D>
+Report FluidSystem::accel_dim(const double *v, const double *rho, double *a) {
   Report rep;
-  const int dim = dim_;
-  const auto &rp = approx_->rowptr();
-  const auto &cols = approx_->cols();
-  const auto &N = N_;
-  const auto &G = G_;
-  force_.assign(static_cast<size_t>(n_) * dim, 0.0);
-  lumped_.assign(n_, 0.0);
-  fb_.assign(static_cast<size_t>(n_) * dim, 0.0);
-  vhat_.resize(static_cast<size_t>(n_) * dim);
-  kinematics(v, rho, vhat_.data(), nullptr);
-  for (int32_t k = 0; k < n_; ++k) {
-    // velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at the quadrature point x_k
-    double L[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
-      const int32_t j = cols[e];
-      for (int aa = 0; aa < dim; ++aa)
-        for (int b = 0; b < dim; ++b) L[aa][b] += v[j * dim + aa] * G[e * dim + b];
-    }
-    double tr = 0.0;
-    for (int c = 0; c < dim; ++c) tr += L[c][c];
-    const double p = kappa_ * (std::pow(rho[k] / rho0_[k], gamma_) - 1.0);
-    double sig[3][3];
-    for (int aa = 0; aa < dim; ++aa)
-      for (int b = 0; b < dim; ++b) {
-        const double d = 0.5 * (L[aa][b] + L[b][aa]) - (aa == b ? tr / 3.0 : 0.0);  // d' (003 eq 61)
-        sig[aa][b] = (aa == b ? -p : 0.0) + 2.0 * mu_ * d;
-      }
-    const double Vk = vol_[k], Mk = mass_[k];
-    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) {
-      const int32_t i = cols[e];
-      for (int aa = 0; aa < dim; ++aa) {
-        double s = 0.0;
-        for (int b = 0; b < dim; ++b) s += sig[aa][b] * G[e * dim + b];
-        force_[i * dim + aa] += -s * Vk + N[e] * Mk * g_[aa];  // 003 eqs 67-68
-      }
-      lumped_[i] += N[e] * Mk;  // 003 eq 56
-    }
-  }
-  // wall forces (003 eqs 122-124), spread to the neighbours through N_i(x_j)
-  if (walls_) {
-    for (int32_t j = 0; j < n_; ++j) {
-      double F[3] = {0, 0, 0};
-      bool any = false;
-      for (int64_t e = wall_nbr_.rowptr[j]; e < wall_nbr_.rowptr[j + 1]; ++e) {
-        const int32_t k = wall_nbr_.cols[e];
-        const double *nk = &wall_n_[static_cast<size_t>(k) * dim];
-        double r2 = 0.0, approach = 0.0;
-        for (int c = 0; c < dim; ++c) {
-          const double d = ps_.x(j, c) - walls_->x(k, c);
-          r2 += d * d;
-          approach += vhat_[j * dim + c] * nk[c];
+  constexpr int P = D * D + 2 + D;  // per point: sigma V (D x D), M, lumping mass, wall force
+  const int32_t nall = nq();
+  v = node_velocities(v);
+  rho = node_densities(rho);
+  const double *rho0 = dummy_.n ? dummy_.rho0.data() : rho0_.data();
+  const double *mass = dummy_.n ? dummy_.mass.data() : mass_.data();
+  pack_.resize(static_cast<size_t>(nall) * P);
+  vhat_.resize(static_cast<size_t>(nall) * D);
+  const int64_t *rp = rp_.data();
+  const int32_t *cols = cols_.data();
+  const double *N = N_.data(), *G = G_.data(), *NT = NT_.data();
+  const int nt = num_threads(nall);
+  parallel_blocks(nall, nt, [&](int, int64_t b, int64_t e) {
+    for (int64_t k = b; k < e; ++k) {
+      // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
+      double vh[D] = {}, L[D][D] = {};
+      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+        const double *vj = v + static_cast<size_t>(cols[q]) * D;
+        const double *gq = G + q * D;
+        for (int c = 0; c < D; ++c) {
+          vh[c] += N[q] * vj[c];
+          for (int bb = 0; bb < D; ++bb) L[c][bb] += vj[c] * gq[bb];
         }
-        const double r = std::sqrt(r2);
-        if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // f1 = 0: moving away
-        const double q = r0_ / r, f2 = strength_ / r * (q * q * q * q - q * q);
-        for (int c = 0; c < dim; ++c) F[c] += f2 * nk[c];
-        any = true;
       }
-      if (!any) continue;
-      for (int64_t e = rp[j]; e < rp[j + 1]; ++e)
-        for (int c = 0; c < dim; ++c) fb_[cols[e] * dim + c] += N[e] * F[c];
+      double tr3 = 0.0;
+      for (int c = 0; c < D; ++c) tr3 += L[c][c];
+      tr3 /= 3.0;
+      const double p = kappa_ * (tait(rho[k], rho0[k]) - 1.0), Vk = vol_[k];
+      double *pk = &pack_[static_cast<size_t>(k) * P];
+      for (int aa = 0; aa < D; ++aa)
+        for (int bb = 0; bb < D; ++bb) {
+          const double d = 0.5 * (L[aa][bb] + L[bb][aa]) - (aa == bb ? tr3 : 0.0);  // d' (003 eq 61)
+          pk[aa * D + bb] = ((aa == bb ? -p : 0.0) + 2.0 * mu_ * d) * Vk;
+        }
+      pk[D * D] = mass[k];
+      pk[D * D + 1] = k < n_ ? mass[k] / share(static_cast<int32_t>(k)) : 0.0;  // dummies carry no fluid mass
+      double F[D] = {};
+      if (walls_ && k < n_) {
+        // wall force (003 eqs 122-124) on approaching particles, spread through N_i(x_k)
+        for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
+          const int32_t w = wall_nbr_.cols[q];
+          const double *nw = &wall_n_[static_cast<size_t>(w) * D];
+          double r2 = 0.0, approach = 0.0;
+          for (int c = 0; c < D; ++c) {
+            const double d = xbound_[k * D + c] - walls_->x(w, c);
+            r2 += d * d;
+            approach += vh[c] * nw[c];
+          }
+          const double r = std::sqrt(r2);
+          if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // f1 = 0: moving away
+          const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
+          for (int c = 0; c < D; ++c) F[c] += f2 * nw[c];
+        }
+      }
+      for (int c = 0; c < D; ++c) {
+        pk[D * D + 2 + c] = F[c];
+        vhat_[k * D + c] = vh[c];
+      }
     }
-  }
-  for (int32_t i = 0; i < n_; ++i) {
-    const double m = lump_ == MFREE_LUMP_GALERKIN ? lumped_[i] : mass_[i];
-    if (!(m > 0.0)) {
-      rep.fail(MFREE_FAIL_SINGULAR, "particle " + std::to_string(i) + " has a non-positive lumped mass " +
-                                        std::to_string(m));
-      for (int c = 0; c < dim; ++c) a[i * dim + c] = 0.0;
-      continue;
+  });
+  const double *pack = pack_.data();
+  const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
+  int32_t bad = n_;  // the first node without a positive mass
+  int32_t first_bad[64];  // parallel_blocks runs at most 64 threads
+  std::fill(first_bad, first_bad + 64, n_);
+  parallel_blocks(n_, num_threads(n_), [&](int t, int64_t b, int64_t e) {
+    for (int64_t i = b; i < e; ++i) {
+      double f[D] = {}, fb[D] = {}, nm = 0.0, lm = 0.0;
+      for (int64_t q = rp[i]; q < rp[i + 1]; ++q) {
+        const double *pk = pack + static_cast<size_t>(cols[q]) * P;
+        const double Ni = NT[q * (D + 1)], *gi = NT + q * (D + 1) + 1;  // N_i(x_k), grad N_i(x_k)
+        for (int aa = 0; aa < D; ++aa) {
+          double sg = 0.0;
+          for (int bb = 0; bb < D; ++bb) sg += pk[aa * D + bb] * gi[bb];
+          f[aa] -= sg;
+          fb[aa] += Ni * pk[D * D + 2 + aa];
+        }
+        nm += Ni * pk[D * D];
+        lm += Ni * pk[D * D + 1];  // 003 eq 56
+      }
+      const double m = galerkin ? lm : mass_[i];
+      if (!(m > 0.0)) {
+        if (first_bad[t] == n_) first_bad[t] = static_cast<int32_t>(i);
+        for (int c = 0; c < D; ++c) a[i * D + c] = 0.0;
+        continue;
+      }
+      // the boundary force acts as an acceleration (003 Sect. 6.1 step 7)
+      for (int c = 0; c < D; ++c) a[i * D + c] = (f[c] + nm * g_[c]) / m + fb[c];
     }
-    // the boundary force acts as an acceleration (003 Sect. 6.1 step 7)
-    for (int c = 0; c < dim; ++c) a[i * dim + c] = force_[i * dim + c] / m + fb_[i * dim + c];
+  });
+  vci_correct(pack, P, a);  // optional, fluid_wall.cpp
+  for (int32_t fbad : first_bad) bad = std::min(bad, fbad);
+  if (bad < n_) {
+    double m = 0.0;
+    if (galerkin)
+      for (int64_t q = rp[bad]; q < rp[bad + 1]; ++q) m += NT[q * (D + 1)] * pack[static_cast<size_t>(cols[q]) * P + D * D + 1];
+    else
+      m = mass_[bad];
+    rep.fail(MFREE_FAIL_SINGULAR, "particle " + std::to_string(bad) + " has a non-positive lumped mass " +
+                                      std::to_string(m));
   }
   return rep;
 }
@@ -341,17 +724,22 @@ Report FluidSystem::interpolation(const double *y, SparseMatrix &S) {
   Report rep = prepare(y);
   if (!rep.ok()) return rep;
   // rows are not guaranteed sorted by column: sort each row with its values
-  std::vector<int64_t> rp = approx_->rowptr();
-  std::vector<int32_t> cols = approx_->cols();
-  std::vector<double> vals = N_;
+  // the fluid rows and columns only (dummies are not unknowns)
+  const auto &arp = rp_;
+  const auto &acols = cols_;
+  std::vector<int64_t> rp(static_cast<size_t>(n_) + 1, 0);
+  std::vector<int32_t> cols;
+  std::vector<double> vals;
   for (int32_t k = 0; k < n_; ++k) {
     std::vector<std::pair<int32_t, double>> row;
-    for (int64_t e = rp[k]; e < rp[k + 1]; ++e) row.push_back({cols[e], vals[e]});
+    for (int64_t e = arp[k]; e < arp[k + 1]; ++e)
+      if (acols[e] < n_) row.push_back({acols[e], N_[e]});
     std::sort(row.begin(), row.end());
-    for (size_t q = 0; q < row.size(); ++q) {
-      cols[rp[k] + q] = row[q].first;
-      vals[rp[k] + q] = row[q].second;
+    for (auto &q : row) {
+      cols.push_back(q.first);
+      vals.push_back(q.second);
     }
+    rp[k + 1] = static_cast<int64_t>(cols.size());
   }
   S.set_pattern(n_, n_, rp, cols);
   std::copy(vals.begin(), vals.end(), S.values_mut().begin());
@@ -363,19 +751,25 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   if (!rep.ok()) return rep;
   const int dim = dim_;
   const size_t nd = static_cast<size_t>(dim) * n_;
-  const auto &rp = approx_->rowptr();
-  const auto &cols = approx_->cols();
+  const auto &rp = rp_;
+  const auto &cols = cols_;
   const auto &N = N_;
   // node-level velocity block: consistent m_ij = sum_k N_i(x_k) N_j(x_k) M_k (003 eq 42),
   // or the lumped row sums
   std::vector<std::vector<std::pair<int32_t, double>>> rows(n_);
+  // with dummies: fluid rows and columns only, lumped masses as in accel (fluid_wall.hpp)
   for (int32_t k = 0; k < n_; ++k)
-    for (int64_t a = rp[k]; a < rp[k + 1]; ++a)
+    for (int64_t a = rp[k]; a < rp[k + 1]; ++a) {
+      if (cols[a] >= n_) continue;
       for (int64_t b = rp[k]; b < rp[k + 1]; ++b) {
         const double m = N[a] * N[b] * mass_[k];
-        if (consistent) rows[cols[a]].push_back({cols[b], m});
-        else rows[cols[a]].push_back({cols[a], m});
+        if (consistent) {
+          if (cols[b] < n_) rows[cols[a]].push_back({cols[b], m});
+        } else {
+          rows[cols[a]].push_back({cols[a], m / share(k)});
+        }
       }
+    }
   std::vector<int64_t> rowptr(static_cast<size_t>(neq()) + 1, 0);
   std::vector<int32_t> ci;
   std::vector<double> vals;
@@ -485,7 +879,7 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
       for (size_t q = 0; q < nd; ++q) yn[q] = x[q] + 0.5 * dt * vh[q];              // x^C
       for (size_t q = 0; q < ny; ++q) yn[q] = 2.0 * yn[q] - y[q];                   // eqs 117-119
     }
-    Report bad = check_state(yn, ("step " + std::to_string(nsteps + 1) + ": ").c_str());
+    Report bad = check_state(yn, nsteps + 1);
     if (!bad.ok()) return bad;  // y keeps the last good state
     std::copy(yn, yn + ny, y);
     t = (t_end - t <= dt) ? t_end : t + dt;

@@ -9,6 +9,7 @@
 
 #include "approximant.hpp"
 #include "error.hpp"
+#include "fluid_wall.hpp"
 #include "matrix.hpp"
 #include "mfree.h"
 #include "particles.hpp"
@@ -29,6 +30,11 @@ class FluidSystem : public System {
   void set_box(const double *lo, const double *hi);
   // Sites whose moment-matrix condition estimate exceeds max_cond use Shepard functions.
   void set_shepard_condition(double max_cond);
+  // Options beyond paper 003 (fluid_wall.cpp): dummy wall particles (n = 0 removes them),
+  // density diffusion coefficient delta (0 = off, the default).
+  void set_dummy_particles(int32_t n, const double *x, const double *vol, int64_t stride);
+  void set_density_diffusion(double delta);
+  void set_consistent_integration(int on);  // 0 (default) or 1: constant VCI correction
 
   int dim() const { return dim_; }
   int32_t size() const { return n_; }
@@ -44,17 +50,39 @@ class FluidSystem : public System {
 
  private:
   void check_ready() const;
-  // Validate the state, point the particle set at it and build the MLS tables.
+  // Validate the state and build the shape-function tables at the nodes (below).
   Report prepare(const double *y);
+  // Candidate neighbour lists (Verlet lists with a skin, see tables_) for the node
+  // positions xn, rebuilt when a node moved more than half the skin since the last build.
+  Report candidates(const double *xn);
+  // Tables rows [k0, k1): linear MLS at the nodes, Shepard rows where ill-conditioned.
+  // (true if a pair is in one node's row only, which the search rules out)
+  template <int D>
+  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch);
+  template <int D>
+  void shepard_row(int n, const double *w, const double *gf, double *const *s, double ih, bool volumes,
+                   const int64_t *js, double *Nk, double *Gk) const;
   // Acceleration parameters a (dim per particle) from the prepared tables and v, rho.
   Report accel(const double *v, const double *rho, double *a);
-  // Copies the approximant's tables into N_, G_ and replaces the rows of ill-conditioned
-  // sites by Shepard functions (003 Sect. 6).
-  void shepard_ill_conditioned();
+  template <int D>
+  Report accel_dim(const double *v, const double *rho, double *a);
   // Interpolated velocities and density rates for velocity parameters v.
   void kinematics(const double *v, const double *rho, double *vhat, double *drho) const;
   double stable_dt(const double *y) const;  // h / max(c_i + |v_i|)
-  Report check_state(const double *y, const char *when) const;
+  // The first invalid particle of y, if any; step >= 0 prefixes the message with it.
+  Report check_state(const double *y, int64_t step) const;
+  double tait(double rho, double rho0) const;  // (rho / rho0)^gamma
+  // fluid_wall.cpp. Nodes (and nodal quadrature points): the n_ fluid particles, then
+  // the dummies. Without dummies the node arrays are the fluid's own.
+  int32_t nq() const { return n_ + dummy_.n; }
+  const double *node_positions(const double *y);     // fluid positions + dummies
+  const double *node_velocities(const double *v) const;  // v + zeros for the dummies
+  const double *node_densities(const double *rho) const;  // rho + extrapolated (fills rho0, mass)
+  double share(int32_t k) const { return dummy_.n ? dummy_.share[k] : 1.0; }
+  void fluid_share();                                 // fills dummy_.share after the tables
+  void density_diffusion(const double *rho, double *drho) const;  // adds the delta-SPH term
+  void vci_setup();  // after the tables
+  void vci_correct(const double *pack, int per_point, double *a) const;  // end of accel
 
   int dim_;
   int32_t n_;
@@ -66,16 +94,43 @@ class FluidSystem : public System {
   std::vector<double> wall_n_;
   double r0_ = 0.0, strength_ = 0.0;
   double shepard_cond_ = 100.0;
+  mutable DummyWall dummy_;  // scratch node arrays are refilled by const evaluations
+  double delta_ = 0.0;
+  bool vci_ = false;
   bool box_ = false;
   double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
 
+  // Shape functions at the nodes, rebuilt at every prepare (003: linear MLS with the
+  // cubic spline, nodal quadrature): CSR rows sorted by column, rp_/cols_; values N_
+  // and gradients G_ (dim per entry) of node cols_[e] at node k, and the transpose NT_
+  // on the same pattern (it is symmetric: one h for all), value and gradient interleaved
+  // (dim + 1 per entry): entry e of row i holds N_i(x_j), j = cols_[e], so that sums over
+  // the quadrature points a node belongs to are gathers that read the tables in order.
+  //
+  // The rows come from candidate (Verlet) lists cand_ of radius 2h + skin built by ps_
+  // at positions xref_; they are reused while no node has moved more than skin / 2 since
+  // (then every pair closer than 2h now was closer than 2h + skin then), so that the
+  // tables never depend on the skin, only the cost does. The wall lists use the same rule.
   ParticleSet ps_;
   std::vector<double> vol_;
-  std::vector<double> N_, G_;  // shape-function values and gradients used by the model
-  std::unique_ptr<Approximant> approx_;
+  std::vector<int64_t> rp_;
+  std::vector<int32_t> cols_;
+  std::vector<double> N_, G_, NT_, cond_;
+  Csr cand_;
+  std::vector<int64_t> ctrans_;  // transposed candidate entry, -1 if none
+  std::vector<int32_t> cpos_;    // position of a candidate in its row of the tables, -1 if out
+  std::vector<double> xref_;
+  double skin_ = 0.25;  // in units of h
+  bool lists_valid_ = false;
+  double href_ = 0.0;
+  const double *xbound_ = nullptr;  // node positions ps_ borrows
+  int64_t rebuilds_ = 0;
+  int64_t maxrow_ = 0;               // longest candidate row
+  std::vector<double> rows_scratch_;  // (dim + 2) maxrow_ per thread
+  std::vector<int64_t> rows_iscratch_;  // 2 maxrow_ per thread
   Csr wall_nbr_;
-  // scratch (reused, sized once)
-  std::vector<double> force_, lumped_, fb_, vhat_, work_state_, stage_;
+  // per node (reused): packed quadrature-point data of accel, interpolated velocities
+  std::vector<double> pack_, vhat_, work_state_, stage_;
 };
 
 }  // namespace mfree
