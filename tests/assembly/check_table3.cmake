@@ -10,8 +10,8 @@
 # 20 s (beam) and 25 s (hole):
 #
 #   rates energy / L2   beam 17x3..129x17     paper      hole 118..814 nodes  paper
-#   SPH                 0.19 / 0.43 (grows)   NC / NC    0.76 / 1.29          NC / NC
-#   JB                  0.24 / 2.50 (grows)   NC / NC    0.47 / 0.81 (l2 grows) NC / NC
+#   SPH                 0.23 / 0.42 (grows)   NC / NC   -0.15 / -0.32 (grows) NC / NC
+#   JB                  0.21 / 0.29 (grows)   NC / NC    0.04 / -0.01 (grows) NC / NC
 #   RL                  1.66 / 1.84           0.98/0.41  0.65 / 0.64          0.51/0.62
 #   CD1                 0.65 / 0.98           1.29/1.84  0.61 / 2.04          0.54/1.10
 #   CD2                 0.60 / 1.05           1.29/1.84  0.51 / 2.06          0.49/1.30
@@ -20,6 +20,15 @@
 #
 # JB is the paper's (normal strains beta-corrected, shear strain symmetrised SPH), which
 # mfree's assembler builds for JOHNSON_BEISSEL under elasticity forms.
+#
+# SPH and JB load their test functions with SPH's kernel estimate W dV (000 eq 21: the
+# symmetrisation and JB correct derivatives only), RL with Shepard values (000 eq 70);
+# the assembler does so since issue 4's second session. Before, all three used Shepard
+# values: then SPH and JB converged slowly on the hole (energy 0.76 and 0.47; SPH's error
+# falls 141 %, 108 %, 82 %, 65 %, 51 %, 41 % over 118 .. 3149 nodes) and JB's L2 error
+# fell at rate 2.5 on the beam. The kernel sums are not a partition of unity next to the
+# boundary, so the tractions' resultant is wrong by O(1) at every resolution: that, with
+# the derivatives' own O(1) boundary deficiency, is what 000 Table III's NC shows.
 #
 # Why CD1 and CD2 fall short on the beam (measured; the paper's setup otherwise: regular
 # nodes, s = sqrt(2) dx, cubic spline, Shepard test functions, nodal quadrature, the FE
@@ -70,7 +79,8 @@
 # error rises at the last level), MLS 0.24 / 0.38 (energy stalls near 4 %): the hole's
 # cut-grid cloud, not the layer, limits the nodal-quadrature schemes there.
 #
-# SPH on the hole (000 Table III: NC). Ours converges slowly because the cloud is a
+# SPH on the hole with Shepard load values (before the change above; kept for the
+# record). It converged slowly because the cloud is a
 # regular grid cut by the hole: the symmetrised SPH strain is exact up to the lattice
 # sum sum_I dW/dx (x_I - x_J) dV_I = 1.016 (s = sqrt(2) dx, cubic spline: a 1.6 %
 # stiffness error in the interior that does not vanish), and the large error comes from
@@ -88,9 +98,12 @@
 # 0.84 / 1.45, CD1 0.91 / 2.03, CD2 0.54 / 1.88, MLS 0.44 / 1.53, EFG 0.95 / 1.69); only
 # JB's and RL's nodal l2 errors grow at the last level. On any smoothly refined cloud
 # with s proportional to the spacing the cloud becomes locally regular, so symmetrised
-# SPH converges towards the lattice error before it stalls; we found no faithful setting
-# in which SPH alone shows NC at these levels. The default grid stays (EFG's hole L2
-# rate is 2.96 there, 1.69 on the graded cloud), with the SPH check below.
+# SPH with Shepard loads converges towards the lattice error before it stalls: the node
+# arrangement does not explain the paper's NC. The load values do: with SPH's kernel
+# estimate (now the default) SPH and JB stall near 45-55 % on the cut grid, on the graded
+# cloud (SPH 47 %, 44 %, 44 %, 45 %; JB 59 %, 57 %, 55 %, 54 %) and on the beam, while RL
+# (Shepard values) is unchanged. The default grid stays (EFG's hole L2 rate is 2.96
+# there, 1.69 on the graded cloud).
 #
 cmake_minimum_required(VERSION 3.19)
 
@@ -155,11 +168,11 @@ function(errors out p s key)
   set(${out} "${list}" PARENT_SCOPE)
 endfunction()
 
-# no_convergence(<problem> <scheme>): 000 Table III "NC" read as "the energy rate is
-# below 0.3 or the energy error grows at some refinement".
-function(no_convergence p s)
-  get(rate ${p} ${s} energy_rate)
-  errors(e ${p} ${s} energy)
+# no_convergence(<problem> <scheme> <energy|L2>): 000 Table III "NC" read as "the rate
+# is below 0.3 or the error grows at some refinement".
+function(no_convergence p s key)
+  get(rate ${p} ${s} ${key}_rate)
+  errors(e ${p} ${s} ${key})
   set(grows OFF)
   list(LENGTH e n)
   math(EXPR last "${n} - 2")
@@ -171,10 +184,10 @@ function(no_convergence p s)
       set(grows ON)
     endif()
   endforeach()
-  message(STATUS "${p} ${s}: energy rate ${rate}, energy errors ${e} (error grows: ${grows}; "
+  message(STATUS "${p} ${s}: ${key} rate ${rate}, ${key} errors ${e} (error grows: ${grows}; "
                  "000 Table III: NC)")
   if(NOT rate LESS 0.3 AND NOT grows)
-    message(SEND_ERROR "${p} ${s} converges (energy rate ${rate}, errors ${e}); 000 Table III: NC")
+    message(SEND_ERROR "${p} ${s} converges (${key} rate ${rate}, errors ${e}); 000 Table III: NC")
   endif()
 endfunction()
 
@@ -265,13 +278,12 @@ function(smallest_at_finest p s key source)
 endfunction()
 
 if(PROBLEM STREQUAL "beam")
-  # 000 Table III, beam: SPH and JB "NC". JB is the paper's (its shear strain keeps the
-  # symmetrised SPH derivatives, 000 eqs 48-52; correcting the shear too would make it
-  # converge on this regular grid: energy 1.2, L2 1.8). JB's L2 error does fall (rate
-  # 2.5): on a regular grid its normal strains are exact; the paper's NC is read on the
-  # energy norm, its Fig. 5.
-  no_convergence(beam SPH)
-  no_convergence(beam JB)
+  # 000 Table III, beam: SPH and JB "NC" (energy and L2). JB is the paper's (its shear
+  # strain keeps the symmetrised SPH derivatives, 000 eqs 48-52).
+  foreach(key energy L2)
+    no_convergence(beam SPH ${key})
+    no_convergence(beam JB ${key})
+  endforeach()
   # 000 Sect. 6.2.3: "JB did improve the SPH accuracy in the energy norm slightly".
   below_at_every_level(beam JB SPH energy "000 Sect. 6.2.3")
   # 000 Table III, MLS 1.50 / 1.82.
@@ -299,41 +311,14 @@ if(PROBLEM STREQUAL "beam")
   get(rl_l beam RL L2_rate)
   message(STATUS "beam RL (not asserted): energy rate ${rl_e}, L2 rate ${rl_l}; 000 Table III 0.98 / 0.41")
 elseif(PROBLEM STREQUAL "hole")
-  # 000 Table III, hole: SPH and JB "NC". On this quasi-uniform cloud (a regular grid cut
-  # by the hole) their energy errors fall, slowly: SPH 0.76 (from 140 %), JB 0.47 (like
-  # RL's 0.65), and so they do with every boundary treatment tried (direct 0.67/0.59,
-  # penalty 0.79/0.88, Lagrange 0.76/0.56). On a jittered cloud all
-  # nodal-quadrature schemes stop converging, so that does not single them out either.
-  # What holds: SPH has no useful accuracy (energy error above 50 % at every level), JB
-  # improves on SPH (000 Sect. 6.2.3), and JB's error at the nodes (000 eq 114, the norm
-  # the spec note infers for the hole rows of Table III from the paper's Fig. 10
-  # discussion) does not converge: it grows from the first to the second level (9.6e-2,
-  # 2.2e-1, 1.4e-1, 9.8e-2; rate 0.11).
-  errors(sph hole SPH energy)
-  message(STATUS "hole SPH energy errors ${sph} (000 Table III: NC; asserted: all >= 0.5)")
-  foreach(e IN LISTS sph)
-    if(e LESS 0.5)
-      fail("hole SPH energy error ${e} < 0.5")
-    endif()
+  # 000 Table III, hole: SPH and JB "NC" (energy and L2): their errors grow or stall
+  # near 50 % (SPH 40 %, 43 %, 45 %, 47 %; JB 53 %, 52 %, 52 %, 51 %). 000 Sect. 6.2.3's
+  # "JB did improve the SPH accuracy in the energy norm slightly" does not hold here (JB's
+  # energy error is above SPH's at every level); it is checked on the beam.
+  foreach(key energy L2)
+    no_convergence(hole SPH ${key})
+    no_convergence(hole JB ${key})
   endforeach()
-  below_at_every_level(hole JB SPH energy "000 Sect. 6.2.3")
-  get(jb_l2 hole JB l2_rate)
-  errors(jb hole JB l2)
-  set(grows OFF)
-  list(LENGTH jb nj)
-  math(EXPR last "${nj} - 2")
-  foreach(k RANGE ${last})
-    math(EXPR k1 "${k} + 1")
-    list(GET jb ${k} a)
-    list(GET jb ${k1} b)
-    if(b GREATER a)
-      set(grows ON)
-    endif()
-  endforeach()
-  message(STATUS "hole JB nodal l2 errors ${jb}, rate ${jb_l2} (000 Table III: NC; asserted: grows or rate < 0.3)")
-  if(NOT grows AND NOT jb_l2 LESS 0.3)
-    fail("hole JB: the nodal l2 error converges (rate ${jb_l2}, errors ${jb}); 000 Table III: NC")
-  endif()
   # 000 Table III, hole: CD1 0.54 / 1.10, CD2 0.49 / 1.30, MLS 0.65 / 1.22.
   foreach(s CD1 CD2 MLS)
     at_least(hole ${s} energy_rate 0.3 "000 Table III hole ${s}")
