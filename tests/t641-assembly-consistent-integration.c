@@ -7,7 +7,9 @@
  * and 2 trial, Shepard test), also with the finite-element layer of 000 Sect. 5.6 (whose
  * strip nodal quadrature samples only at its two edges). Without the correction the same
  * residual is O(1) relative (nodal quadrature fails the patch test); switching the
- * correction off again (npts = 0) restores that matrix exactly. Bad input: NULL arrays,
+ * correction off again (npts = 0) restores that matrix exactly. The second-order part:
+ * a quadratic field with its body force under Bubnov MLS of order 2; and the Laplace
+ * form (flux on the boundary). Bad input: NULL arrays,
  * negative or NaN weights, non-unit normals, methods without test values, mass and
  * collocation forms. Library only. */
 #include <math.h>
@@ -254,6 +256,52 @@ static void test_quadratic_identity(void **s) {
   assert_true(r1 < 1e-9);
 }
 
+/* Laplace: u = 1 + 2 x - 3 y with the flux c grad u . n on the whole boundary. */
+static const double CL = 2.5;
+static void flux(void *user, const double *x, double *t) {
+  const double *n = user;
+  (void)x;
+  t[0] = CL * (2.0 * n[0] - 3.0 * n[1]);
+}
+static void test_laplace_identity(void **s) {
+  (void)s;
+  for (int vci = 0; vci < 2; ++vci) {
+    mfree_particles_t *ps = cloud();
+    mfree_approximant_t *tr = NULL, *te = NULL;
+    assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_KB_METHOD1, &tr));
+    assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_SHEPARD, &te));
+    mfree_assembler_t *as = NULL;
+    assert_ok(ctx, mfree_assembler_create(ctx, tr, te, MFREE_FORM_LAPLACE, &as));
+    assert_ok(ctx, mfree_assembler_set_coefficient(as, CL));
+    assert_ok(ctx, mfree_assembler_set_quadrature_nodal(as));
+    boundary();
+    for (int e = 0; e < 4; ++e)
+      assert_ok(ctx, mfree_assembler_add_traction(as, first[e + 1] - first[e], BX + 2 * first[e], MFREE_LAYOUT_AOS,
+                                                  2, BW + first[e], flux, BN + 2 * first[e]));
+    if (vci) assert_ok(ctx, mfree_assembler_set_consistent_integration(as, NBP, BX, MFREE_LAYOUT_AOS, 2, BW, BN));
+    assert_ok(ctx, mfree_assembler_setup(as));
+    mfree_matrix_t *K = NULL;
+    assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+    double f[N], u[N], Ku[N], rmax = 0.0, fmax_ = 0.0;
+    assert_ok(ctx, mfree_assembler_assemble_rhs(as, f));
+    for (int p = 0; p < N; ++p) u[p] = 1.0 + 2.0 * X[2 * p] - 3.0 * X[2 * p + 1];
+    assert_ok(ctx, mfree_matrix_apply(K, u, Ku));
+    for (int i = 0; i < N; ++i) {
+      rmax = fmax(rmax, fabs(Ku[i] - f[i]));
+      fmax_ = fmax(fmax_, fabs(f[i]));
+    }
+    print_message("Laplace, KB Method 1 / Shepard: |K u - f| / |f| = %.3e %s\n", rmax / fmax_,
+                  vci ? "with VCI" : "plain");
+    if (vci) assert_true(rmax / fmax_ < 1e-10);
+    else assert_true(rmax / fmax_ > 1e-3);
+    mfree_matrix_destroy(&K);
+    mfree_assembler_destroy(&as);
+    mfree_approximant_destroy(&tr);
+    mfree_approximant_destroy(&te);
+    mfree_particles_destroy(&ps);
+  }
+}
+
 static void test_bad_input(void **s) {
   (void)s;
   mfree_particles_t *ps = cloud();
@@ -313,6 +361,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_patch_identity),
       cmocka_unit_test(test_quadratic_identity),
+      cmocka_unit_test(test_laplace_identity),
       cmocka_unit_test(test_bad_input),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
