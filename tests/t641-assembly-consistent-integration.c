@@ -302,6 +302,55 @@ static void test_laplace_identity(void **s) {
   }
 }
 
+/* Particles moved (interior ones, same neighbours): mfree_assembler_update recomputes
+ * the corrections, so the identity holds on the moved cloud with the same pattern. */
+static void test_update(void **s) {
+  (void)s;
+  mfree_particles_t *ps = cloud();
+  assert_ok(ctx, mfree_particles_set_positions(ps, X, MFREE_LAYOUT_AOS, 2, MFREE_BORROW));
+  assert_ok(ctx, mfree_particles_setup(ps));
+  mfree_approximant_t *tr = NULL, *te = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_KB_METHOD2, &tr));
+  assert_ok(ctx, mfree_approximant_set_order(tr, 1));
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_SHEPARD, &te));
+  mfree_assembler_t *as = NULL;
+  assert_ok(ctx, mfree_assembler_create(ctx, tr, te, MFREE_FORM_ELASTICITY_PLANE_STRESS, &as));
+  assert_ok(ctx, mfree_assembler_set_material(as, E, NU));
+  assert_ok(ctx, mfree_assembler_set_quadrature_nodal(as));
+  boundary();
+  for (int e = 0; e < 4; ++e)
+    assert_ok(ctx, mfree_assembler_add_traction(as, first[e + 1] - first[e], BX + 2 * first[e], MFREE_LAYOUT_AOS, 2,
+                                                BW + first[e], traction, BN + 2 * first[e]));
+  assert_ok(ctx, mfree_assembler_set_consistent_integration(as, NBP, BX, MFREE_LAYOUT_AOS, 2, BW, BN));
+  assert_ok(ctx, mfree_assembler_setup(as));
+  mfree_matrix_t *K = NULL;
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  int64_t id0 = -1, id1 = -2;
+  assert_ok(ctx, mfree_matrix_get_pattern_id(K, &id0));
+  for (int i = 1; i < NX - 1; ++i)
+    for (int j = 1; j < NY - 1; ++j) X[2 * (i * NY + j)] += 0.01 * DX * sin(3.0 * i + j);
+  assert_ok(ctx, mfree_particles_update(ps));
+  assert_ok(ctx, mfree_assembler_update(as));
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  assert_ok(ctx, mfree_matrix_get_pattern_id(K, &id1));
+  assert_true(id1 == id0);
+  double f[2 * N], u[2 * N], Ku[2 * N], rmax = 0.0, fmax_ = 0.0;
+  assert_ok(ctx, mfree_assembler_assemble_rhs(as, f));
+  for (int p = 0; p < N; ++p) exact_u(NULL, X + 2 * p, u + 2 * p);
+  assert_ok(ctx, mfree_matrix_apply(K, u, Ku));
+  for (int i = 0; i < 2 * N; ++i) {
+    rmax = fmax(rmax, fabs(Ku[i] - f[i]));
+    fmax_ = fmax(fmax_, fabs(f[i]));
+  }
+  print_message("after update: |K u - f| / |f| = %.3e\n", rmax / fmax_);
+  assert_true(rmax / fmax_ < 1e-10);
+  mfree_matrix_destroy(&K);
+  mfree_assembler_destroy(&as);
+  mfree_approximant_destroy(&tr);
+  mfree_approximant_destroy(&te);
+  mfree_particles_destroy(&ps);
+}
+
 static void test_bad_input(void **s) {
   (void)s;
   mfree_particles_t *ps = cloud();
@@ -362,6 +411,7 @@ int main(void) {
       cmocka_unit_test(test_patch_identity),
       cmocka_unit_test(test_quadratic_identity),
       cmocka_unit_test(test_laplace_identity),
+      cmocka_unit_test(test_update),
       cmocka_unit_test(test_bad_input),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
