@@ -75,15 +75,31 @@ template <int D, int K>
 constexpr Tab<D, K> make_tab() {
   Tab<D, K> t{};
   int m = 0;
-  for (int deg = 0; deg <= 2 * K + 1; ++deg)
+  // degrees 0..2 in the order of Basis (1; s_i; s_i^2; s1 s2, s2 s3, s3 s1), so that the
+  // moment matrices are those of the general path entry for entry (pivoting and the
+  // condition estimate depend on the order); higher degrees in any order
+  auto push = [&](int a, int b, int c) {
+    t.e[m][0] = a;
+    t.e[m][1] = b;
+    t.e[m][2] = c;
+    ++m;
+  };
+  push(0, 0, 0);
+  for (int i = 0; i < D; ++i) push(i == 0, i == 1, i == 2);
+  if (K >= 1) {  // degree 2 is needed from order 1 on (2K + 1 >= 3)
+    for (int i = 0; i < D; ++i) push(2 * (i == 0), 2 * (i == 1), 2 * (i == 2));
+    if (D >= 2) push(1, 1, 0);
+    if (D >= 3) {
+      push(0, 1, 1);
+      push(1, 0, 1);
+    }
+  }
+  for (int deg = 3; deg <= 2 * K + 1; ++deg)
     for (int a = deg; a >= 0; --a)
       for (int b = deg - a; b >= 0; --b) {
         const int c = deg - a - b;
         if ((D < 2 && b) || (D < 3 && c)) continue;
-        t.e[m][0] = a;
-        t.e[m][1] = b;
-        t.e[m][2] = c;
-        ++m;
+        push(a, b, c);
       }
   for (int q = 1; q < Tab<D, K>::NM; ++q) {
     int v = 0;
@@ -116,40 +132,150 @@ inline void monomials(const double *s, double *mo) {
 }
 
 // ---------------------------------------------------------------------------------------
-// Small dense inverses with the exact 1-norm condition number ||A||_1 ||A^-1||_1 (the
-// quantity Eigen's rcond() estimates from below in the general path).
+// Small dense inverses, with the general path's singularity test and condition number
+// (local.cpp check_rcond): rc = min(Eigen's rcond() estimate, ratio of the smallest to
+// the largest pivot of the same pivoted factorisation), singular below kMinRcond,
+// reported as 1 / rc. Both are reproduced here on the explicit inverse, so that the
+// two paths report the same condition numbers and decide alike (up to round-off).
 
 template <int L>
 double norm1(const double (&A)[L][L]) {
   double big = 0.0;
-  MFREE_UNROLL
   for (int b = 0; b < L; ++b) {
     double s = 0.0;
-    MFREE_UNROLL
     for (int a = 0; a < L; ++a) s += std::fabs(A[a][b]);
     big = std::max(big, s);
   }
   return big;
 }
 
-template <int L>
-bool accept(const double (&A)[L][L], const double (&X)[L][L], double &cond) {
-  const double c = norm1(A) * norm1(X);
-  if (!std::isfinite(c) || !(c > 0.0)) return false;
-  cond = c;
-  return 1.0 / c >= kMinRcond;
+// out = X b (T: X^T b)
+template <int L, bool T>
+void mul(const double (&X)[L][L], const double *b, double *out) {
+  MFREE_UNROLL
+  for (int a = 0; a < L; ++a) {
+    double t = 0.0;
+    MFREE_UNROLL
+    for (int c = 0; c < L; ++c) t += (T ? X[c][a] : X[a][c]) * b[c];
+    out[a] = t;
+  }
 }
 
-// Symmetric positive definite A (moment matrices of non-negative weights): LDL^T
-// without pivoting, X = L^-T D^-1 L^-1. False when a pivot is not positive or the
-// system is ill-conditioned.
+template <int L>
+double sum_abs(const double *v) {
+  double t = 0.0;
+  MFREE_UNROLL
+  for (int a = 0; a < L; ++a) t += std::fabs(v[a]);
+  return t;
+}
+
+// Eigen's rcond_invmatrix_L1_norm_estimate (Hager / Higham), step for step, with the
+// solves done by the inverse X.
+template <int L>
+double inverse_norm_estimate(const double (&X)[L][L]) {
+  double v[L], w[L], sign[L], old_sign[L];
+  for (int a = 0; a < L; ++a) w[a] = 1.0 / L;
+  mul<L, false>(X, w, v);
+  double lower = sum_abs<L>(v);
+  if (L == 1) return lower;
+  double old_lower = lower;
+  int idx = -1, old_idx = -1;
+  for (int k = 0; k < 4; ++k) {
+    bool same = k > 0;
+    MFREE_UNROLL
+    for (int a = 0; a < L; ++a) {
+      sign[a] = v[a] < 0.0 ? -1.0 : 1.0;
+      same = same && sign[a] == old_sign[a];
+    }
+    if (same) break;
+    mul<L, true>(X, sign, v);
+    idx = 0;
+    double vmax = std::fabs(v[0]);
+    MFREE_UNROLL
+    for (int a = 1; a < L; ++a) {  // first largest, without branches
+      const double va = std::fabs(v[a]);
+      idx = va > vmax ? a : idx;
+      vmax = va > vmax ? va : vmax;
+    }
+    if (idx == old_idx) break;
+    for (int a = 0; a < L; ++a) v[a] = X[a][idx];
+    lower = sum_abs<L>(v);
+    if (lower <= old_lower) break;
+    for (int a = 0; a < L; ++a) old_sign[a] = sign[a];
+    old_idx = idx;
+    old_lower = lower;
+  }
+  double alt = 1.0;
+  for (int a = 0; a < L; ++a) {
+    w[a] = alt * (1.0 + static_cast<double>(a) / static_cast<double>(L - 1));
+    alt = -alt;
+  }
+  mul<L, false>(X, w, v);
+  return std::max(lower, 2.0 * sum_abs<L>(v) / (3.0 * L));
+}
+
+// matrix_norm = ||A||_1, piv = the factorisation's pivots.
+template <int L>
+bool accept(double matrix_norm, const double (&X)[L][L], const double *piv, double &cond) {
+  double rc;
+  if (matrix_norm == 0.0) {
+    rc = 0.0;
+  } else if (L == 1) {
+    rc = 1.0;
+  } else {
+    const double inv = inverse_norm_estimate<L>(X);
+    rc = inv == 0.0 ? 0.0 : (1.0 / inv) / matrix_norm;
+  }
+  if (!std::isfinite(rc)) rc = 0.0;
+  double big = 0.0, small = INFINITY;
+  for (int k = 0; k < L; ++k) {
+    big = std::max(big, std::fabs(piv[k]));
+    small = std::min(small, std::fabs(piv[k]));
+  }
+  rc = std::min(rc, big > 0.0 ? small / big : 0.0);
+  cond = rc > 0.0 ? 1.0 / rc : INFINITY;
+  return rc >= kMinRcond;
+}
+
+// Symmetric positive definite A (moment matrices of non-negative weights): LDL^T with
+// Eigen's diagonal pivoting (largest remaining original diagonal first), X = A^-1.
+// False when a pivot is not positive (the general path then decides) or the test fails.
 template <int L>
 bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
+  int p[L];
+  double dg[L];
+  MFREE_UNROLL
+  for (int k = 0; k < L; ++k) {
+    p[k] = k;
+    dg[k] = std::fabs(A[k][k]);
+  }
+  MFREE_UNROLL
+  for (int k = 0; k < L; ++k) {
+    int big = k;
+    double dmax = dg[k];
+    MFREE_UNROLL
+    for (int j = 0; j < L; ++j) {  // first largest of the rest, without branches
+      if (j <= k) continue;
+      big = dg[j] > dmax ? j : big;
+      dmax = dg[j] > dmax ? dg[j] : dmax;
+    }
+    const int pk = p[k];
+    p[k] = p[big];
+    p[big] = pk;
+    dg[big] = dg[k];
+    dg[k] = dmax;
+  }
+  double B[L][L];
+  MFREE_UNROLL
+  for (int a = 0; a < L; ++a) {
+    MFREE_UNROLL
+    for (int b = 0; b < L; ++b) B[a][b] = A[p[a]][p[b]];
+  }
   // fixed loop bounds with guards: fully unrolled, the guards fold away
   double Lw[L][L] = {}, Dg[L] = {}, iD[L] = {};
   MFREE_UNROLL
   for (int k = 0; k < L; ++k) {
-    double dk = A[k][k];
+    double dk = B[k][k];
     MFREE_UNROLL
     for (int m = 0; m < L; ++m)
       if (m < k) dk -= Lw[k][m] * Lw[k][m] * Dg[m];
@@ -159,7 +285,7 @@ bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
     MFREE_UNROLL
     for (int i = 0; i < L; ++i) {
       if (i <= k) continue;
-      double v = A[i][k];
+      double v = B[i][k];
       MFREE_UNROLL
       for (int m = 0; m < L; ++m)
         if (m < k) v -= Lw[i][m] * Lw[k][m] * Dg[m];
@@ -189,54 +315,49 @@ bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
       MFREE_UNROLL
       for (int k = 0; k < L; ++k)
         if (k >= b) v += Y[k][a] * Y[k][b] * iD[k];
-      X[a][b] = X[b][a] = v;
+      X[p[a]][p[b]] = X[p[b]][p[a]] = v;
     }
   }
-  return accept(A, X, cond);
+  return accept<L>(norm1(A), X, Dg, cond);
 }
 
-// General A (the corrected-derivative systems): Gauss-Jordan with partial pivoting.
+// General A (the corrected-derivative systems): Gauss-Jordan with partial pivoting (the
+// pivots of Eigen's PartialPivLU).
 template <int L>
 bool gen_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
-  double W[L][L];
-  MFREE_UNROLL
+  double W[L][L], piv[L];
   for (int a = 0; a < L; ++a)
     for (int b = 0; b < L; ++b) {
       W[a][b] = A[a][b];
       X[a][b] = a == b ? 1.0 : 0.0;
     }
-  MFREE_UNROLL
   for (int k = 0; k < L; ++k) {
     int p = k;
-    MFREE_UNROLL
     for (int i = k + 1; i < L; ++i)
       if (std::fabs(W[i][k]) > std::fabs(W[p][k])) p = i;
     if (!(std::fabs(W[p][k]) > 0.0)) return false;
     if (p != k)
-      MFREE_UNROLL
       for (int b = 0; b < L; ++b) {
         std::swap(W[p][b], W[k][b]);
         std::swap(X[p][b], X[k][b]);
       }
+    piv[k] = W[k][k];
     const double ip = 1.0 / W[k][k];
-    MFREE_UNROLL
     for (int b = 0; b < L; ++b) {
       W[k][b] *= ip;
       X[k][b] *= ip;
     }
-    MFREE_UNROLL
     for (int i = 0; i < L; ++i) {
       if (i == k) continue;
       const double f = W[i][k];
       if (f == 0.0) continue;
-      MFREE_UNROLL
       for (int b = 0; b < L; ++b) {
         W[i][b] -= f * W[k][b];
         X[i][b] -= f * X[k][b];
       }
     }
   }
-  return accept(A, X, cond);
+  return accept<L>(norm1(A), X, piv, cond);
 }
 
 // ---------------------------------------------------------------------------------------
