@@ -1,8 +1,9 @@
 // Specialised per-site shape functions for the common value + gradient tables (issue 8):
 // one template per (dimension, kernel shape, method family, basis order), SoA neighbour
 // data gathered once per site, the kernel shape inlined for the cubic spline, moments
-// accumulated as sums of monomials in one neighbour pass, fixed-size factorisations with
-// an exact 1-norm condition number. Everything it does not cover (Hessians, MSPH, KB
+// accumulated as sums of monomials in one neighbour pass, fixed-size factorisations that
+// repeat the general path's pivoting and condition estimate (so statuses and reported
+// condition numbers agree to round-off; test t432). Everything it does not cover (Hessians, MSPH, KB
 // Methods 2 and 3, order 3, sign-changing kernels) stays on the general path of
 // local.cpp, and a site it cannot finish (any non-zero status) is recomputed there from
 // scratch, so that statuses, fallbacks and failure rows are those of the general path.
@@ -20,8 +21,9 @@ struct FastTables {
   const int64_t *rowptr = nullptr;
   const int32_t *cols = nullptr;
   const int32_t *self = nullptr;  // position of the site in its row, -1 at host points
-  // particles: coordinate c of particle j at x[c][j * stride], volume (1 when the set
-  // has none) vol[j * stride], support h[j * stride]
+  // particles, one record of `stride` doubles each: coordinate c of particle j at
+  // x[c][j * stride] with x[c] == x[0] + c, volume (1 when the set has none)
+  // vol[j * stride], support h[j * stride]
   const double *x[3] = {nullptr, nullptr, nullptr};
   const double *vol = nullptr;
   const double *h = nullptr;
@@ -59,7 +61,8 @@ class FastPath {
 
   // Rows of site s (written only on success). Returns 0, or a positive status when the
   // site must be recomputed by the general path. support: neighbours with non-zero
-  // weight; cond: exact 1-norm condition number of the local system (1 when none).
+  // weight; cond: condition estimate of the local system as the general path reports
+  // it (1 when none).
   int site(const FastTables &t, int32_t s, FastScratch &w, int &support, double &cond) const {
     return fn_(*this, t, s, w, support, cond);
   }
