@@ -1,6 +1,7 @@
 /* One full step of the Galerkin-SPH dam break of paper 003 through the public system API
- * (mfree_system_integrate, leap-frog, CFL 0.25): neighbour search, MLS shape functions
- * rebuilt every step, forces, wall forces, kinematics, update. The column is nx x 2nx
+ * (mfree_system_integrate, leap-frog, CFL 0.25): state checks, MLS shape functions
+ * rebuilt every step at all particles (on Verlet candidate lists, which the first steps
+ * from rest do not need to rebuild), forces, wall forces, kinematics, update. The column is nx x 2nx
  * particles (default nx = 112: 25,088 particles, close to PySPH's 25,153-particle WCSPH
  * dam break, 21 ms per step on this machine class = 1.2 million particle-steps/s; the
  * issue-8 target is 2x that per core). Usage: bench_dambreak [nx] [steps] [threads]: without
