@@ -574,7 +574,11 @@ MFREE_API mfree_status_t mfree_mesh_get_size(const mfree_mesh_t *mesh, int32_t *
  * Gauss quadrature over the mesh, e.g. for mfree_assembler_set_quadrature_points:
  * ngauss points per direction and element (LINE2 ngauss, QUAD4 ngauss^2, HEX8 ngauss^3
  * through the isoparametric map; TRI3 a collapsed ngauss^2 rule), in element order.
- * Call with x = w = NULL to get the count first.
+ * Call with x = w = NULL to get the count first. MPFEM integrands are not polynomials,
+ * and where the kernel support's edges cross the elements (TRI3 with a square support)
+ * they have kinks inside them: the relative quadrature error then does not shrink under
+ * refinement, so take more points there (test t475: TRI3 Poisson L2 rate 1.44 with 3,
+ * 2.00 with 5 points per direction, n = 32 -> 64).
  * @param[in]  ngauss  1..10
  * @param[out] npts    number of points
  * @param[out] x       dim coordinates per point (AoS), or NULL
@@ -1041,6 +1045,21 @@ MFREE_API mfree_status_t mfree_system_set_dummy_particles(mfree_system_t *sys, i
  */
 MFREE_API mfree_status_t mfree_system_set_density_diffusion(mfree_system_t *sys,
                                                             double delta);
+/**
+ * Variationally consistent nodal integration of the fluid's momentum equation (not in
+ * paper 003; Chen, Hillman & Rueter 2013, constant correction): the test-function
+ * gradients at the quadrature points become grad N_i(x_k) + xi_i N_i(x_k) with xi_i such
+ * that sum_k V_k grad N~_i(x_k) = 0 for every node whose support lies in the fluid (with
+ * the dummy particles; nodes near a free surface, kernel volume sum below 0.95, are
+ * blended out, below 0.85 uncorrected). A uniform pressure then exerts no force on a
+ * disordered particle set; without the correction it does, and that force destabilises
+ * the particle positions at a rate growing as sqrt(p) (a still column goes unstable
+ * after ~0.5 s, t702). Linear and angular momentum are then no longer conserved to
+ * round-off.
+ * @param[in] on  0 (default, the paper's nodal integration) or 1; else MFREE_ERR_ARG
+ */
+MFREE_API mfree_status_t mfree_system_set_consistent_integration(mfree_system_t *sys,
+                                                                 int32_t on);
 
 /** Length of the state vector. */
 MFREE_API mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq);

@@ -371,6 +371,53 @@ static void test_density_diffusion(void **s) {
   free(y);
 }
 
+/* Consistent nodal integration (mfree_system_set_consistent_integration): fluid at rest
+ * under a uniform pressure (rho = 1.01 rho0 everywhere, no gravity) on a jittered lattice
+ * (+-0.2 d) closed by four layers of dummy particles on all sides. Every node's support
+ * then lies in fluid and dummies, so with the correction no particle feels a force (to
+ * round-off against p / (rho0 d)); without it the integration-constraint error of nodal
+ * integration pushes the particles by a sizeable fraction of p / (rho0 d), the force that
+ * destabilises the positions of a still column (t702 test 3). */
+static void test_consistent_integration(void **s) {
+  (void)s;
+  enum { L = 4, CAP = (NX + 2 * L) * (NZ + 2 * L) };
+  double m[N];
+  double *y = patch(m, 1, 1);
+  for (int p = 0; p < 2 * N; ++p) y[2 * N + p] = 0.0;
+  for (int p = 0; p < N; ++p) y[4 * N + p] = 1.01 * RHO0;
+  double *dx = malloc(2 * sizeof(double) * CAP);
+  int nd = 0;
+  for (int j = -L; j < NZ + L; ++j)
+    for (int i = -L; i < NX + L; ++i) {
+      if (j >= 0 && j < NZ && i >= 0 && i < NX) continue;
+      dx[2 * nd] = (i + 0.5) * D;
+      dx[2 * nd + 1] = (j + 0.5) * D;
+      ++nd;
+    }
+  const double vol = D * D, kap = kappa_of(NZ * D);
+  const double scale = kap * (pow(1.01, GAMMA) - 1.0) / (RHO0 * D); /* p / (rho0 d) */
+  double *yd = calloc(5 * (size_t)N, sizeof(double));
+  double amax[2] = {0, 0};
+  for (int on = 0; on < 2; ++on) {
+    mfree_system_t *sys = fluid(m, NZ * D, 0.5, 0);
+    assert_ok(ctx, mfree_system_set_dummy_particles(sys, nd, dx, &vol, 0));
+    assert_ok(ctx, mfree_system_set_consistent_integration(sys, on));
+    assert_ok(ctx, mfree_system_rhs(sys, 0.0, y, yd));
+    for (int p = 0; p < 2 * N; ++p) amax[on] = fmax(amax[on], fabs(yd[2 * N + p]));
+    if (on) {
+      assert_error(ctx, mfree_system_set_consistent_integration(sys, 2), MFREE_ERR_ARG, "consistent");
+    }
+    mfree_system_destroy(&sys);
+  }
+  if (amax[1] > 1e-10 * scale) fail_msg("with the correction: |a| up to %g (scale %g)", amax[1], scale);
+  if (amax[0] < 1e-3 * scale) fail_msg("without the correction: |a| only %g (scale %g)", amax[0], scale);
+  print_message("uniform pressure, jittered lattice: |a| %.3g without, %.3g with consistent integration "
+                "(p / (rho0 d) = %.3g)\n", amax[0], amax[1], scale);
+  free(yd);
+  free(dx);
+  free(y);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_conservation),
@@ -379,6 +426,7 @@ int main(void) {
       cmocka_unit_test(test_shepard_condition),
       cmocka_unit_test(test_dummy_walls),
       cmocka_unit_test(test_density_diffusion),
+      cmocka_unit_test(test_consistent_integration),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

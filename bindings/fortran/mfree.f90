@@ -1095,6 +1095,13 @@ module mfree
       real(c_double), value :: delta
     end function mfree_system_set_density_diffusion_c
 
+    integer(c_int) function mfree_system_set_consistent_integration_c(sys, on) &
+        bind(C, name="mfree_system_set_consistent_integration")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: on
+    end function mfree_system_set_consistent_integration_c
+
     integer(c_int) function mfree_system_set_box_c(sys, lo, hi) &
         bind(C, name="mfree_system_set_box")
       import :: c_int, c_double, c_ptr
@@ -1265,6 +1272,7 @@ module mfree
   public :: mfree_system_set_gravity_c, mfree_system_set_lumping_c
   public :: mfree_system_set_walls_c, mfree_system_set_box_c, mfree_system_get_size_c
   public :: mfree_system_set_dummy_particles_c, mfree_system_set_density_diffusion_c
+  public :: mfree_system_set_consistent_integration_c
   public :: mfree_system_rhs_c, mfree_system_assemble_mass_c
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
@@ -1344,6 +1352,7 @@ module mfree
   public :: mfree_system_set_masses, mfree_system_set_smoothing, mfree_system_set_gravity
   public :: mfree_system_set_lumping, mfree_system_set_walls, mfree_system_set_box
   public :: mfree_system_set_dummy_particles, mfree_system_set_density_diffusion
+  public :: mfree_system_set_consistent_integration
   public :: mfree_system_get_size, mfree_system_rhs, mfree_system_assemble_mass
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
@@ -2510,6 +2519,13 @@ contains
     real(c_double), intent(in) :: delta
     st = mfree_system_set_density_diffusion_c(sys%ptr, delta)
   end function mfree_system_set_density_diffusion
+
+  !> Consistent nodal integration of the fluid (constant correction): 0 off (default), 1 on.
+  integer(c_int) function mfree_system_set_consistent_integration(sys, on) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: on
+    st = mfree_system_set_consistent_integration_c(sys%ptr, on)
+  end function mfree_system_set_consistent_integration
 
   integer(c_int) function mfree_system_set_box(sys, lo, hi) result(st)
     type(mfree_system), intent(in) :: sys

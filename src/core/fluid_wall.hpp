@@ -29,6 +29,8 @@ struct DummyWall {
   // lumped mass of a fluid node is sum_k N_i(x_k) M_k / share[k], so that the fluid nodes
   // carry the whole fluid mass (the dummies' part of the partition of unity is the wall's).
   std::vector<double> share;
+  std::vector<double> xi;        // consistent-integration corrections of the fluid nodes
+  std::vector<double> blend;     // their completeness blends (see vci_setup)
   std::vector<double> grad_rho;  // MLS density gradients at the nodes (density diffusion)
 };
 

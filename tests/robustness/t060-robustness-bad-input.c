@@ -868,6 +868,9 @@ static void rows_system(void) {
   ROW0(MFREE_ERR_NULL, mfree_system_set_density_diffusion(NULL, 0.1));
   ROW(MFREE_ERR_ARG, mfree_system_set_density_diffusion(F.sys, -0.1));
   ROW(MFREE_ERR_ARG, mfree_system_set_density_diffusion(F.sys, NAN));
+  ROW0(MFREE_ERR_NULL, mfree_system_set_consistent_integration(NULL, 1));
+  ROW(MFREE_ERR_ARG, mfree_system_set_consistent_integration(F.sys, -1));
+  ROW(MFREE_ERR_ARG, mfree_system_set_consistent_integration(F.sys, 2));
   ROW0(MFREE_ERR_NULL, mfree_system_set_box(NULL, lo, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, NULL, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, lo, NULL));
