@@ -184,24 +184,26 @@ static void test_hydrostatic_column(void **s) {
  *    in a tank 0.1 m wide, d = H/20 (400 particles), h = 1.5 d, rho0 = 1000, gamma = 7,
  *    kappa = 100 rho0 (2 g H) / gamma (eq 125), initial densities of eq 65, masses
  *    rho_i d^2, the paper's mu = 0.5, Galerkin lumping, leap-frog at CFL 0.2, no damping.
- *    Walls: dummy particles (mfree_system_set_dummy_particles, Adami, Hu & Adams 2012),
- *    four layers at spacing d past the floor and both side walls up to 1.5 H, instead of
- *    the paper's wall force; density diffusion delta = 0.1 (delta-SPH with the MLS
- *    gradient correction). Checked at t = 0.3 s, when the surface waves that the free
- *    surface's one-sided nodal integration starts have died down (kinetic energy
- *    ~2e-6 M g H, speeds below 1 % of sqrt(g H)): particle pressures (not interpolated)
- *    within 2 % of rho0 g H of rho0 g (H - z) at least 2h from the walls and 3h above the
- *    floor (measured 0.9 %, interpolated 0.35 %), no particle past a wall face (the box
- *    is the tank), Galerkin lumped masses summing to the fluid's mass.
- *    Not solved: the hold is not indefinite. From t ~ 0.45 s on, at d = H/10 and H/20,
- *    with or without gravity or a free surface (a lid of dummies), with the continuity
- *    equation written with the interpolated velocities or in SPH form, with mirrored
- *    (no-slip) dummy velocities, with mu = 5: the floor row develops a growing
- *    undulation (amplitude growth ~17/s) and a particle reaches the dummies by 0.5-1 s.
- *    The wall terms are not energy-consistent (the dummies' extrapolated pressure and
- *    body force do work on the fluid nodes through the MLS functions while the dummies
- *    have no energy of their own); an energy-consistent wall for nodal integration is
- *    left open. */
+ *    Three options that paper 003 does not have: dummy wall particles
+ *    (mfree_system_set_dummy_particles, Adami, Hu & Adams 2012), four layers at spacing d
+ *    past the floor and both side walls up to 1.5 H, instead of the paper's wall force;
+ *    density diffusion delta = 0.1 (delta-SPH with the MLS gradient correction); the
+ *    constant consistent-integration correction. Checked at t = 0.4 s: the surface waves
+ *    that the free surface's one-sided nodal integration starts have died down by ~0.2 s
+ *    (kinetic energy ~1e-6 M g H, speeds below 1 % of sqrt(g H)), then held. Particle
+ *    pressures (not interpolated) within 2 % of rho0 g H of rho0 g (H - z) at least 2h
+ *    from the side walls and 3h above the floor (measured 1.14 %, interpolated 0.67 %), no
+ *    particle past a wall face (the box is the tank), Galerkin lumped masses summing to the
+ *    fluid's mass.
+ *    Not solved: the hold is not indefinite. The paper's nodal integration has a position
+ *    instability under pressure (a jittered closed box at rest under a uniform 1000 Pa
+ *    blows up at ~24/s, at 4000 Pa ~42/s, at 0 Pa nothing moves; walls and gravity do not
+ *    matter): without the consistent-integration correction a floor particle reaches the
+ *    dummies by 0.5-1 s (d = H/10 and H/20, any of: continuity from the interpolated
+ *    velocities or in SPH form, mirrored dummy velocities, mu = 5). The constant
+ *    correction removes the uniform-pressure part; what is left (the pressure gradient's
+ *    part, the uncorrected rows near the free surface) lets the pressure error creep:
+ *    1.8 % at 0.55 s, 2.7 % at 0.65 s, 5 % at 0.95 s; a linear correction was not tried. */
 static double max_pressure_error(const double *y, const double *p, int n, double W, double H, double h, int *checked) {
   double err = 0.0;
   *checked = 0;
@@ -239,12 +241,13 @@ static void test_hydrostatic_column_paper_setting(void **s) {
   assert_ok(ctx, mfree_system_set_gravity(sys, g));
   assert_ok(ctx, mfree_system_set_dummy_particles(sys, nd, dx, &vol, 0));
   assert_ok(ctx, mfree_system_set_density_diffusion(sys, 0.1));
+  assert_ok(ctx, mfree_system_set_consistent_integration(sys, 1));
   const double lo[2] = {0.0, 0.0}, hi[2] = {W, 2 * H}; /* the wall faces: crossing one fails */
   assert_ok(ctx, mfree_system_set_box(sys, lo, hi));
   double t = 0.0;
   int64_t steps = 0;
-  assert_ok(ctx, mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 0.3, 0.2, 0.0, NULL, NULL, &steps));
-  assert_true(t == 0.3 && steps > 2000);
+  assert_ok(ctx, mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 0.4, 0.2, 0.0, NULL, NULL, &steps));
+  assert_true(t == 0.4 && steps > 3000);
 
   mfree_matrix_t *M = NULL;
   assert_ok(ctx, mfree_system_assemble_mass(sys, y, 0, &M));
@@ -276,7 +279,7 @@ static void test_hydrostatic_column_paper_setting(void **s) {
     vmax = fmax(vmax, hypot(vh[2 * q], vh[2 * q + 1]));
     zmin = fmin(zmin, y[2 * q + 1]);
   }
-  print_message("paper setting, dummy walls + delta 0.1: particle pressure within %.2f %% of rho0 g H "
+  print_message("paper setting, dummy walls + delta 0.1 + consistent integration, t = 0.4 s: particle pressure within %.2f %% of rho0 g H "
                 "(interpolated %.2f %%), max speed %.4f m/s, lowest particle %.3f d above the floor, %lld steps\n",
                 100 * err, 100 * errh, vmax, zmin / d, (long long)steps);
   if (err > 0.02) fail_msg("particle pressure off by %.2f %% of rho0 g H", 100 * err);
