@@ -167,8 +167,11 @@ static void test_neighbors(void **state) {
   cloud_t c = make_cloud(2, 48);
   double *h = malloc(sizeof(double) * (size_t)c.n);
   for (int i = 0; i < c.n; ++i) h[i] = 0.9 + 0.6 * c.u[i];
-  const int conv[3] = {MFREE_SEARCH_GATHER, MFREE_SEARCH_SYMMETRIC_MAX, MFREE_SEARCH_SYMMETRIC_MEAN};
-  for (int k = 0; k < 3; ++k) {
+  /* the fourth: gather with one h for all, sorted by transposition like the symmetric
+   * conventions (the first is sorted row by row) */
+  const int conv[4] = {MFREE_SEARCH_GATHER, MFREE_SEARCH_SYMMETRIC_MAX, MFREE_SEARCH_SYMMETRIC_MEAN,
+                       MFREE_SEARCH_GATHER};
+  for (int k = 0; k < 4; ++k) {
     int64_t *rp[2];
     int32_t *cl[2];
     int64_t nnz[2];
@@ -179,7 +182,7 @@ static void test_neighbors(void **state) {
       mfree_particles_t *ps = NULL;
       assert_ok(ctx, mfree_particles_create(ctx, 2, c.n, &ps));
       assert_ok(ctx, mfree_particles_set_positions(ps, c.x, MFREE_LAYOUT_AOS, 2, MFREE_BORROW));
-      assert_ok(ctx, mfree_particles_set_support(ps, h, 1, MFREE_BORROW));
+      assert_ok(ctx, mfree_particles_set_support(ps, h, k == 3 ? 0 : 1, MFREE_BORROW));
       assert_ok(ctx, mfree_particles_set_search(ps, (mfree_search_t)conv[k], 2.0));
       assert_ok(ctx, mfree_particles_setup(ps));
       assert_ok(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz[t]));

@@ -14,6 +14,7 @@
 // The permutation never leaves this file: rows hold host indices, sorted ascending.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include "approximant.hpp"
@@ -218,8 +219,55 @@ void CellGrid::scan(const double *xq, double ri, const Rule &rule, int64_t p0, i
   const double lim2 = ri * ri * (1.0 + kEdgeTol2);
   const double *x0 = sx_[0].data(), *x1 = sx_[1].data(), *x2 = sx_[2].data();
   const int32_t *id = id_.data();
+  int64_t p = p0;
+#if defined(__GNUC__)
+  if (!Periodic && Gather) {
+    // Two candidates per step (GCC/Clang vector extensions: SSE2 on x86-64, NEON on
+    // arm64), the last odd one in lane 0 of a pair too, so that every pair goes through
+    // the same instructions (the symmetric transposition in run_queries needs the test
+    // to give the same answer for (i, j) and (j, i), also under FMA contraction). Lane
+    // arithmetic is that of the scalar loop: ((d0^2 + d1^2) + d2^2) <= lim2.
+    typedef double v2d __attribute__((vector_size(16)));
+    typedef long long v2l __attribute__((vector_size(16)));
+    const v2d q0 = {xq[0], xq[0]}, q1 = {D > 1 ? xq[1] : 0.0, D > 1 ? xq[1] : 0.0},
+              q2 = {D > 2 ? xq[2] : 0.0, D > 2 ? xq[2] : 0.0}, lv = {lim2, lim2};
+    auto test = [&](const v2d &a0, const v2d &a1, const v2d &a2) {
+      const v2d e0 = q0 - a0;
+      v2d d2 = e0 * e0;
+      if (D > 1) {
+        const v2d e1 = q1 - a1;
+        d2 = d2 + e1 * e1;
+      }
+      if (D > 2) {
+        const v2d e2 = q2 - a2;
+        d2 = d2 + e2 * e2;
+      }
+      return static_cast<v2l>(d2 <= lv);  // lanes: -1 hit, 0 miss
+    };
+    for (; p + 2 <= p1; p += 2) {
+      v2d a0, a1 = {0, 0}, a2 = {0, 0};
+      std::memcpy(&a0, x0 + p, sizeof a0);
+      if (D > 1) std::memcpy(&a1, x1 + p, sizeof a1);
+      if (D > 2) std::memcpy(&a2, x2 + p, sizeof a2);
+      const v2l m = test(a0, a1, a2);
+      out[k] = id[p];
+      k -= static_cast<size_t>(m[0]);
+      out[k] = id[p + 1];
+      k -= static_cast<size_t>(m[1]);
+    }
+    if (p < p1) {
+      const v2d a0 = {x0[p], x0[p]}, a1 = {D > 1 ? x1[p] : 0.0, D > 1 ? x1[p] : 0.0},
+                a2 = {D > 2 ? x2[p] : 0.0, D > 2 ? x2[p] : 0.0};
+      const v2l m = test(a0, a1, a2);
+      out[k] = id[p];
+      k -= static_cast<size_t>(m[0]);
+    }
+    cnt = k;
+    return;
+  }
+#endif
   // every candidate is written, the count advances only for a hit (no branch)
-  for (int64_t p = p0; p < p1; ++p) {
+  for (; p < p1; ++p) {
     double d[3] = {xq[0] - x0[p], D > 1 ? xq[1] - x1[p] : 0.0, D > 2 ? xq[2] - x2[p] : 0.0};
     if (Periodic)
       for (int c = 0; c < D; ++c)
@@ -342,6 +390,9 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
   const int nt = num_threads(nq);
   std::vector<std::vector<int32_t>> buf(nt);
   std::vector<int64_t> first(static_cast<size_t>(nq) + 1, 0);  // offsets into the buffers
+  // smallest and largest member of each row, for the threads of the transposition
+  const bool track = symmetric && num_threads(nsites) > 1 && nt > 1;
+  std::vector<int32_t> lo_hi(track ? 2 * static_cast<size_t>(nsites) : 0);
   parallel_blocks(nq, nt, [&](int t, int64_t b, int64_t e) {
     std::vector<int32_t> &cols = buf[t];
     cols.resize(static_cast<size_t>((e - b) * 32 + 64));
@@ -354,7 +405,17 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
       if (r < 0.0) continue;
       const size_t r0 = cnt;
       grid.query(x, r, rule, cols, cnt);
-      if (!symmetric) sort_row(cols.data() + r0, cols.data() + cnt);
+      if (!symmetric) {
+        sort_row(cols.data() + r0, cols.data() + cnt);
+      } else if (track) {
+        int32_t a = nsites, z = -1;
+        for (size_t k = r0; k < cnt; ++k) {
+          a = cols[k] < a ? cols[k] : a;
+          z = cols[k] > z ? cols[k] : z;
+        }
+        lo_hi[2 * static_cast<size_t>(s)] = a;
+        lo_hi[2 * static_cast<size_t>(s) + 1] = z;
+      }
     }
     cols.resize(cnt);
   });
@@ -400,13 +461,16 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
   parallel_blocks(nsites, ntt, [&](int t, int64_t jb, int64_t je) {
     if (jb >= je) return;
     // sources that reach rows [jb, je): by symmetry, the members of those rows
-    int64_t imin = nsites, imax = -1;
-    for (int64_t j = jb; j < je; ++j)
-      for (int64_t k = 0; k < rp[j + 1] - rp[j]; ++k) {
-        const int32_t i = src[j][k];
-        imin = i < imin ? i : imin;
-        imax = i > imax ? i : imax;
-      }
+    int64_t imin = 0, imax = nsites - 1;
+    if (ntt > 1) {
+      imin = nsites;
+      imax = -1;
+      for (int64_t j = jb; j < je; ++j)
+        if (rp[j + 1] > rp[j]) {
+          imin = std::min<int64_t>(imin, lo_hi[2 * j]);
+          imax = std::max<int64_t>(imax, lo_hi[2 * j + 1]);
+        }
+    }
     int32_t *cols = out.cols.data();
     Slot *sl = slot.data();
     const uint64_t span = static_cast<uint64_t>(je - jb);
