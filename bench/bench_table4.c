@@ -2,18 +2,14 @@
  * Belytschko Method 1) over MLS when building shape functions and their derivatives,
  * for domain-size multipliers d_m = 1.5, 2.5, 3.5 (support radius d_m * dx; cubic
  * spline, so h = d_m dx / 2). The paper reports 3.06, 3.12 and 2.43. Prints particles
- * per second for both and the ratio. Usage: bench_table4 [particles-per-side, 300]. */
-#include <stdio.h>
-#include <stdlib.h>
-#include <time.h>
+ * per second for both and the ratio (one thread; best of 3 setups, each pattern +
+ * tables). Usage: bench_table4 [particles-per-side, 300]. */
+#include "bench_util.h"
 
 #include <mfree.h>
 
-static double now(void) {
-  struct timespec t;
-  timespec_get(&t, TIME_UTC);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+/* wall clock, or process CPU time with MFREE_BENCH_CLOCK=cpu (bench_util.h) */
+static double now(void) { return bench_now(); }
 
 static double time_setup(mfree_context_t *ctx, mfree_particles_t *ps, mfree_method_t m, int reps) {
   mfree_approximant_t *a = NULL;
@@ -49,6 +45,7 @@ int main(int argc, char **argv) {
   const double vol = dx * dx, dms[3] = {1.5, 2.5, 3.5}, paper[3] = {3.06, 3.12, 2.43};
   mfree_context_t *ctx = NULL;
   mfree_context_create(&ctx);
+  mfree_context_set_num_threads(ctx, 1);
   printf("paper 000 Table IV: Method 1 vs MLS (order 1) shape functions + gradients, %d particles\n", n);
   printf("%5s %14s %14s %10s %10s\n", "d_m", "Method1 p/s", "MLS p/s", "speed-up", "paper");
   for (int k = 0; k < 3; ++k) {
