@@ -12,7 +12,7 @@
  * for SPH, Shepard, MLS orders 0-2, RKPM orders 1-2 and SSPH order 2, in 2D and 3D,
  * with the inlined cubic spline and a kernel evaluated through Kernel::shape (Wendland
  * C2), the gather and symmetric-max conventions, at the particles and at host points,
- * with a periodic axis, and for sites that fail (too few neighbours) with and without
+ * with a periodic axis, for the value table or the gradient table alone, and for sites that fail (too few neighbours) with and without
  * the lower-order fallback, which the fast path hands to the general path.
  * Randles-Libersky and KB Method 1 have no Hessian; t404 checks them against an O(N^2)
  * oracle. */
@@ -100,10 +100,14 @@ static void build(mfree_particles_t *ps, const method_t *m, mfree_kernel_t kerne
   assert_ok(ctx, mfree_approximant_get_num_sites(a, &t->nsites));
   assert_ok(ctx, mfree_approximant_get_nnz(a, &t->nnz));
   assert_true(t->nnz <= (int64_t)(NNZMAX));
-  assert_ok(ctx, mfree_approximant_assemble_csr(a, MFREE_DERIV_VALUE, 0, t->rowptr, t->cols, t->val));
   assert_ok(ctx, mfree_particles_get_dimension(ps, &dim));
-  for (int c = 0; c < dim; ++c)
-    assert_ok(ctx, mfree_approximant_assemble_csr(a, MFREE_DERIV_GRADIENT, c, NULL, NULL, t->grad[c]));
+  memset(t->val, 0, sizeof t->val);
+  memset(t->grad, 0, sizeof t->grad);
+  if (flags & MFREE_DERIV_VALUE)
+    assert_ok(ctx, mfree_approximant_assemble_csr(a, MFREE_DERIV_VALUE, 0, t->rowptr, t->cols, t->val));
+  if (flags & MFREE_DERIV_GRADIENT)
+    for (int c = 0; c < dim; ++c)
+      assert_ok(ctx, mfree_approximant_assemble_csr(a, MFREE_DERIV_GRADIENT, c, t->rowptr, t->cols, t->grad[c]));
   assert_ok(ctx, mfree_approximant_get_site_status(a, t->status, &t->nfailed));
   assert_ok(ctx, mfree_approximant_get_neighbor_counts(a, t->counts));
   assert_ok(ctx, mfree_approximant_get_site_order(a, t->order));
@@ -113,9 +117,9 @@ static void build(mfree_particles_t *ps, const method_t *m, mfree_kernel_t kerne
 
 /* Fast (value + gradient) against general (+ Hessian) for one configuration; returns
  * the largest table difference relative to tolerance (<= 1 passes). */
-static double compare(mfree_particles_t *ps, int dim, const method_t *m, mfree_kernel_t kernel,
-                      int fallback, const double *pts, int npts, const double *ph, const char *what) {
-  const int vg = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
+static double compare_flags(mfree_particles_t *ps, int dim, const method_t *m, mfree_kernel_t kernel,
+                            int fallback, const double *pts, int npts, const double *ph, const char *what,
+                            int vg) {
   build(ps, m, kernel, vg, fallback, pts, npts, ph, &ta);
   build(ps, m, kernel, vg | MFREE_DERIV_HESSIAN, fallback, pts, npts, ph, &tb);
   assert_int_equal(ta.nsites, tb.nsites);
@@ -148,6 +152,12 @@ static double compare(mfree_particles_t *ps, int dim, const method_t *m, mfree_k
                big, ta.cond[s]);
   }
   return worst;
+}
+
+static double compare(mfree_particles_t *ps, int dim, const method_t *m, mfree_kernel_t kernel,
+                      int fallback, const double *pts, int npts, const double *ph, const char *what) {
+  return compare_flags(ps, dim, m, kernel, fallback, pts, npts, ph, what,
+                       MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT);
 }
 
 static mfree_particles_t *particles(const cloud_t *c, mfree_search_t conv, int periodic) {
@@ -203,6 +213,22 @@ static void test_fast_vs_general_3d(void **s) {
   run_dim(3, 7);
 }
 
+/* Value table only and gradient table only (the fast path skips the derivative moments
+ * for values alone). */
+static void test_one_table(void **s) {
+  (void)s;
+  cloud_t c;
+  make_cloud(&c, 2, 12, 1.6, 5);
+  mfree_particles_t *ps = particles(&c, MFREE_SEARCH_GATHER, 0);
+  for (size_t k = 0; k < sizeof kMethods / sizeof kMethods[0]; ++k) {
+    compare_flags(ps, 2, &kMethods[k], MFREE_KERNEL_CUBIC_SPLINE, 0, NULL, 0, NULL, "value only",
+                  MFREE_DERIV_VALUE);
+    compare_flags(ps, 2, &kMethods[k], MFREE_KERNEL_CUBIC_SPLINE, 0, NULL, 0, NULL, "gradient only",
+                  MFREE_DERIV_GRADIENT);
+  }
+  mfree_particles_destroy(&ps);
+}
+
 /* Sites with too few neighbours: the fast path gives them to the general path, with
  * the same statuses, and with MFREE_FALLBACK_LOWER_ORDER the same lower-order rows. */
 static void test_failing_sites(void **s) {
@@ -227,6 +253,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_fast_vs_general_2d),
       cmocka_unit_test(test_fast_vs_general_3d),
+      cmocka_unit_test(test_one_table),
       cmocka_unit_test(test_failing_sites),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
