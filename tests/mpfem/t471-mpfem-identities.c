@@ -374,6 +374,38 @@ static void test_fem_reduction(void **state) {
     mfree_mesh_destroy(&m);
     mfree_particles_destroy(&ps);
   }
+
+  /* A support of 1e-6 of the spacing on a union-jack mesh (alternating diagonals): the
+   * eq 13 check must not mistake round-off for reach. The support of node (1, 0) touches
+   * the triangle (2,0)-(2,1)-(1,1) of the next cell only in the limit, and its edge
+   * integrals cancel to eps |x| / (R h) (about 1e-10 here), not to 1e-12: reported as a
+   * violation before the check scaled its tolerance with that. */
+  enum { UJ = 4, UJN = (UJ + 1) * (UJ + 1) };
+  double xu[2 * UJN], gsu[UJ + 1];
+  int32_t cu[6 * UJ * UJ];
+  for (int i = 0; i <= UJ; ++i) gsu[i] = 0.25 * i;
+  mp_grid_nodes(UJ, UJ, gsu, gsu, xu);
+  for (int j = 0; j < UJ; ++j)
+    for (int i = 0; i < UJ; ++i) {
+      const int32_t A = j * (UJ + 1) + i, B = A + 1, C = A + UJ + 2, D = A + UJ + 1, e = 2 * (j * UJ + i);
+      const int32_t t0[6] = {A, B, C, A, C, D}, t1[6] = {A, B, D, B, C, D};
+      for (int k = 0; k < 6; ++k) cu[3 * e + k] = ((i + j) & 1) ? t1[k] : t0[k];
+    }
+  ps = mp_particles(ctx, 2, UJN, xu, 0.25e-6);
+  m = mp_mesh(ctx, ps, MFREE_ELEMENT_TRI3, 2 * UJ * UJ, cu);
+  mfree_status_t st = MFREE_SUCCESS;
+  a = mp_approx(ctx, ps, m, MFREE_KERNEL_COSINE, MFREE_MPFEM_DERIV_FULL, MFREE_DERIV_VALUE, 0, NULL, 0, &st);
+  assert_status(ctx, st, MFREE_SUCCESS);
+  mp_table_get(ctx, a, MFREE_DERIV_VALUE, &t);
+  double kerr = 0.0; /* Kronecker delta at the nodes, to the same round-off level */
+  for (int p = 0; p < UJN; ++p)
+    for (int j = 0; j < UJN; ++j) kerr = fmax(kerr, fabs(mp_at(&t, t.val, p, j) - (p == j)));
+  print_message("union jack, support 1e-6 h: Kronecker error %.1e\n", kerr);
+  assert_true(kerr < 1e-8);
+  mp_table_free(&t);
+  mfree_approximant_destroy(&a);
+  mfree_mesh_destroy(&m);
+  mfree_particles_destroy(&ps);
 }
 
 /* Tensor-product identity (spec 4.B item 24): on a structured grid of rectangles with
