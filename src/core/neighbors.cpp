@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <utility>
 
 #include "approximant.hpp"
 #include "kernel.hpp"
@@ -25,6 +26,28 @@
 namespace mfree {
 
 namespace {
+
+// Row buffers are written before they are read: growing them need not zero the new
+// entries (a std::vector value-initialises them; that memset was ~4 % of a 3D search).
+template <class T>
+struct NoInitAlloc : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = NoInitAlloc<U>;
+  };
+  NoInitAlloc() = default;
+  template <class U>
+  NoInitAlloc(const NoInitAlloc<U> &) noexcept {}
+  template <class U>
+  void construct(U *p) noexcept {
+    ::new (static_cast<void *>(p)) U;
+  }
+  template <class U, class... A>
+  void construct(U *p, A &&...a) {
+    ::new (static_cast<void *>(p)) U(std::forward<A>(a)...);
+  }
+};
+using RowBuf = std::vector<int32_t, NoInitAlloc<int32_t>>;
 
 // Query radius and pair limit of a site with search radius ri under the convention.
 struct Rule {
@@ -63,7 +86,7 @@ class CellGrid {
   // Write to row[cnt...] every valid particle j with squared distance to xq (wrapped)
   // within the rule's limit for a site of radius ri, growing row as needed; cnt is
   // advanced past them (row may hold junk beyond cnt).
-  void query(const double *xq, double ri, const Rule &rule, std::vector<int32_t> &row, size_t &cnt) const;
+  void query(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const;
 
  private:
   int64_t coord(double x, int c) const {
@@ -84,7 +107,7 @@ class CellGrid {
     return id;
   }
   void scan_range(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
-                  std::vector<int32_t> &row, size_t &cnt) const {
+                  RowBuf &row, size_t &cnt) const {
     const bool g = rule.conv == MFREE_SEARCH_GATHER;
     switch (dim_ * 4 + (any_periodic_ ? 2 : 0) + (g ? 1 : 0)) {
 #define MFREE_SCAN(D, P, G) \
@@ -98,7 +121,7 @@ class CellGrid {
   }
   template <int D, bool Periodic, bool Gather>
   void scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
-            std::vector<int32_t> &row, size_t &cnt) const;
+            RowBuf &row, size_t &cnt) const;
 
   int dim_;
   double lo_[3] = {0, 0, 0}, cell_[3] = {1, 1, 1}, L_[3] = {0, 0, 0};
@@ -212,7 +235,7 @@ CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : 
 
 template <int D, bool Periodic, bool Gather>
 void CellGrid::scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
-                    std::vector<int32_t> &row, size_t &cnt) const {
+                    RowBuf &row, size_t &cnt) const {
   if (row.size() < cnt + static_cast<size_t>(p1 - p0)) row.resize(2 * (cnt + static_cast<size_t>(p1 - p0)));
   int32_t *out = row.data();
   size_t k = cnt;
@@ -284,7 +307,7 @@ void CellGrid::scan(const double *xq, double ri, const Rule &rule, int64_t p0, i
   cnt = k;
 }
 
-void CellGrid::query(const double *xq, double ri, const Rule &rule, std::vector<int32_t> &row,
+void CellGrid::query(const double *xq, double ri, const Rule &rule, RowBuf &row,
                      size_t &cnt) const {
   if (nvalid_ == 0) return;
   const double R = rule.query(ri) * (1.0 + 1e-12);  // closed supports (kEdgeTol)
@@ -388,13 +411,13 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
   if (grid.empty() || order.empty()) return;
   const int64_t nq = static_cast<int64_t>(order.size());
   const int nt = num_threads(nq);
-  std::vector<std::vector<int32_t>> buf(nt);
+  std::vector<RowBuf> buf(nt);
   std::vector<int64_t> first(static_cast<size_t>(nq) + 1, 0);  // offsets into the buffers
   // smallest and largest member of each row, for the threads of the transposition
   const bool track = symmetric && num_threads(nsites) > 1 && nt > 1;
   std::vector<int32_t> lo_hi(track ? 2 * static_cast<size_t>(nsites) : 0);
   parallel_blocks(nq, nt, [&](int t, int64_t b, int64_t e) {
-    std::vector<int32_t> &cols = buf[t];
+    RowBuf &cols = buf[t];
     cols.resize(static_cast<size_t>((e - b) * 32 + 64));
     size_t cnt = 0;
     for (int64_t q = b; q < e; ++q) {
