@@ -11,7 +11,9 @@
 // stencil row are one contiguous range scanned by a branch-light loop. Queries run in
 // cell order too (neighbouring queries share cache lines), in static blocks over the
 // context's threads, each into its own buffer; the rows are then placed by host index.
-// The permutation never leaves this file: rows hold host indices, sorted ascending.
+// The permutation never leaves this file: rows hold host indices, sorted ascending --
+// for a symmetric relation by transposing the unsorted rows (no comparisons, see
+// run_queries), otherwise by sorting each row.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
