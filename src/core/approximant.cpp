@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include "basis.hpp"
 #include "parallel.hpp"
@@ -338,17 +339,27 @@ void Approximant::build_pattern() {
       if (conv == MFREE_SEARCH_GATHER && !any_periodic) {
         // the common case, branch-free: keep j when within R hs (or j is the site)
         const double lim = R * hs, lim2 = lim * lim * tol;
-        for (int64_t q = srp[s]; q < srp[s + 1]; ++q) {
-          const int32_t j = scl[q];
-          double r2 = 0.0;
-          for (int c = 0; c < dim; ++c) {
-            const double v = P[j * PS + c] - xs[c];
-            r2 += v * v;
+        // the record length as a compile-time constant for 2D and 3D
+        auto scan = [&](auto dimc) {
+          constexpr int D = decltype(dimc)::value;
+          const int pd = D > 0 ? D : dim;
+          const int64_t ps = pd + 2;
+          for (int64_t q = srp[s]; q < srp[s + 1]; ++q) {
+            const int32_t j = scl[q];
+            const double *pj = P + j * ps;
+            double r2 = 0.0;
+            for (int c = 0; c < pd; ++c) {
+              const double v = pj[c] - xs[c];
+              r2 += v * v;
+            }
+            if (j == me) at_self = k;
+            cl[k] = j;
+            k += (r2 <= lim2) | (j == me);
           }
-          if (j == me) at_self = k;
-          cl[k] = j;
-          k += (r2 <= lim2) | (j == me);
-        }
+        };
+        if (dim == 2) scan(std::integral_constant<int, 2>());
+        else if (dim == 3) scan(std::integral_constant<int, 3>());
+        else scan(std::integral_constant<int, 0>());
       } else {
         for (int64_t q = srp[s]; q < srp[s + 1]; ++q) {
           const int32_t j = scl[q];
