@@ -116,8 +116,9 @@ file(MAKE_DIRECTORY ${OUT})
 
 set(args --problem ${PROBLEM})
 if(PROBLEM STREQUAL "beam-vci")
-  # CD1, CD2, MLS with mfree_assembler_set_consistent_integration, from the 33x5 level
-  set(args --problem beam --vci --scheme CD1,CD2,MLS --first 1)
+  # CD1 and CD2 with mfree_assembler_set_consistent_integration, from the 33x5 level
+  # (MLS with it: 2.14 / 2.57, not run here to keep the test short)
+  set(args --problem beam --vci --scheme CD1,CD2 --first 1)
 endif()
 execute_process(COMMAND ${EXE} --json --no-plot ${args} --levels ${LEVELS} --out ${OUT}
                 RESULT_VARIABLE rc OUTPUT_VARIABLE json ERROR_VARIABLE stderr)
@@ -338,7 +339,7 @@ elseif(PROBLEM STREQUAL "beam-vci")
   # variationally consistent integration of the test functions (second order: constant and
   # linear corrections of grad Psi_J; see the top of this file). Measured over 33x5 ..
   # 257x33: CD1 1.36 / 1.68, CD2 1.22 / 1.58, MLS 2.14 / 2.57.
-  foreach(s CD1 CD2 MLS)
+  foreach(s CD1 CD2)
     string(JSON vci GET "${json}" beam ${s} vci)
     if(NOT vci STREQUAL "ON" AND NOT vci STREQUAL "true")
       fail("beam-vci: ${s} ran without consistent integration (vci = ${vci})")
@@ -348,8 +349,6 @@ elseif(PROBLEM STREQUAL "beam-vci")
   at_least(beam CD1 L2_rate 1.5 "000 Table III beam CD1 1.84 (with VCI)")
   at_least(beam CD2 energy_rate 1.0 "000 Table III beam CD2 1.29 (with VCI)")
   at_least(beam CD2 L2_rate 1.5 "000 Table III beam CD2 1.84 (with VCI)")
-  at_least(beam MLS energy_rate 1.0 "000 Table III beam MLS 1.50 (with VCI)")
-  at_least(beam MLS L2_rate 1.5 "000 Table III beam MLS 1.82 (with VCI)")
   close_at_every_level(beam CD1 CD2 energy 15 "000 Sect. 6.2.3")
 elseif(PROBLEM STREQUAL "patch")
   # Galerkin patch test on an irregular cloud: consistent schemes reproduce a linear
