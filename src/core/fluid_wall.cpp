@@ -1,5 +1,5 @@
-// Dummy wall particles and density diffusion for the Galerkin-SPH fluid (see
-// fluid_wall.hpp). Neither is in paper 003; both are off by default.
+// Dummy wall particles, density diffusion and consistent nodal integration for the
+// Galerkin-SPH fluid (see fluid_wall.hpp). None is in paper 003; all are off by default.
 //
 // Why (t702, 003 B5): the paper's wall force (eqs 122-124) acts only on approaching
 // particles, so it cannot carry the bottom pressure of a still column, and the dropped
@@ -9,7 +9,8 @@
 // interior rows: the Galerkin force of a fluid node whose support crosses the wall picks
 // up int_dummies (p grad N_i + N_i rho g) = the wall traction int_wall N_i p n.
 // Nodal integration also leaves odd-even density modes that no force sees (t702 test 1);
-// the density-diffusion term damps them.
+// the density-diffusion term damps them. And it lets a pressure push disordered particles
+// (integration-constraint error), which destabilises their positions: see vci_setup.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -92,7 +93,6 @@ const double *FluidSystem::node_densities(const double *rho) const {
     dummy_.level[f] = 1;
   }
   const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0);
-  const Csr &nb = ps_.neighbors();
   const double fallback_rho0 = rho0_.empty() ? 1000.0 : rho0_[0];
   bool progress = true;
   // pass 2: dummies with fluid neighbours; passes 3, 4 reach 4h into the wall, as deep as
@@ -102,8 +102,8 @@ const double *FluidSystem::node_densities(const double *rho) const {
     for (int32_t w = n_; w < nall; ++w) {
       if (dummy_.level[w]) continue;
       double sw = 0.0, sp = 0.0, sr0 = 0.0;
-      for (int64_t e = nb.rowptr[w]; e < nb.rowptr[w + 1]; ++e) {
-        const int32_t f = nb.cols[e];
+      for (int64_t e = rp_[w]; e < rp_[w + 1]; ++e) {  // the pairs closer than 2h
+        const int32_t f = cols_[e];
         const int lf = dummy_.level[f];
         if (lf == 0 || lf == pass) continue;  // only values of earlier passes
         double r2 = 0.0, gr = 0.0;
@@ -177,12 +177,11 @@ void FluidSystem::density_diffusion(const double *rho, double *drho) const {
       for (int c = 0; c < dim; ++c) dummy_.grad_rho[static_cast<size_t>(k) * dim + c] += G_[e * dim + c] * r[cols[e]];
   const double *gr = dummy_.grad_rho.data();
   const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0);
-  const Csr &nb = ps_.neighbors();
   for (int32_t i = 0; i < n_; ++i) {
     const double c0 = std::sqrt(gamma_ * kappa_ / rho0_[i]);
     double s = 0.0;
-    for (int64_t e = nb.rowptr[i]; e < nb.rowptr[i + 1]; ++e) {
-      const int32_t j = nb.cols[e];
+    for (int64_t e = rp[i]; e < rp[i + 1]; ++e) {
+      const int32_t j = cols[e];
       if (j == i) continue;
       double r2 = 0.0, gx = 0.0;
       for (int c = 0; c < dim; ++c) {
