@@ -211,7 +211,8 @@ static void tables_against_references(int dim, int steps) {
     free_reference(&ref);
     mfree_matrix_destroy(&S);
   }
-  /* the flow moved neighbours relative to each other by more than the skin (0.25 h) */
+  /* the flow moved neighbours relative to each other by more than the skin (0.25 h),
+   * so that lists that were never rebuilt would miss pairs (checked by mutation) */
   double rel = 0.0;
   for (int k = 0; k < N; ++k)
     for (int64_t e = rp0[k]; e < rp0[k + 1]; ++e) {
@@ -223,7 +224,7 @@ static void tables_against_references(int dim, int steps) {
       }
       rel = fmax(rel, sqrt(r2));
     }
-  if (!(rel > 0.5 * HS)) fail_msg("%dD: largest relative displacement of neighbours %g h: too small a test", dim, rel / HS);
+  if (!(rel > 0.3 * HS)) fail_msg("%dD: largest relative displacement of neighbours %g h: too small a test", dim, rel / HS);
   assert_true(checked_rows > steps * N / 2);
   free(y0);
   free(rp0);
@@ -236,12 +237,13 @@ static void tables_against_references(int dim, int steps) {
   mfree_system_destroy(&sys);
 }
 
-/* Fewer steps in unoptimised (sanitizer) builds, where the O(N^2) pairs dominate; 3D
- * steps are longer (smaller c): 6 steps move neighbours by ~1h, 4 by ~0.7h. */
+/* Fewer steps in unoptimised (sanitizer) builds, where the O(N^2) pairs dominate: 2D
+ * steps move neighbours relative to each other by ~0.07 h, 3D steps (smaller c, longer
+ * steps) by ~0.15 h. */
 #ifdef __OPTIMIZE__
 enum { STEPS_2D = 12, STEPS_3D = 6 };
 #else
-enum { STEPS_2D = 6, STEPS_3D = 4 };
+enum { STEPS_2D = 8, STEPS_3D = 4 };
 #endif
 
 static void test_tables_2d(void **s) {
