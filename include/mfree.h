@@ -1012,10 +1012,13 @@ MFREE_API mfree_status_t mfree_system_set_shepard_condition(mfree_system_t *sys,
 
 /**
  * Dummy wall particles (not in paper 003; Adami, Hu & Adams 2012, J. Comput. Phys. 231,
- * 7057): fixed particles that fill the solid past the walls, at least 2h deep (three
- * layers at the fluid spacing for h = 1.5 d). They are nodes of the MLS approximation
- * with zero velocity parameters (walls at rest, no-slip) and quadrature points of the
- * momentum equation, with the pressure extrapolated from the fluid at every evaluation,
+ * 7057): fixed particles that fill the solid past the walls, best continuing the fluid's
+ * lattice, at least 4h - d deep (four layers at spacing d for h = 1.5 d: the MLS
+ * functions at the dummies a fluid node reaches must see full supports; with three
+ * layers the floor row of a still column is pushed up by 6 % of g). They are nodes
+ * of the MLS approximation with zero velocity parameters (walls at rest, no-slip) and
+ * quadrature points of the momentum equation, with the pressure extrapolated from the
+ * fluid at every evaluation,
  * p_w = sum_f W_wf (p_f + rho_f g.(x_w - x_f)) / sum_f W_wf (fluid neighbours f within
  * the support), their density from the inverse equation of state, their mass
  * rho_w V_w feeling gravity. So a fluid node next to a wall sees a full support, and the
