@@ -790,6 +790,24 @@ static void rows_assembler(void) {
   ROW0(MFREE_ERR_NULL, mfree_assembler_set_penalty(NULL, 1e6));
   ROW(MFREE_ERR_ARG, mfree_assembler_set_penalty(F.as_new, -1.0));
   ROW(MFREE_ERR_ARG, mfree_assembler_set_penalty(F.as_new, NAN));
+  {
+    double nrmbad[4] = {1, 0, 0.5, 0}, pwnan[2] = {0.1, NAN};
+    ROW0(MFREE_ERR_NULL, mfree_assembler_set_consistent_integration(NULL, 2, px, MFREE_LAYOUT_AOS, 2, pw, nrm));
+    ROW(MFREE_ERR_ARG, mfree_assembler_set_consistent_integration(F.as_new, -1, px, MFREE_LAYOUT_AOS, 2, pw, nrm));
+    ROW(MFREE_ERR_NULL, mfree_assembler_set_consistent_integration(F.as_new, 2, NULL, MFREE_LAYOUT_AOS, 2, pw, nrm));
+    ROW(MFREE_ERR_NULL, mfree_assembler_set_consistent_integration(F.as_new, 2, px, MFREE_LAYOUT_AOS, 2, NULL, nrm));
+    ROW(MFREE_ERR_NULL, mfree_assembler_set_consistent_integration(F.as_new, 2, px, MFREE_LAYOUT_AOS, 2, pw, NULL));
+    ROW(MFREE_ERR_INPUT, mfree_assembler_set_consistent_integration(F.as_new, 2, px, MFREE_LAYOUT_AOS, 2, pwbad, nrm));
+    ROW(MFREE_ERR_INPUT, mfree_assembler_set_consistent_integration(F.as_new, 2, px, MFREE_LAYOUT_AOS, 2, pwnan, nrm));
+    ROW(MFREE_ERR_INPUT, mfree_assembler_set_consistent_integration(F.as_new, 2, px, MFREE_LAYOUT_AOS, 2, pw, nrmbad));
+    ROW(MFREE_ERR_ARG, mfree_assembler_set_consistent_integration(F.as_new, 2, px, MFREE_LAYOUT_AOS, 1, pw, nrm));
+    ROW(MFREE_ERR_ARG, mfree_assembler_set_consistent_integration(F.as_new, 2, px, (mfree_layout_t)7, 2, pw, nrm));
+    mfree_assembler_t *mass = NULL; /* the correction is for stiffness forms only */
+    assert_ok(F.ctx, mfree_assembler_create(F.ctx, F.a, NULL, MFREE_FORM_MASS, &mass));
+    ROW(MFREE_ERR_UNSUPPORTED,
+        mfree_assembler_set_consistent_integration(mass, 2, px, MFREE_LAYOUT_AOS, 2, pw, nrm));
+    mfree_assembler_destroy(&mass);
+  }
 
   ROW0(MFREE_ERR_NULL, mfree_assembler_setup(NULL));
   ROW0(MFREE_ERR_NULL, mfree_assembler_update(NULL));
