@@ -94,6 +94,30 @@ static void test_zero_energy_modes(void **s) {
   mfree_system_destroy(&sys);
 }
 
+/* Galerkin lumped masses sum to the total (003 eq 57); particle pressures p and their
+ * MLS interpolant ph at the particles. */
+static void check_mass_and_pressures(mfree_system_t *sys, const double *y, const double *m, int n,
+                                     double *p, double *ph) {
+  mfree_matrix_t *M = NULL;
+  assert_ok(ctx, mfree_system_assemble_mass(sys, y, 0, &M));
+  const int64_t *rp;
+  const int32_t *ci;
+  const double *mv;
+  assert_ok(ctx, mfree_matrix_get_csr(M, &rp, &ci, &mv));
+  double total = 0.0, lumped = 0.0;
+  for (int q = 0; q < n; ++q) {
+    total += m[q];
+    lumped += mv[rp[2 * n + 2 * q]];
+  }
+  assert_true(fabs(lumped - total) < 1e-12 * total);
+  mfree_matrix_destroy(&M);
+  mfree_matrix_t *S = NULL;
+  assert_ok(ctx, mfree_system_get_pressure(sys, y, p));
+  assert_ok(ctx, mfree_system_assemble_interpolation(sys, y, &S));
+  assert_ok(ctx, mfree_matrix_apply(S, p, ph));
+  mfree_matrix_destroy(&S);
+}
+
 static void test_hydrostatic_column(void **s) {
   (void)s;
   enum { NZ = 10, NX = 3 * NZ, N = NX * NZ };
@@ -134,28 +158,9 @@ static void test_hydrostatic_column(void **s) {
   assert_ok(ctx, mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 0.3, 0.2, 0.0, NULL, NULL, &steps));
   assert_true(t == 0.3 && steps > 1000);
 
-  /* mass: Galerkin lumped masses sum to the total (003 eq 57) */
-  mfree_matrix_t *M = NULL;
-  assert_ok(ctx, mfree_system_assemble_mass(sys, y, 0, &M));
-  const int64_t *rp;
-  const int32_t *ci;
-  const double *mv;
-  assert_ok(ctx, mfree_matrix_get_csr(M, &rp, &ci, &mv));
-  double total = 0.0, lumped = 0.0;
-  for (int p = 0; p < N; ++p) {
-    total += m[p];
-    lumped += mv[rp[2 * N + 2 * p]];
-  }
-  assert_true(fabs(lumped - total) < 1e-12 * total);
-  mfree_matrix_destroy(&M);
-
-  /* interpolated pressure against rho0 g (H - z) */
+  /* mass exact; interpolated pressure against rho0 g (H - z) */
   double p[N], ph[N], vh[2 * N];
-  mfree_matrix_t *S = NULL;
-  assert_ok(ctx, mfree_system_get_pressure(sys, y, p));
-  assert_ok(ctx, mfree_system_assemble_interpolation(sys, y, &S));
-  assert_ok(ctx, mfree_matrix_apply(S, p, ph));
-  mfree_matrix_destroy(&S);
+  check_mass_and_pressures(sys, y, m, N, p, ph);
   double err = 0.0, raw = 0.0;
   int checked = 0;
   for (int q = 0; q < N; ++q) {
@@ -249,26 +254,8 @@ static void test_hydrostatic_column_paper_setting(void **s) {
   assert_ok(ctx, mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 0.4, 0.2, 0.0, NULL, NULL, &steps));
   assert_true(t == 0.4 && steps > 3000);
 
-  mfree_matrix_t *M = NULL;
-  assert_ok(ctx, mfree_system_assemble_mass(sys, y, 0, &M));
-  const int64_t *rp;
-  const int32_t *ci;
-  const double *mv;
-  assert_ok(ctx, mfree_matrix_get_csr(M, &rp, &ci, &mv));
-  double total = 0.0, lumped = 0.0;
-  for (int q = 0; q < N; ++q) {
-    total += m[q];
-    lumped += mv[rp[2 * N + 2 * q]];
-  }
-  assert_true(fabs(lumped - total) < 1e-12 * total);
-  mfree_matrix_destroy(&M);
-
   double p[N], ph[N], vh[2 * N];
-  mfree_matrix_t *S = NULL;
-  assert_ok(ctx, mfree_system_get_pressure(sys, y, p));
-  assert_ok(ctx, mfree_system_assemble_interpolation(sys, y, &S));
-  assert_ok(ctx, mfree_matrix_apply(S, p, ph));
-  mfree_matrix_destroy(&S);
+  check_mass_and_pressures(sys, y, m, N, p, ph);
   int checked = 0, checked_h = 0;
   const double err = max_pressure_error(y, p, N, W, H, h, &checked);
   const double errh = max_pressure_error(y, ph, N, W, H, h, &checked_h);
