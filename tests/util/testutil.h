@@ -37,4 +37,10 @@ typedef struct { uint64_t s; } mfree_rng_t;
 void mfree_rng_seed(mfree_rng_t *r, uint64_t seed);
 double mfree_rng_uniform(mfree_rng_t *r);
 
+/* Fluid systems: the Galerkin lumped masses of mfree_system_assemble_mass (row sums at the
+ * first velocity component of each particle) summed over the n particles, and the total
+ * of the particle masses m; returns |lumped - total| / total (003 eq 57 makes it zero). */
+double mfree_test_lumped_mass_rel_diff(mfree_context_t *ctx, mfree_system_t *sys, const double *y,
+                                       const double *m, int n);
+
 #endif
