@@ -22,6 +22,22 @@
  *  - With b = 10 a: nt = 11 gives 17 rings and 209 particles (the paper: 188 with 11 on
  *    the quarter hole), nt = 21 gives 31 rings and 677 particles (the paper: 686 with 21).
  *
+ * PLATE_LAYOUT_RAYS, the ruled arrangement that the paper's counts suggest (188 =
+ * 11 x 17 + 1, 686 ~ 21 x 33; "coarser away from the hole"): nt straight rays from the
+ * hole points H(t_j), t_j = j/(nt - 1), to the points P(t_j) of the outer edges above
+ * (equally spaced along them, the middle ray ending at the corner (b, b)), nr particles
+ * on each ray with geometric spacing whose first step is the spacing a dtheta on the
+ * hole (square cells at the hole), so nt x nr particles. PLATE_LAYOUT_POLAR is the same
+ * with radial rays theta_j = pi t_j / 2 ending where they meet x = b or y = b. Volumes: a
+ * quarter of each adjacent quadrilateral (ray j, j + 1 by particle k, k + 1), so they
+ * sum to the area of the polygonal model. On the standard plate of paper 000 (b = 5 a)
+ * the rays' cells are long across the rays near the outer edges (spacing 2 b/(nt - 1)
+ * there against (b - a)/(nr - 1) on average along them), so with h_i = 1.5 Delta_i some
+ * supports reach only two rays and the quadratic fit is singular; no geometric grading
+ * helps (a coarser end needs a finer start, and then the supports at the hole reach only
+ * one ray). 11 x 17 first works from b = 9 a, 21 x 33 from b = 10 a; with square cells
+ * along the whole axis the 17 particles of 11 rays reach (1 + pi/20)^16 a = 10.3 a.
+ *
  * Volumes: spacing along the ring times the spacing across the rings, halved on the
  * boundary. Supports: h_i = hfac Delta_i, Delta_i the distance from particle i to its
  * nearest neighbour (spec 001 8.3: "the smallest distance between particle i and other
@@ -38,7 +54,11 @@
  *    corner (b, b) n = (1, 1)/sqrt 2 (the exact stress makes any normal consistent);
  *  - the four corners of the model: (a, 0) hole traction t_1 = 0 and u_2 = 0; (0, a)
  *    hole traction t_2 = 0 and u_1 = 0; (b, 0) exact t_1 on x = b and u_2 = 0; (0, b)
- *    exact t_2 on y = b and u_1 = 0.
+ *    exact t_2 on y = b and u_1 = 0: one rule at every corner on a symmetry line, its
+ *    displacement condition and the other boundary's traction for the other component
+ *    (PLATE_CORNER_DIRICHLET; the paper does not say, erratum 11). The alternatives at the
+ *    hole corners, PLATE_CORNER_SYMMETRY (u_n = 0 and sigma_12 = 0 of the symmetry line)
+ *    and PLATE_CORNER_HOLE (both hole tractions), are there to measure the choice.
  * Interior particles carry the two Navier equations (6.22). */
 #define _POSIX_C_SOURCE 200809L
 #include "plate.h"
@@ -63,8 +83,12 @@ void plate_config_default(plate_config_t *cfg, int nt, int nr) {
   cfg->sigma0 = 1.0;
   cfg->kernel_param = 1.6;
   cfg->hfac = 1.5;
+  cfg->layout = PLATE_LAYOUT_RINGS;
+  cfg->hole_corner = PLATE_CORNER_DIRICHLET;
   cfg->patch = 0;
 }
+
+int plate_ray_particles(int nt) { return 1 + 8 * (nt - 1) / 5; }
 
 int plate_rings(double a, double b, int nt) {
   const double dtheta = 0.5 * kPi / (nt - 1);
@@ -136,13 +160,92 @@ static double ray_length(const plate_config_t *cfg, double t) {
   return hypot(P[0] - H[0], P[1] - H[1]);
 }
 
+/* h_i = hfac Delta_i, Delta_i the distance to the nearest other particle (O(n^2): the
+ * example's sizes are small). */
+static void nearest_supports(int n, const double *x, double hfac, double *h) {
+  for (int i = 0; i < n; ++i) {
+    double dmin = INFINITY;
+    for (int j = 0; j < n; ++j) {
+      if (j == i) continue;
+      const double d = hypot(x[2 * j] - x[2 * i], x[2 * j + 1] - x[2 * i + 1]);
+      if (d < dmin) dmin = d;
+    }
+    h[i] = hfac * dmin;
+  }
+}
+
+/* Twice the signed area of the triangle (p, q, r). */
+static double area2(const double *p, const double *q, const double *r) {
+  return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+}
+
+/* The ruled arrangement PLATE_LAYOUT_RAYS (see the top of this file): nt rays, nr
+ * particles on each, stored ring by ring (index k nt + j, k along the ray, j the ray). */
+static int rays_particles(const plate_config_t *cfg, int *nout, double **xout, double **vout,
+                          double **hout, int32_t **tagout) {
+  const int nt = cfg->nt, nr = cfg->nr, n = nt * nr;
+  const double a = cfg->a;
+  double *x = malloc(sizeof(double) * 2 * (size_t)n), *v = calloc((size_t)n, sizeof(double));
+  double *h = malloc(sizeof(double) * (size_t)n);
+  int32_t *tag = malloc(sizeof(int32_t) * (size_t)n);
+  if (!x || !v || !h || !tag) {
+    free(x), free(v), free(h), free(tag);
+    return 1;
+  }
+  const double d1 = a * kPi / (2.0 * (nt - 1)); /* the particle spacing on the hole */
+  for (int j = 0; j < nt; ++j) {
+    const double t = (double)j / (nt - 1), th = 0.5 * kPi * t;
+    const double c = j == nt - 1 ? 0.0 : cos(th), sn = j == 0 ? 0.0 : sin(th);
+    const double len = cfg->layout == PLATE_LAYOUT_POLAR ? cfg->b / fmax(c, sn) - a : ray_length(cfg, t);
+    /* geometric spacing along the ray from d1 at the hole: square cells at the hole */
+    const double g = grading(d1, nr - 1, len);
+    double s = 0.0;
+    for (int k = 0; k < nr; ++k) {
+      if (cfg->layout == PLATE_LAYOUT_POLAR) {
+        const double r = k == nr - 1 ? a + len : a + s;
+        x[2 * (k * nt + j)] = r * c, x[2 * (k * nt + j) + 1] = r * sn;
+        if (k == nr - 1 && 2 * j <= nt - 1) x[2 * (k * nt + j)] = cfg->b;
+        if (k == nr - 1 && 2 * j >= nt - 1) x[2 * (k * nt + j) + 1] = cfg->b;
+      } else {
+        ring_point(cfg, k == nr - 1 ? 1.0 : s / len, t, &x[2 * (k * nt + j)]);
+      }
+      s += d1 * pow(g, k);
+      tag[k * nt + j] = (k == 0 ? PLATE_HOLE : 0) | (j == 0 ? PLATE_SYM_Y0 : 0) |
+                        (j == nt - 1 ? PLATE_SYM_X0 : 0) |
+                        (k == nr - 1 && 2 * j <= nt - 1 ? PLATE_EDGE_XB : 0) |
+                        (k == nr - 1 && 2 * j >= nt - 1 ? PLATE_EDGE_YB : 0);
+    }
+  }
+  /* volumes: a quarter of each adjacent quadrilateral cell (they sum to the area of the
+   * polygonal model) */
+  for (int k = 0; k + 1 < nr; ++k)
+    for (int j = 0; j + 1 < nt; ++j) {
+      const int c[4] = {k * nt + j, k * nt + j + 1, (k + 1) * nt + j + 1, (k + 1) * nt + j};
+      const double area = 0.5 * fabs(area2(&x[2 * c[0]], &x[2 * c[1]], &x[2 * c[2]]) +
+                                     area2(&x[2 * c[0]], &x[2 * c[2]], &x[2 * c[3]]));
+      for (int q = 0; q < 4; ++q) v[c[q]] += 0.25 * area;
+    }
+  nearest_supports(n, x, cfg->hfac, h);
+  *nout = n;
+  *xout = x;
+  *vout = v;
+  *hout = h;
+  *tagout = tag;
+  return 0;
+}
+
 enum { NTAB = 2000 }; /* subintervals of the half ring for the particle count */
 
 int plate_particles(const plate_config_t *cfg, int *nout, double **xout, double **vout,
                     double **hout, int32_t **tagout) {
   const int nt = cfg->nt, nr = cfg->nr, m0 = (nt - 1) / 2;
   const double a = cfg->a, b = cfg->b;
-  if (nt < 3 || nt % 2 == 0 || nr < 3 || !(b > a && a > 0) || !(cfg->hfac > 0)) return 1;
+  if (nt < 3 || nt % 2 == 0 || nr < 3 || !(b > a && a > 0) || !(cfg->hfac > 0) ||
+      cfg->hole_corner < PLATE_CORNER_DIRICHLET || cfg->hole_corner > PLATE_CORNER_HOLE)
+    return 1;
+  if (cfg->layout == PLATE_LAYOUT_RAYS || cfg->layout == PLATE_LAYOUT_POLAR)
+    return rays_particles(cfg, nout, xout, vout, hout, tagout);
+  if (cfg->layout != PLATE_LAYOUT_RINGS) return 1;
   double *s = malloc(sizeof(double) * (size_t)nr), *gap = malloc(sizeof(double) * (size_t)nr);
   int *m = malloc(sizeof(int) * (size_t)nr);
   double *tk = malloc(sizeof(double) * (size_t)nr * (NTAB + 1)); /* t of each ring's points */
@@ -222,15 +325,7 @@ int plate_particles(const plate_config_t *cfg, int *nout, double **xout, double 
       v[first + j] *= along;
     }
   }
-  for (int i = 0; i < n; ++i) { /* h_i = hfac Delta_i, Delta_i the nearest distance */
-    double dmin = INFINITY;
-    for (int j = 0; j < n; ++j) {
-      if (j == i) continue;
-      const double d = hypot(x[2 * j] - x[2 * i], x[2 * j + 1] - x[2 * i + 1]);
-      if (d < dmin) dmin = d;
-    }
-    h[i] = cfg->hfac * dmin;
-  }
+  nearest_supports(n, x, cfg->hfac, h);
   free(s), free(gap), free(m), free(tk), free(cum);
   *nout = n;
   *xout = x;
@@ -324,7 +419,8 @@ mfree_status_t plate_solve(mfree_context_t *ctx, const plate_config_t *cfg,
   memset(res, 0, sizeof *res);
   if (plate_particles(cfg, &n, &x, &vol, &h, &tag))
     return mfree_context_set_error(ctx, MFREE_ERR_ARG,
-                                   "plate: needs odd nt >= 3, nr >= 3, b > a > 0, hfac > 0");
+                                   "plate: needs odd nt >= 3, nr >= 3, b > a > 0, hfac > 0, "
+                                   "a PLATE_LAYOUT_* and a PLATE_CORNER_* value");
   const int neq = 2 * n;
   res->n = n;
   res->neq = neq;
@@ -396,9 +492,12 @@ mfree_status_t plate_solve(mfree_context_t *ctx, const plate_config_t *cfg,
     int nn = 0;
     for (int p = 0; p < n; ++p) {
       const int32_t t = tag[p];
-      const int in = e == 0   ? (t & PLATE_HOLE) != 0
-                     : e == 1 ? (t & PLATE_SYM_Y0) && !(t & (PLATE_HOLE | edges))
-                     : e == 2 ? (t & PLATE_SYM_X0) && !(t & (PLATE_HOLE | edges))
+      /* hole corners in the symmetry lines' sets (PLATE_CORNER_SYMMETRY) or the hole's */
+      const int sym_corner = cfg->hole_corner == PLATE_CORNER_SYMMETRY;
+      const int hole = (t & PLATE_HOLE) && !(sym_corner && (t & (PLATE_SYM_X0 | PLATE_SYM_Y0)));
+      const int in = e == 0   ? hole
+                     : e == 1 ? (t & PLATE_SYM_Y0) && !hole && !(t & edges)
+                     : e == 2 ? (t & PLATE_SYM_X0) && !hole && !(t & edges)
                      : e == 3 ? (t & edges) == PLATE_EDGE_XB
                      : e == 4 ? (t & edges) == edges
                               : (t & edges) == PLATE_EDGE_YB;
@@ -414,7 +513,9 @@ mfree_status_t plate_solve(mfree_context_t *ctx, const plate_config_t *cfg,
   for (int c = 0; c < 2; ++c) { /* u_2 = 0 on y = 0 (c = 0), u_1 = 0 on x = 0 (c = 1) */
     int nn = 0;
     for (int p = 0; p < n; ++p)
-      if (tag[p] & (c ? PLATE_SYM_X0 : PLATE_SYM_Y0)) nodes[nn++] = p;
+      if ((tag[p] & (c ? PLATE_SYM_X0 : PLATE_SYM_Y0)) &&
+          !(cfg->hole_corner == PLATE_CORNER_HOLE && (tag[p] & PLATE_HOLE)))
+        nodes[nn++] = p;
     CHECK(mfree_assembler_add_dirichlet_nodes(as, nn, nodes, c ? 1 : 2, exact_u, (void *)cfg));
   }
 

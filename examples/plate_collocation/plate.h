@@ -15,18 +15,39 @@
 
 #include <mfree.h>
 
+/* Particle arrangements (plate.c describes them). */
+enum {
+  PLATE_LAYOUT_RINGS = 0, /* rings with square cells, more particles per ring outwards
+                             (the default) */
+  PLATE_LAYOUT_RAYS = 1,  /* ruled: nt straight rays from the hole to equally spaced
+                             points of the outer edges, nr particles on each, graded */
+  PLATE_LAYOUT_POLAR = 2  /* the same with radial rays (theta = const) */
+};
+
+/* The two rows of the particles (a, 0) and (0, a) where the hole meets a symmetry line. */
+enum {
+  PLATE_CORNER_DIRICHLET = 0, /* the symmetry line's displacement condition and the
+                                 hole's other traction component, as at the outer
+                                 corners (b, 0), (0, b) (the default) */
+  PLATE_CORNER_SYMMETRY = 1,  /* both rows of the symmetry line (u_n = 0, t_t = 0) */
+  PLATE_CORNER_HOLE = 2       /* both hole tractions, no displacement condition */
+};
+
 typedef struct {
   double a;               /* hole radius (1) */
   double b;               /* half-width of the plate (10) */
   int nt;                 /* particles on the quarter hole, odd (symmetric about the
                              diagonal) */
   int nr;                 /* rings of particles from the hole to the outer edges
-                             (plate_rings) */
+                             (plate_rings); for the ray layouts the particles on each
+                             ray (plate_ray_particles) */
   mfree_method_t method;  /* MFREE_METHOD_SSPH or MFREE_METHOD_MSPH */
   double young, poisson;  /* 1, 0.25 (plane strain) */
   double sigma0;          /* remote tension, 1 */
   double kernel_param;    /* revised super Gauss decay a = 1.6 */
   double hfac;            /* h_i = hfac * Delta_i, 1.5 */
+  int layout;             /* PLATE_LAYOUT_* */
+  int hole_corner;        /* PLATE_CORNER_* */
   int patch;              /* nonzero: uniform tension sigma_11 = sigma0 everywhere (its
                              tractions also on the hole) instead of Kirsch, a patch test
                              that quadratic shape functions must pass to round-off */
@@ -74,6 +95,10 @@ typedef struct {
  * r_{k+1} = r_k (1 + dtheta) on the axes, dtheta = pi / (2 (nt - 1)): locally square
  * cells near the hole. b = 10 a: nt = 11 -> 17 (209 particles), 21 -> 31 (677). */
 int plate_rings(double a, double b, int nt);
+
+/* Particles on each ray of the ray layouts for nt rays: 1 + 8 (nt - 1)/5, the paper's
+ * counts 188 = 11 x 17 + 1 and 686 ~ 21 x 33 (nt = 11 -> 17, 21 -> 33, 31 -> 49). */
+int plate_ray_particles(int nt);
 
 /* Defaults of paper 001 Sect. 6.3 (a = 1, b = 10, SSPH, E = 1, nu = 0.25, sigma0 = 1,
  * revised super Gauss a = 1.6, h_i = 1.5 Delta_i) with nt particles on the hole and nr
