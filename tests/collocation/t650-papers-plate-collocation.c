@@ -22,6 +22,9 @@
  *   rays on b = 5 to 8 (the standard b = 5 a of paper 000 included) and polar rays on
  *   b = 5: the quadratic fit is singular at some particles with h_i = 1.5 Delta_i
  *   (tested below).
+ *   rays b = 10 with other supports (not the paper's 1.5; recorded, not used):
+ *   h_i = 1.3 Delta_i singular; 1.7: 187: 0.0518 / 0.0578, 693: 0.0279 / 0.0311 (SSPH
+ *   below MSPH at both); 2.0: 0.0435 / 0.0664, 0.0137 / 0.0114.
  * The ruled rays match the paper's counts best (188 = 11 x 17 + 1, 686 ~ 21 x 33) and
  * b = 10 a is where their square cells end (plate.c); on them SSPH is above MSPH at
  * every resolution. Hole-corner rows (plate.h, PLATE_CORNER_*), rings 209 / 677:
@@ -32,8 +35,12 @@
  * 0.239 / 0.030 at 677; rays 187: 0.181 against 0.229) and the same gradient error at
  * the boundary (0.72 at 209); the largest solution errors sit on the hole near 45
  * degrees (u_1 off by 0.35 SSPH, 0.25 MSPH at 209), so the collocation system amplifies
- * SSPH's truncation error more than MSPH's at these resolutions. The norm with the
- * nodal values instead of the estimates differs by < 1 %. */
+ * SSPH's truncation error more than MSPH's at these resolutions. Split by rows (the
+ * error K^-1 r of each group's share of the residual r = f - K u_exact, axis norm of
+ * u_2): rings 209, hole rows 0.178 SSPH against 0.047 MSPH from equal residuals (0.52);
+ * rays 693, interior rows 0.0187 against 0.0098 from a smaller SSPH residual (0.157
+ * against 0.185). The norm with the nodal values instead of the estimates differs by
+ * < 1 %. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
