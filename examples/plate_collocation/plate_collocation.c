@@ -17,6 +17,13 @@
  * any b admissible, so b only sets the resolution and the length of the x_2 axis over
  * which the error is integrated (from a to b). --width changes it.
  *
+ * The arrangement (--layout): rings (default) or the ruled rays that the paper's counts
+ * suggest (188 = 11 x 17 + 1, 686 ~ 21 x 33), which on b = 10 a also have square cells
+ * along the axes and which cannot carry the quadratic basis with h_i = 1.5 Delta_i on
+ * the smaller standard plate b = 5 a (plate.c explains why). The note printed under the
+ * table records every arrangement measured; on none of them does SSPH beat MSPH at both
+ * of the paper's resolutions.
+ *
  * Reported per resolution and method: the error sqrt(int_a^b (u_2^h - u_2)^2 dx_2)
  * along the x_2 axis (trapezoidal rule over the particles on the axis; u_2^h the
  * SSPH/MSPH estimate, the nodal unknowns give the same to 2-3 digits), the same
@@ -61,7 +68,8 @@ static const char kNote[] =
     "  polar rays, b = 10:      187: 0.644 / 0.117   693: 0.0465 / 0.0384   1519: 0.0236 / 0.0205\n"
     "  rays or polar on the standard b = 5 (paper 000): singular supports with h = 1.5 Delta\n"
     "  (cells 4x longer across the rays than along them at the outer edges).\n"
-    "So SSPH <= MSPH (the paper's ordering) holds only on the rings from ~1500 particles.\n"
+    "So SSPH <= MSPH (the paper's ordering) holds only on the rings from ~1500 particles\n"
+    "(and, with h = 1.7 Delta instead of the paper's 1.5, on the rays at 187 and 693).\n"
     "Corner rows on the rings, 209 / 677: symmetry 0.079 / 0.081, 0.0208 / 0.0178;\n"
     "hole 0.088 / 0.088, 0.0201 / 0.0206; on the rays SSPH stays above MSPH with all three.\n"
     "SSPH's shape functions are not the cause: applied to the exact field their Navier\n"
