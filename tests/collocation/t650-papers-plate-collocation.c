@@ -17,6 +17,9 @@
  *   rings b = 5              142: 0.455 / 0.139   472: 0.0537 / 0.0111  1063: 0.0270 / 0.0092
  *   rays b = 10 (11x17 ...)  187: 0.149 / 0.131   693: 0.0487 / 0.0353  1519: 0.0236 / 0.0166
  *   polar rays b = 10        187: 0.644 / 0.117   693: 0.0465 / 0.0384  1519: 0.0236 / 0.0205
+ *   rays b = 10 with the axis ray's spacings as fractions on every ray (not the default
+ *   square cells at the whole hole): 187: 0.137 / 0.091, 693: 0.0518 / 0.0331, 1519:
+ *   0.0221 / 0.0097
  *   rays b = 9: 187: 0.150 / 0.132 (693 singular); b = 11: 0.141 / 0.123, 0.0438 / 0.0352;
  *   b = 12: 0.131 / 0.123, 0.0408 / 0.0310; b = 15: 0.119 / 0.127, 0.0359 / 0.0254
  *   rays on b = 5 to 8 (the standard b = 5 a of paper 000 included) and polar rays on
