@@ -135,11 +135,26 @@ double pivots(const Eigen::LDLT<M> &f) { return pivot_ratio(f.vectorD()); }
 template <class M>
 double pivots(const Eigen::PartialPivLU<M> &f) { return pivot_ratio(f.matrixLU().diagonal()); }
 
-// Eigen's rcond() estimate is blind to an exactly zero pivot (it reports 1 for
-// [[1,0],[0,0]]), so the smaller of it and the pivot ratio decides.
-template <class Solver>
-bool check_rcond(Site &s, const Solver &solver) {
-  double rc = solver.rcond();
+// The reciprocal 1-norm condition number 1 / (||A||_1 ||A^-1||_1), exact: the systems
+// are small (L <= 20), so the inverse costs a few solves, and the fast path
+// (shape_fast.cpp), which has the inverse anyway, gets the same number from one column
+// sum (Eigen's rcond() estimate, a lower bound of ||A^-1||_1, cost the fast path a tenth
+// of an MLS setup). It is blind to an exactly zero pivot (1 for [[1,0],[0,0]] when the
+// solve does not overflow), so the smaller of it and the pivot ratio decides.
+template <class MatA, class Solver>
+double rcond_exact(const MatA &A, const Solver &solver) {
+  const Eigen::Index L = A.rows();
+  const double anorm = A.cwiseAbs().colwise().sum().maxCoeff();
+  if (anorm == 0.0) return 0.0;
+  if (L == 1) return 1.0;
+  const MatA X = solver.solve(MatA::Identity(L, L));
+  const double xnorm = X.cwiseAbs().colwise().sum().maxCoeff();
+  return xnorm == 0.0 ? 0.0 : (1.0 / xnorm) / anorm;
+}
+
+template <class MatA, class Solver>
+bool check_rcond(Site &s, const MatA &A, const Solver &solver) {
+  double rc = rcond_exact(A, solver);
   if (!std::isfinite(rc)) rc = 0.0;
   rc = std::min(rc, pivots(solver));
   s.out.cond = rc > 0.0 ? 1.0 / rc : INFINITY;
@@ -224,7 +239,7 @@ int mls_fixed(Site &s, const Basis &B, bool rkpm) {
       for (int c = 0; c < D; ++c) Mi[c](a, b) = Mi[c](b, a) = mi[c][t];
     }
   Eigen::LDLT<MatL> ldlt(M);
-  if (ldlt.info() != Eigen::Success || !check_rcond(s, ldlt)) return MFREE_FAIL_SINGULAR;
+  if (ldlt.info() != Eigen::Success || !check_rcond(s, M, ldlt)) return MFREE_FAIL_SINGULAR;
 
   VecL e = VecL::Zero();
   e(0) = 1.0;
@@ -338,7 +353,7 @@ int taylor_fit(Site &s, int order, const double *omega) {
   }
   K.triangularView<Eigen::StrictlyUpper>() = K.transpose().triangularView<Eigen::StrictlyUpper>();
   Eigen::LDLT<Mat> ldlt(K);
-  if (ldlt.info() != Eigen::Success || !check_rcond(s, ldlt)) return MFREE_FAIL_SINGULAR;
+  if (ldlt.info() != Eigen::Success || !check_rcond(s, K, ldlt)) return MFREE_FAIL_SINGULAR;
   auto row = [&](int m, double scale, double *dst, int stride) {
     Vec e = Vec::Zero(L);
     e(m) = 1.0;
@@ -390,7 +405,7 @@ int msph(Site &s, int order) {
       for (int b = 0; b < L; ++b) K(a, b) += m[a] * p[b] * V;
   }
   Eigen::PartialPivLU<Mat> lu(K);
-  if (!check_rcond(s, lu)) return MFREE_FAIL_SINGULAR;
+  if (!check_rcond(s, K, lu)) return MFREE_FAIL_SINGULAR;
   const Mat Ki = lu.inverse();
   auto row = [&](int a, double scale, double *dst, int stride) {
     for (int j = 0; j < n; ++j) {
@@ -419,7 +434,7 @@ int correction_fixed(Site &s, const double *p, const double *q, double *coef) {
   for (int a = 0; a < M; ++a)
     for (int b = 0; b < M; ++b) A(a, b) = acc[a][b];
   Eigen::PartialPivLU<MatM> lu(A);
-  if (!check_rcond(s, lu)) return MFREE_FAIL_SINGULAR;
+  if (!check_rcond(s, A, lu)) return MFREE_FAIL_SINGULAR;
   const MatM C = lu.inverse().transpose();
   for (int a = 0; a < M; ++a)
     for (int b = 0; b < M; ++b) coef[a * M + b] = C(a, b);
