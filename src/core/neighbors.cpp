@@ -1,19 +1,23 @@
 // Cell-list neighbour search with variable support, three conventions, periodic axes.
 //
-// Cells have edge >= half the mean search radius; a query with radius R scans the cells
-// within R (gather: kappa h_i; symmetric-max: kappa max_j h_j, filtered by
-// max(h_i, h_j); symmetric-mean: kappa (h_i + max h)/2, filtered by the mean), so
-// uniform supports cost a 5^dim stencil and strongly variable ones stay correct. The
-// same grid answers queries from the particles themselves and from host points.
+// Cells have edge >= half the mean search radius (a quarter along x, where a stencil
+// row is one contiguous range and finer cells only trim it); a query with radius R
+// scans the cells within R (gather: kappa h_i; symmetric-max: kappa max_j h_j, filtered
+// by max(h_i, h_j); symmetric-mean: kappa (h_i + max h)/2, filtered by the mean), so
+// uniform supports cost a 9 x 5^(dim-1) stencil and strongly variable ones stay correct.
+// The same grid answers queries from the particles themselves and from host points.
 //
-// Speed: the particles are counting-sorted by cell (row-major cell order, x fastest) and
-// their coordinates and radii copied in that order (SoA), so that the cells of one
-// stencil row are one contiguous range scanned by a branch-light loop. Queries run in
-// cell order too (neighbouring queries share cache lines), in static blocks over the
-// context's threads, each into its own buffer; the rows are then placed by host index.
-// The permutation never leaves this file: rows hold host indices, sorted ascending --
-// for a symmetric relation by transposing the unsorted rows (no comparisons, see
-// run_queries), otherwise by sorting each row.
+// Speed: the particles are counting-sorted by cell (row-major cell order, x fastest;
+// per-thread histograms, so the sort is parallel and its result does not depend on the
+// thread count) and their coordinates and radii copied in that order (SoA), so that
+// the cells of one stencil row are one contiguous range scanned by a branch-free loop.
+// Queries run in cell order too (neighbouring queries share cache lines), in static
+// blocks over the context's threads, each into its own buffer; the rows are then placed
+// by host index. The permutation never leaves this file: rows hold host indices, sorted
+// ascending -- for a symmetric relation by transposing the unsorted rows (no
+// comparisons, see run_queries), otherwise by sorting each row. A particle set keeps
+// the grid and the buffers between searches (NeighborScratch), so a repeated search
+// allocates nothing and touches no new pages once the sizes have settled.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -30,9 +34,10 @@ namespace mfree {
 namespace {
 
 // Row buffers are written before they are read: growing them need not zero the new
-// entries (a std::vector value-initialises them; that memset was ~4 % of a 3D search).
+// entries (a value-initialising vector's memset was ~4 % of a 3D search). Storage comes
+// from the context's allocator hook, like the lists themselves.
 template <class T>
-struct NoInitAlloc : std::allocator<T> {
+struct NoInitAlloc : HostAllocator<T> {
   template <class U>
   struct rebind {
     using other = NoInitAlloc<U>;
@@ -49,7 +54,9 @@ struct NoInitAlloc : std::allocator<T> {
     ::new (static_cast<void *>(p)) U(std::forward<A>(a)...);
   }
 };
-using RowBuf = std::vector<int32_t, NoInitAlloc<int32_t>>;
+template <class T>
+using Buf = std::vector<T, NoInitAlloc<T>>;
+using RowBuf = Buf<int32_t>;
 
 // Query radius and pair limit of a site with search radius ri under the convention.
 struct Rule {
@@ -63,14 +70,26 @@ struct Rule {
   }
 };
 
+// Work split into `nchunks` fixed chunks (chunk v: thread_block(count, v, nchunks)), run
+// by however many threads the runtime grants: passes that must see the same blocks
+// (histogram, then scatter) agree even if a team comes out smaller than asked.
+template <class Body>
+void for_chunks(int nchunks, Body &&body) {
+  parallel_blocks(nchunks, nchunks, [&](int, int64_t b, int64_t e) {
+    for (int64_t v = b; v < e; ++v) body(static_cast<int>(v));
+  });
+}
+
 class CellGrid {
  public:
-  CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status);
+  // (Re)build for the valid particles of ps; keeps the buffers' capacity.
+  void build(const ParticleSet &ps, const std::vector<int32_t> &status);
 
   bool empty() const { return nvalid_ == 0; }
   double rmax() const { return rmax_; }
   double radius(int32_t j) const { return rad_[j]; }
-  int64_t num_cells() const { return static_cast<int64_t>(start_.size()) - 1; }
+  bool uniform() const { return uniform_; }
+  int64_t num_cells() const { return ncells_; }
 
   // Wrap a coordinate into the periodic box along periodic axes.
   double wrap(double x, int c) const {
@@ -83,12 +102,25 @@ class CellGrid {
     return index(k);
   }
   // Host indices of the valid particles in cell order.
-  const std::vector<int32_t> &members() const { return id_; }
+  const int32_t *members() const { return id_.data(); }
+  int32_t num_valid() const { return nvalid_; }
 
   // Write to row[cnt...] every valid particle j with squared distance to xq (wrapped)
   // within the rule's limit for a site of radius ri, growing row as needed; cnt is
   // advanced past them (row may hold junk beyond cnt).
-  void query(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const;
+  void query(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const {
+    if (nvalid_ == 0) return;
+    const bool g = rule.conv == MFREE_SEARCH_GATHER;
+    switch (dim_ * 4 + (any_periodic_ ? 2 : 0) + (g ? 1 : 0)) {
+#define MFREE_QUERY(D, P, G) \
+  case D * 4 + (P ? 2 : 0) + (G ? 1 : 0): query_t<D, P, G>(xq, ri, rule, row, cnt); break;
+      MFREE_QUERY(1, false, false) MFREE_QUERY(1, false, true) MFREE_QUERY(1, true, false) MFREE_QUERY(1, true, true)
+      MFREE_QUERY(2, false, false) MFREE_QUERY(2, false, true) MFREE_QUERY(2, true, false) MFREE_QUERY(2, true, true)
+      MFREE_QUERY(3, false, false) MFREE_QUERY(3, false, true) MFREE_QUERY(3, true, false) MFREE_QUERY(3, true, true)
+#undef MFREE_QUERY
+      default: break;
+    }
+  }
 
  private:
   int64_t coord(double x, int c) const {
@@ -108,62 +140,98 @@ class CellGrid {
     for (int c = dim_ - 1; c >= 0; --c) id = id * nc_[c] + k[c];
     return id;
   }
-  void scan_range(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
-                  RowBuf &row, size_t &cnt) const {
-    const bool g = rule.conv == MFREE_SEARCH_GATHER;
-    switch (dim_ * 4 + (any_periodic_ ? 2 : 0) + (g ? 1 : 0)) {
-#define MFREE_SCAN(D, P, G) \
-  case D * 4 + (P ? 2 : 0) + (G ? 1 : 0): scan<D, P, G>(xq, ri, rule, p0, p1, row, cnt); break;
-      MFREE_SCAN(1, false, false) MFREE_SCAN(1, false, true) MFREE_SCAN(1, true, false) MFREE_SCAN(1, true, true)
-      MFREE_SCAN(2, false, false) MFREE_SCAN(2, false, true) MFREE_SCAN(2, true, false) MFREE_SCAN(2, true, true)
-      MFREE_SCAN(3, false, false) MFREE_SCAN(3, false, true) MFREE_SCAN(3, true, false) MFREE_SCAN(3, true, true)
-#undef MFREE_SCAN
-      default: break;
-    }
-  }
   template <int D, bool Periodic, bool Gather>
-  void scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
-            RowBuf &row, size_t &cnt) const;
+  void query_t(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const;
+  template <int D, bool Periodic, bool Gather>
+  size_t scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1, int32_t *out,
+              size_t k) const;
 
-  int dim_;
+  int dim_ = 1;
   double lo_[3] = {0, 0, 0}, cell_[3] = {1, 1, 1}, L_[3] = {0, 0, 0};
   double margin_[3] = {0, 0, 0};  // slack of the geometric cell bounds (query)
   int64_t nc_[3] = {1, 1, 1};
+  int64_t ncells_ = 1;
   bool periodic_[3] = {false, false, false};
   bool any_periodic_ = false;
+  bool uniform_ = true;  // one search radius for every valid particle
   double rmax_ = 0.0;
   int32_t nvalid_ = 0;
-  std::vector<double> rad_;                 // by host index
-  std::vector<double> sx_[3], srad_;        // by cell order
-  std::vector<int32_t> id_;                 // host index by cell order
-  std::vector<int64_t> start_;              // cell c holds [start_[c], start_[c+1])
+  Buf<double> rad_;              // by host index
+  Buf<double> sx_[3], srad_;     // by cell order, one padding entry at the end
+  Buf<int32_t> id_;              // host index by cell order, one padding entry
+  Buf<int64_t> start_;           // cell c holds [start_[c], start_[c+1])
+  Buf<int64_t> cell_idx_;        // cell of each host index (-1: invalid)
+  Buf<int32_t> hist_;            // per-chunk cell counts, then fill positions
 };
 
-CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : dim_(ps.dim()) {
+void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) {
+  dim_ = ps.dim();
   const int32_t n = ps.size();
   const double kappa = ps.kappa();
-  for (int c = 0; c < dim_; ++c) {
-    periodic_[c] = ps.periodic(c);
+  any_periodic_ = false;
+  for (int c = 0; c < 3; ++c) {
+    periodic_[c] = c < dim_ && ps.periodic(c);
     any_periodic_ = any_periodic_ || periodic_[c];
-    if (periodic_[c]) {
-      lo_[c] = ps.box_lo(c);
-      L_[c] = ps.box_hi(c) - ps.box_lo(c);
-    }
+    lo_[c] = periodic_[c] ? ps.box_lo(c) : 0.0;
+    L_[c] = periodic_[c] ? ps.box_hi(c) - ps.box_lo(c) : 0.0;
+    cell_[c] = 1.0;
+    nc_[c] = 1;
+    margin_[c] = 0.0;
   }
-  rad_.assign(n, 0.0);
-  double rsum = 0.0, bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};
-  for (int32_t i = 0; i < n; ++i) {
-    if (status[i] != 0) continue;
-    rad_[i] = kappa * ps.h(i);
-    rmax_ = std::max(rmax_, rad_[i]);
-    rsum += rad_[i];
+  rmax_ = 0.0;
+  nvalid_ = 0;
+  uniform_ = true;
+  ncells_ = 1;
+  rad_.resize(static_cast<size_t>(n));
+
+  // Pass 1 over fixed chunks: radii, bounding box, sum and maximum of the radii.
+  const int nch = std::min(num_threads(n), 64);
+  struct Part {
+    double rsum = 0.0, rmin = 0.0, rmax = 0.0, bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};
+    int32_t count = 0;
+  };
+  Part part[64];
+  for_chunks(nch, [&](int v) {
+    int64_t b, e;
+    thread_block(n, v, nch, b, e);
+    Part &p = part[v];
+    for (int64_t i = b; i < e; ++i) {
+      if (status[i] != 0) {
+        rad_[i] = 0.0;
+        continue;
+      }
+      const double r = kappa * ps.h(static_cast<int32_t>(i));
+      rad_[i] = r;
+      if (p.count == 0 || r < p.rmin) p.rmin = r;
+      if (r > p.rmax) p.rmax = r;
+      p.rsum += r;
+      for (int c = 0; c < dim_; ++c) {
+        const double x = wrap(ps.x(static_cast<int32_t>(i), c), c);
+        if (p.count == 0 || x < p.bmin[c]) p.bmin[c] = x;
+        if (p.count == 0 || x > p.bmax[c]) p.bmax[c] = x;
+      }
+      ++p.count;
+    }
+  });
+  double rsum = 0.0, rmin = 0.0, bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};
+  for (int v = 0; v < nch; ++v) {
+    const Part &p = part[v];
+    if (p.count == 0) continue;
     for (int c = 0; c < dim_; ++c) {
-      const double x = wrap(ps.x(i, c), c);
-      if (nvalid_ == 0 || x < bmin[c]) bmin[c] = x;
-      if (nvalid_ == 0 || x > bmax[c]) bmax[c] = x;
+      if (nvalid_ == 0 || p.bmin[c] < bmin[c]) bmin[c] = p.bmin[c];
+      if (nvalid_ == 0 || p.bmax[c] > bmax[c]) bmax[c] = p.bmax[c];
     }
-    ++nvalid_;
+    if (nvalid_ == 0 || p.rmin < rmin) rmin = p.rmin;
+    rmax_ = std::max(rmax_, p.rmax);
+    rsum += p.rsum;  // chunk sums: the cell edge may differ in the last bit between thread
+                     // counts, the lists cannot (they are sets, sorted)
+    nvalid_ += p.count;
   }
+  uniform_ = rmin == rmax_;
+  start_.assign(2, 0);
+  id_.assign(1, 0);
+  for (int c = 0; c < 3; ++c) sx_[c].assign(1, 0.0);
+  srad_.assign(1, 0.0);
   if (nvalid_ == 0) return;
 
   for (int c = 0; c < dim_; ++c)
@@ -171,124 +239,189 @@ CellGrid::CellGrid(const ParticleSet &ps, const std::vector<int32_t> &status) : 
       std::ostringstream s;
       s << "support radius kappa*h = " << rmax_ << " is not below half the periodic box length "
         << L_[c] << " on axis " << c;
+      nvalid_ = 0;
       throw Error(MFREE_ERR_INPUT, s.str());
     }
 
-  // Cell edge: half the mean radius, enlarged so that the grid has at most ~2 cells per
-  // particle (clustered or far-flung particles would otherwise make it huge). Enlarge
-  // until the grid fits (one particle at 1e15 needs more than 64 steps); an extent whose
-  // cell count is not a finite double gets one cell, which is always correct because
-  // coordinates are clamped into the grid, and never reaches an out-of-range cast.
+  // Cell edge: half the mean radius (a quarter along x), enlarged so that the grid has
+  // at most ~2 cells per particle (clustered or far-flung particles would otherwise make
+  // it huge). Enlarge until the grid fits (one particle at 1e15 needs more than 64
+  // steps); an extent whose cell count is not a finite double gets one cell, which is
+  // always correct because coordinates are clamped into the grid, and never reaches an
+  // out-of-range cast.
   double edge = 0.5 * rsum / static_cast<double>(nvalid_);
   const double max_cells = 2.0 * static_cast<double>(nvalid_) + 64.0;
-  auto span = [&edge](double ext) {
-    const double k = std::floor(ext / edge);
+  auto span = [](double ext, double e) {
+    const double k = std::floor(ext / e);
     return std::isfinite(k) ? k : 0.0;
   };
+  auto edge_of = [&edge](int c) { return c == 0 ? 0.5 * edge : edge; };
   for (;;) {
     double total = 1.0;
     for (int c = 0; c < dim_; ++c) {
       const double ext = periodic_[c] ? L_[c] : bmax[c] - bmin[c];
-      total *= std::max(1.0, span(ext));
+      total *= std::max(1.0, span(ext, edge_of(c)));
     }
     if (total <= max_cells) break;
     edge *= 1.5;
   }
   for (int c = 0; c < dim_; ++c) {
     if (periodic_[c]) {
-      nc_[c] = std::max<int64_t>(1, static_cast<int64_t>(span(L_[c])));
+      nc_[c] = std::max<int64_t>(1, static_cast<int64_t>(span(L_[c], edge_of(c))));
       cell_[c] = L_[c] / static_cast<double>(nc_[c]);
     } else {
       lo_[c] = bmin[c];
-      nc_[c] = static_cast<int64_t>(span(bmax[c] - bmin[c])) + 1;
-      cell_[c] = edge;
+      nc_[c] = static_cast<int64_t>(span(bmax[c] - bmin[c], edge_of(c))) + 1;
+      cell_[c] = edge_of(c);
     }
   }
-  int64_t ncells = 1;
-  for (int c = 0; c < dim_; ++c) ncells *= nc_[c];
+  ncells_ = 1;
+  for (int c = 0; c < dim_; ++c) ncells_ *= nc_[c];
   // A particle's cell index floor((x - lo) / cell) may be off by one for x within a few
   // ulps of a cell face; 1e-10 of the grid's scale covers that with room to spare.
   for (int c = 0; c < dim_; ++c)
     margin_[c] = 1e-10 * (std::fabs(lo_[c]) + static_cast<double>(nc_[c]) * cell_[c]);
 
-  // Counting sort of the valid particles by cell (stable: ascending index in a cell).
-  std::vector<int64_t> cell(n, -1);
-  start_.assign(static_cast<size_t>(ncells) + 1, 0);
-  for (int32_t i = 0; i < n; ++i) {
-    if (status[i] != 0) continue;
-    double x[3] = {0, 0, 0};
-    for (int c = 0; c < dim_; ++c) x[c] = wrap(ps.x(i, c), c);
-    cell[i] = cell_of(x);
-    ++start_[cell[i] + 1];
+  // Counting sort of the valid particles by cell, stable (ascending host index in a
+  // cell) for any chunk count: chunk v's particles follow chunk v-1's in every cell.
+  const int64_t nc = ncells_;
+  cell_idx_.resize(static_cast<size_t>(n));
+  start_.resize(static_cast<size_t>(nc) + 1);
+  id_.resize(static_cast<size_t>(nvalid_) + 1);
+  srad_.resize(static_cast<size_t>(nvalid_) + 1);
+  for (int c = 0; c < dim_; ++c) sx_[c].resize(static_cast<size_t>(nvalid_) + 1);
+  id_[nvalid_] = 0;  // padding read by the two-lane scan
+  srad_[nvalid_] = 0.0;
+  for (int c = 0; c < dim_; ++c) sx_[c][nvalid_] = 0.0;
+  int64_t *cell = cell_idx_.data();
+  // (per-chunk histograms only while they stay small against the particle count)
+  if (nch == 1 || static_cast<double>(nch) * static_cast<double>(nc) > 8.0 * (static_cast<double>(n) + 4096.0)) {
+    std::fill(start_.begin(), start_.end(), 0);
+    for (int32_t i = 0; i < n; ++i) {
+      if (status[i] != 0) {
+        cell[i] = -1;
+        continue;
+      }
+      double x[3] = {0, 0, 0};
+      for (int c = 0; c < dim_; ++c) x[c] = wrap(ps.x(i, c), c);
+      cell[i] = cell_of(x);
+      ++start_[cell[i] + 1];
+    }
+    for (int64_t c = 0; c < nc; ++c) start_[c + 1] += start_[c];
+    for (int32_t i = 0; i < n; ++i) {
+      if (cell[i] < 0) continue;
+      const int64_t p = start_[cell[i]]++;
+      id_[p] = i;
+      srad_[p] = rad_[i];
+      for (int c = 0; c < dim_; ++c) sx_[c][p] = wrap(ps.x(i, c), c);
+    }
+    // start_[c] now holds the old start_[c + 1]: shift back
+    for (int64_t c = nc; c > 0; --c) start_[c] = start_[c - 1];
+    start_[0] = 0;
+    return;
   }
-  for (int64_t c = 0; c < ncells; ++c) start_[c + 1] += start_[c];
-  id_.resize(nvalid_);
-  srad_.resize(nvalid_);
-  for (int c = 0; c < dim_; ++c) sx_[c].resize(nvalid_);
-  std::vector<int64_t> fill(start_.begin(), start_.end() - 1);
-  for (int32_t i = 0; i < n; ++i) {
-    if (cell[i] < 0) continue;
-    const int64_t p = fill[cell[i]]++;
-    id_[p] = i;
-    srad_[p] = rad_[i];
-    for (int c = 0; c < dim_; ++c) sx_[c][p] = wrap(ps.x(i, c), c);
-  }
+  // chunk counts (nvalid < 2^31, so every count and position fits 32 bits)
+  hist_.resize(static_cast<size_t>(nch) * static_cast<size_t>(nc));
+  int32_t *hist = hist_.data();
+  for_chunks(nch, [&](int v) {
+    int32_t *h = hist + static_cast<int64_t>(v) * nc;
+    std::fill(h, h + nc, 0);
+    int64_t b, e;
+    thread_block(n, v, nch, b, e);
+    for (int64_t i = b; i < e; ++i) {
+      if (status[i] != 0) {
+        cell[i] = -1;
+        continue;
+      }
+      double x[3] = {0, 0, 0};
+      for (int c = 0; c < dim_; ++c) x[c] = wrap(ps.x(static_cast<int32_t>(i), c), c);
+      cell[i] = cell_of(x);
+      ++h[cell[i]];
+    }
+  });
+  // prefix sums over (cell, chunk), two passes over cell blocks
+  int64_t block_total[64];
+  for_chunks(nch, [&](int v) {
+    int64_t b, e, s = 0;
+    thread_block(nc, v, nch, b, e);
+    for (int64_t c = b; c < e; ++c)
+      for (int u = 0; u < nch; ++u) s += hist[static_cast<int64_t>(u) * nc + c];
+    block_total[v] = s;
+  });
+  for (int v = 1; v < nch; ++v) block_total[v] += block_total[v - 1];
+  for_chunks(nch, [&](int v) {
+    int64_t b, e, s = v > 0 ? block_total[v - 1] : 0;
+    thread_block(nc, v, nch, b, e);
+    for (int64_t c = b; c < e; ++c) {
+      start_[c] = s;
+      for (int u = 0; u < nch; ++u) {
+        int32_t &h = hist[static_cast<int64_t>(u) * nc + c];
+        const int32_t cnt = h;
+        h = static_cast<int32_t>(s);
+        s += cnt;
+      }
+    }
+  });
+  start_[nc] = nvalid_;
+  for_chunks(nch, [&](int v) {
+    int32_t *f = hist + static_cast<int64_t>(v) * nc;
+    int64_t b, e;
+    thread_block(n, v, nch, b, e);
+    for (int64_t i = b; i < e; ++i) {
+      if (cell[i] < 0) continue;
+      const int32_t p = f[cell[i]]++;
+      id_[p] = static_cast<int32_t>(i);
+      srad_[p] = rad_[i];
+      for (int c = 0; c < dim_; ++c) sx_[c][p] = wrap(ps.x(static_cast<int32_t>(i), c), c);
+    }
+  });
 }
 
+// Members [p0, p1) within the limit of xq, written from out[k]; returns the new count.
+// out must have room for p1 - p0 + 1 entries from k.
 template <int D, bool Periodic, bool Gather>
-void CellGrid::scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
-                    RowBuf &row, size_t &cnt) const {
-  if (row.size() < cnt + static_cast<size_t>(p1 - p0)) row.resize(2 * (cnt + static_cast<size_t>(p1 - p0)));
-  int32_t *out = row.data();
-  size_t k = cnt;
+size_t CellGrid::scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1,
+                      int32_t *out, size_t k) const {
   const double lim2 = ri * ri * (1.0 + kEdgeTol2);
-  const double *x0 = sx_[0].data(), *x1 = sx_[1].data(), *x2 = sx_[2].data();
+  const double *x0 = sx_[0].data(), *x1 = sx_[D > 1 ? 1 : 0].data(), *x2 = sx_[D > 2 ? 2 : 0].data();
   const int32_t *id = id_.data();
   int64_t p = p0;
 #if defined(__GNUC__)
   if (!Periodic && Gather) {
     // Two candidates per step (GCC/Clang vector extensions: SSE2 on x86-64, NEON on
-    // arm64), the last odd one in lane 0 of a pair too, so that every pair goes through
-    // the same instructions (the symmetric transposition in run_queries needs the test
-    // to give the same answer for (i, j) and (j, i), also under FMA contraction). Lane
-    // arithmetic is that of the scalar loop: ((d0^2 + d1^2) + d2^2) <= lim2.
+    // arm64); an odd range reads one member past its end (the next cell's, or the
+    // padding entry) and takes it back, so that every pair goes through the same
+    // instructions (the symmetric transposition in run_queries needs the test to give
+    // the same answer for (i, j) and (j, i), also under FMA contraction). Lane
+    // arithmetic: ((d0^2 + d1^2) + d2^2) <= lim2.
     typedef double v2d __attribute__((vector_size(16)));
     typedef long long v2l __attribute__((vector_size(16)));
     const v2d q0 = {xq[0], xq[0]}, q1 = {D > 1 ? xq[1] : 0.0, D > 1 ? xq[1] : 0.0},
               q2 = {D > 2 ? xq[2] : 0.0, D > 2 ? xq[2] : 0.0}, lv = {lim2, lim2};
-    auto test = [&](const v2d &a0, const v2d &a1, const v2d &a2) {
+    v2l m = {0, 0};
+    for (; p < p1; p += 2) {
+      v2d a0, a1, a2;
+      std::memcpy(&a0, x0 + p, sizeof a0);
       const v2d e0 = q0 - a0;
       v2d d2 = e0 * e0;
       if (D > 1) {
+        std::memcpy(&a1, x1 + p, sizeof a1);
         const v2d e1 = q1 - a1;
         d2 = d2 + e1 * e1;
       }
       if (D > 2) {
+        std::memcpy(&a2, x2 + p, sizeof a2);
         const v2d e2 = q2 - a2;
         d2 = d2 + e2 * e2;
       }
-      return static_cast<v2l>(d2 <= lv);  // lanes: -1 hit, 0 miss
-    };
-    for (; p + 2 <= p1; p += 2) {
-      v2d a0, a1 = {0, 0}, a2 = {0, 0};
-      std::memcpy(&a0, x0 + p, sizeof a0);
-      if (D > 1) std::memcpy(&a1, x1 + p, sizeof a1);
-      if (D > 2) std::memcpy(&a2, x2 + p, sizeof a2);
-      const v2l m = test(a0, a1, a2);
+      m = static_cast<v2l>(d2 <= lv);  // lanes: -1 hit, 0 miss
       out[k] = id[p];
       k -= static_cast<size_t>(m[0]);
       out[k] = id[p + 1];
       k -= static_cast<size_t>(m[1]);
     }
-    if (p < p1) {
-      const v2d a0 = {x0[p], x0[p]}, a1 = {D > 1 ? x1[p] : 0.0, D > 1 ? x1[p] : 0.0},
-                a2 = {D > 2 ? x2[p] : 0.0, D > 2 ? x2[p] : 0.0};
-      const v2l m = test(a0, a1, a2);
-      out[k] = id[p];
-      k -= static_cast<size_t>(m[0]);
-    }
-    cnt = k;
-    return;
+    if (p > p1) k += static_cast<size_t>(m[1]);  // the member past the range
+    return k;
   }
 #endif
   // every candidate is written, the count advances only for a hit (no branch)
@@ -306,12 +439,11 @@ void CellGrid::scan(const double *xq, double ri, const Rule &rule, int64_t p0, i
       k += d2 <= l * l * (1.0 + kEdgeTol2);
     }
   }
-  cnt = k;
+  return k;
 }
 
-void CellGrid::query(const double *xq, double ri, const Rule &rule, RowBuf &row,
-                     size_t &cnt) const {
-  if (nvalid_ == 0) return;
+template <int D, bool Periodic, bool Gather>
+void CellGrid::query_t(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const {
   const double R = rule.query(ri) * (1.0 + 1e-12);  // closed supports (kEdgeTol)
   const double R2 = R * R;
   // Cell ranges per axis: [k(x - R), k(x + R)] clamped, [k - m, k + m] on a periodic
@@ -319,8 +451,8 @@ void CellGrid::query(const double *xq, double ri, const Rule &rule, RowBuf &row,
   // geometric pruning along that axis, the pair test takes the nearest image).
   int64_t kmin[3] = {0, 0, 0}, kmax[3] = {0, 0, 0};
   bool full[3] = {false, false, false};
-  for (int c = 0; c < dim_; ++c) {
-    if (periodic_[c]) {
+  for (int c = 0; c < D; ++c) {
+    if (Periodic && periodic_[c]) {
       const int64_t kc = coord(xq[c], c);
       const int64_t m = static_cast<int64_t>(std::ceil(R / cell_[c]));
       if (2 * m + 1 >= nc_[c]) {
@@ -340,7 +472,7 @@ void CellGrid::query(const double *xq, double ri, const Rule &rule, RowBuf &row,
   // for every particle stored in it: shrunk by a margin far above the rounding of the
   // cell index, so that no pair at the closed edge is lost.
   auto gap2 = [&](int c, int64_t k) {
-    if (full[c]) return 0.0;
+    if (Periodic && full[c]) return 0.0;
     const double a = lo_[c] + static_cast<double>(k) * cell_[c], b = a + cell_[c];
     double g = std::max(a - xq[c], xq[c] - b) - margin_[c];
     g = g > 0.0 ? g : 0.0;
@@ -350,7 +482,7 @@ void CellGrid::query(const double *xq, double ri, const Rule &rule, RowBuf &row,
   // where a periodic range wraps. (Trimming them to the sphere's chord per row costs a
   // square root and two divisions, more than the few candidates it saves.)
   int64_t seg[2][2] = {{kmin[0], kmax[0]}, {0, -1}};
-  if (periodic_[0]) {
+  if (Periodic && periodic_[0]) {
     if (kmin[0] < 0) {
       seg[0][0] = 0;
       seg[1][0] = kmin[0] + nc_[0];
@@ -361,21 +493,40 @@ void CellGrid::query(const double *xq, double ri, const Rule &rule, RowBuf &row,
       seg[1][1] = kmax[0] - nc_[0];
     }
   }
-  const int nseg = seg[1][1] >= seg[1][0] ? 2 : 1;
+  const int nseg = Periodic && seg[1][1] >= seg[1][0] ? 2 : 1;
+  // Room for every member the rows can hold (+1 for the two-lane scan's overrun). Without
+  // periodic axes the scanned rows lie between the stencil's first and last cell in cell
+  // order, so one check per query suffices.
+  const int64_t *st = start_.data();
+  bool checked = false;
+  if (!Periodic) {
+    const int64_t need = static_cast<int64_t>(cnt) + st[index(kmax) + 1] - st[index(kmin)] + 1;
+    if (static_cast<int64_t>(row.size()) < need) row.resize(2 * static_cast<size_t>(need));
+    checked = true;
+  }
+  int32_t *out = row.data();
+  size_t k = cnt;
   // rows of cells whose slab misses the query's sphere are skipped (the corners of the
-  // 5^dim stencil)
+  // stencil)
   for (int64_t k2 = kmin[2]; k2 <= kmax[2]; ++k2) {
-    const double gz = dim_ > 2 ? gap2(2, k2) : 0.0;
+    const double gz = D > 2 ? gap2(2, k2) : 0.0;
     if (gz > R2) continue;
-    const int64_t w2 = periodic_[2] ? ((k2 % nc_[2]) + nc_[2]) % nc_[2] : k2;
+    const int64_t w2 = Periodic && periodic_[2] ? ((k2 % nc_[2]) + nc_[2]) % nc_[2] : k2;
     for (int64_t k1 = kmin[1]; k1 <= kmax[1]; ++k1) {
-      if (dim_ > 1 && gz + gap2(1, k1) > R2) continue;
-      const int64_t w1 = periodic_[1] ? ((k1 % nc_[1]) + nc_[1]) % nc_[1] : k1;
+      if (D > 1 && gz + gap2(1, k1) > R2) continue;
+      const int64_t w1 = Periodic && periodic_[1] ? ((k1 % nc_[1]) + nc_[1]) % nc_[1] : k1;
       const int64_t base = (w2 * nc_[1] + w1) * nc_[0];
-      for (int sg = 0; sg < nseg; ++sg)
-        scan_range(xq, ri, rule, start_[base + seg[sg][0]], start_[base + seg[sg][1] + 1], row, cnt);
+      for (int sg = 0; sg < nseg; ++sg) {
+        const int64_t p0 = st[base + seg[sg][0]], p1 = st[base + seg[sg][1] + 1];
+        if (!checked && row.size() < k + static_cast<size_t>(p1 - p0) + 1) {
+          row.resize(2 * (k + static_cast<size_t>(p1 - p0) + 1));
+          out = row.data();
+        }
+        k = scan<D, Periodic, Gather>(xq, ri, rule, p0, p1, out, k);
+      }
     }
   }
+  cnt = k;
 }
 
 // Rows are short (tens) and, for particles stored in lattice or cell order, nearly
@@ -392,6 +543,29 @@ void sort_row(int32_t *b, int32_t *e) {
   }
 }
 
+struct Slot {
+  int64_t next, end;
+};
+
+}  // namespace
+
+// Buffers of a search, kept by a particle set between searches (sizes settle after the
+// first; a repeated search then allocates nothing), or local to one host-point search.
+struct NeighborScratch {
+  CellGrid grid;
+  Buf<int32_t> order;
+  RowBuf buf[64];
+  Buf<int64_t> first, rowptr;
+  Buf<int32_t> lo_hi;
+  Buf<const int32_t *> src;
+  Buf<Slot> slot;
+};
+
+NeighborScratch *new_neighbor_scratch() { return new NeighborScratch; }
+void NeighborScratchDeleter::operator()(NeighborScratch *s) const { delete s; }
+
+namespace {
+
 // Rows for nsites sites visited in `order`: site(s, x) writes the wrapped position of
 // site s and returns its search radius, or a negative value for a site without a row.
 // Each thread searches a static block of `order` into its own buffer; the rows are
@@ -405,22 +579,33 @@ void sort_row(int32_t *b, int32_t *e) {
 // symmetric: x_i - x_j = -(x_j - x_i) in IEEE arithmetic, also after the periodic
 // shift). Each thread fills a static block of rows, visiting the sources that can reach
 // it. Otherwise each row is sorted where it was found.
+//
+// out is written only after every buffer is in place (its capacity reserved first), so
+// an exception (no memory) leaves it unchanged.
 template <class Site>
-void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const std::vector<int32_t> &order,
-                 bool symmetric, Site &&site, Csr &out) {
-  out.rowptr.assign(static_cast<size_t>(nsites) + 1, 0);
-  out.cols.clear();
-  if (grid.empty() || order.empty()) return;
-  const int64_t nq = static_cast<int64_t>(order.size());
-  const int nt = num_threads(nq);
-  std::vector<RowBuf> buf(nt);
-  std::vector<int64_t> first(static_cast<size_t>(nq) + 1, 0);  // offsets into the buffers
+void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool symmetric, Site &&site, Csr &out) {
+  const CellGrid &grid = sc.grid;
+  const int64_t nq = static_cast<int64_t>(sc.order.size());
+  if (grid.empty() || nq == 0) {
+    out.rowptr.reserve(static_cast<size_t>(nsites) + 1);
+    out.rowptr.assign(static_cast<size_t>(nsites) + 1, 0);
+    out.cols.clear();
+    return;
+  }
+  const int32_t *order = sc.order.data();
+  const int nt = std::min(num_threads(nq), 64);
+  Buf<int64_t> &first = sc.first;  // offsets into the buffers
+  first.resize(static_cast<size_t>(nq) + 1);
   // smallest and largest member of each row, for the threads of the transposition
   const bool track = symmetric && num_threads(nsites) > 1 && nt > 1;
-  std::vector<int32_t> lo_hi(track ? 2 * static_cast<size_t>(nsites) : 0);
-  parallel_blocks(nq, nt, [&](int t, int64_t b, int64_t e) {
-    RowBuf &cols = buf[t];
-    cols.resize(static_cast<size_t>((e - b) * 32 + 64));
+  if (track) sc.lo_hi.resize(2 * static_cast<size_t>(nsites));
+  int32_t *lo_hi = sc.lo_hi.data();
+  size_t used[64];
+  for_chunks(nt, [&](int t) {
+    int64_t b, e;
+    thread_block(nq, t, nt, b, e);
+    RowBuf &cols = sc.buf[t];
+    if (cols.size() < static_cast<size_t>((e - b) * 32 + 64)) cols.resize(static_cast<size_t>((e - b) * 32 + 64));
     size_t cnt = 0;
     for (int64_t q = b; q < e; ++q) {
       const int32_t s = order[q];
@@ -442,27 +627,39 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
         lo_hi[2 * static_cast<size_t>(s) + 1] = z;
       }
     }
-    cols.resize(cnt);
+    used[t] = cnt;
   });
   // row lengths by site, then prefix sums; each block knows its own buffer's end
-  std::vector<const int32_t *> src(symmetric ? static_cast<size_t>(nsites) : 0, nullptr);
-  for (int t = 0; t < nt; ++t) {
+  sc.rowptr.resize(static_cast<size_t>(nsites) + 1);
+  int64_t *rp = sc.rowptr.data();
+  std::fill(rp, rp + nsites + 1, 0);
+  if (symmetric) sc.src.resize(static_cast<size_t>(nsites));
+  const int32_t **src = sc.src.data();
+  for_chunks(nt, [&](int t) {
     int64_t b, e;
     thread_block(nq, t, nt, b, e);
     for (int64_t q = b; q < e; ++q) {
-      const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(buf[t].size());
-      out.rowptr[order[q] + 1] = end - first[q];
-      if (symmetric) src[order[q]] = buf[t].data() + first[q];
+      const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(used[t]);
+      rp[order[q] + 1] = end - first[q];
+      if (symmetric) src[order[q]] = sc.buf[t].data() + first[q];
     }
-  }
-  for (int32_t s = 0; s < nsites; ++s) out.rowptr[s + 1] += out.rowptr[s];
-  out.cols.resize(static_cast<size_t>(out.rowptr[nsites]));
+  });
+  for (int32_t s = 0; s < nsites; ++s) rp[s + 1] += rp[s];
+  const int64_t nnz = rp[nsites];
+  if (symmetric) sc.slot.resize(static_cast<size_t>(nsites));
+  out.rowptr.reserve(static_cast<size_t>(nsites) + 1);
+  out.cols.reserve(static_cast<size_t>(nnz));
+  // nothing below allocates
+  out.rowptr.assign(rp, rp + nsites + 1);
+  out.cols.resize(static_cast<size_t>(nnz));
   auto place = [&]() {
-    parallel_blocks(nq, nt, [&](int t, int64_t b, int64_t e) {
+    for_chunks(nt, [&](int t) {
+      int64_t b, e;
+      thread_block(nq, t, nt, b, e);
       for (int64_t q = b; q < e; ++q) {
-        const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(buf[t].size());
-        int32_t *o = out.cols.data() + out.rowptr[order[q]];
-        std::copy(buf[t].begin() + first[q], buf[t].begin() + end, o);
+        const int64_t end = q + 1 < e ? first[q + 1] : static_cast<int64_t>(used[t]);
+        int32_t *o = out.cols.data() + rp[order[q]];
+        std::copy(sc.buf[t].begin() + first[q], sc.buf[t].begin() + end, o);
         if (symmetric) sort_row(o, o + (end - first[q]));
       }
     });
@@ -475,16 +672,14 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
   // would overfill a row or leave one short (an asymmetric pair, which the conditions
   // above exclude: a safety net, not a proof) sets `bad`, and the rows are then placed
   // and sorted instead.
-  const int64_t *rp = out.rowptr.data();
-  struct Slot {
-    int64_t next, end;
-  };
-  std::vector<Slot> slot(static_cast<size_t>(nsites));
-  for (int32_t j = 0; j < nsites; ++j) slot[j] = Slot{rp[j], rp[j + 1]};
-  std::vector<char> bad(static_cast<size_t>(nt), 0);
+  Slot *sl = sc.slot.data();
   const int ntt = num_threads(nsites) < nt ? num_threads(nsites) : nt;
-  parallel_blocks(nsites, ntt, [&](int t, int64_t jb, int64_t je) {
+  char bad[64] = {0};
+  for_chunks(ntt, [&](int t) {
+    int64_t jb, je;
+    thread_block(nsites, t, ntt, jb, je);
     if (jb >= je) return;
+    for (int64_t j = jb; j < je; ++j) sl[j] = Slot{rp[j], rp[j + 1]};
     // sources that reach rows [jb, je): by symmetry, the members of those rows
     int64_t imin = 0, imax = nsites - 1;
     if (ntt > 1) {
@@ -497,7 +692,6 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
         }
     }
     int32_t *cols = out.cols.data();
-    Slot *sl = slot.data();
     const uint64_t span = static_cast<uint64_t>(je - jb);
     const bool all = jb == 0 && je == nsites;
     bool over = false;
@@ -524,26 +718,24 @@ void run_queries(const CellGrid &grid, const Rule &rule, int32_t nsites, const s
 
 }  // namespace
 
-void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, Csr &out) {
+void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, NeighborScratch &sc, Csr &out) {
   const int32_t rows = ps.num_owned();
-  const CellGrid grid(ps, status);
+  sc.grid.build(ps, status);
+  const CellGrid &grid = sc.grid;
   const Rule rule{ps.search_convention(), grid.rmax()};
   // owned valid particles in cell order
-  std::vector<int32_t> order;
-  order.reserve(rows);
-  for (int32_t i : grid.members())
-    if (i < rows) order.push_back(i);
+  const int32_t *mem = grid.members();
+  const int32_t nv = grid.num_valid();
+  sc.order.resize(static_cast<size_t>(nv));
+  int32_t no = 0;
+  for (int32_t p = 0; p < nv; ++p)
+    if (mem[p] < rows) sc.order[no++] = mem[p];
+  sc.order.resize(static_cast<size_t>(no));
   const int dim = ps.dim();
   // symmetric relation (see run_queries): every valid particle has a row (no ghosts), and
   // a symmetric convention or one radius for all
-  bool symmetric = rows == ps.size();
-  if (symmetric && rule.conv == MFREE_SEARCH_GATHER)
-    for (int32_t i : grid.members())
-      if (grid.radius(i) != grid.rmax()) {
-        symmetric = false;
-        break;
-      }
-  run_queries(grid, rule, rows, order, symmetric,
+  const bool symmetric = rows == ps.size() && (rule.conv != MFREE_SEARCH_GATHER || grid.uniform());
+  run_queries(sc, rule, rows, symmetric,
               [&](int32_t i, double *x) {
                 for (int c = 0; c < dim; ++c) x[c] = grid.wrap(ps.x(i, c), c);
                 return grid.radius(i);
@@ -553,7 +745,9 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, C
 
 void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, int32_t npts,
                           const VectorArray &x, const ScalarArray &h, Csr &out) {
-  const CellGrid grid(ps, status);
+  NeighborScratch sc;
+  sc.grid.build(ps, status);
+  const CellGrid &grid = sc.grid;
   const Rule rule{ps.search_convention(), grid.rmax()};
   const int dim = ps.dim();
   auto site = [&](int32_t s, double *xs) {
@@ -561,7 +755,7 @@ void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &sta
     return ps.kappa() * h(s);
   };
   // points in cell order (counting sort by the cell they fall in)
-  std::vector<int32_t> order(npts);
+  sc.order.resize(static_cast<size_t>(npts));
   if (!grid.empty() && npts > 0) {
     const int64_t ncells = grid.num_cells();
     std::vector<int64_t> start(static_cast<size_t>(ncells) + 1, 0), cell(npts);
@@ -572,9 +766,9 @@ void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &sta
       ++start[cell[s] + 1];
     }
     for (int64_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
-    for (int32_t s = 0; s < npts; ++s) order[start[cell[s]]++] = s;
+    for (int32_t s = 0; s < npts; ++s) sc.order[start[cell[s]]++] = s;
   }
-  run_queries(grid, rule, npts, order, false, site, out);
+  run_queries(sc, rule, npts, false, site, out);
 }
 
 }  // namespace mfree

@@ -264,13 +264,16 @@ Report ParticleSet::setup() {
         out.rowptr[i + 1] = static_cast<int64_t>(out.cols.size());
       }
     } else {
-      find_neighbors(*this, site_status_, out);
+      // in place: the search reuses the lists' storage and leaves them unchanged when
+      // it throws
+      if (!scratch_) scratch_.reset(new_neighbor_scratch());
+      find_neighbors(*this, site_status_, *scratch_, nbr_);
     }
   } catch (...) {
     site_status_.swap(prev_status_);
     throw;
   }
-  nbr_ = std::move(out);
+  if (host_neighbors()) nbr_ = std::move(out);
   setup_done_ = true;
   return rep;
 }

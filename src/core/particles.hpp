@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,12 @@ struct Csr {
   HVec<int64_t> rowptr = HVec<int64_t>(1, 0);
   HVec<int32_t> cols;
   int64_t nnz() const { return rowptr.empty() ? 0 : rowptr.back(); }
+};
+
+// Grid and buffers of the cell-list search, kept between searches (neighbors.cpp).
+struct NeighborScratch;
+struct NeighborScratchDeleter {
+  void operator()(NeighborScratch *s) const;
 };
 
 class ParticleSet {
@@ -121,10 +128,16 @@ class ParticleSet {
   // The statuses before the running setup/update, kept as a member (sized at setup) so
   // that update allocates nothing.
   std::vector<int32_t> prev_status_;
+  // The search's grid and buffers, created at the first search and reused by the next
+  // ones (same sizes: no allocation, no page faults).
+  std::unique_ptr<NeighborScratch, NeighborScratchDeleter> scratch_;
 };
 
-// Cell-list search over the valid particles of ps (valid[i] != 0); fills rows for the
-// owned particles. Throws Error on a periodic box too small for the supports.
-void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &site_status, Csr &out);
+// Cell-list search over the valid particles of ps (site_status[i] == 0); fills rows for
+// the owned particles, sorted. Throws Error on a periodic box too small for the supports;
+// on any exception out is unchanged. scratch holds the grid and buffers between calls.
+NeighborScratch *new_neighbor_scratch();
+void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &site_status, NeighborScratch &scratch,
+                    Csr &out);
 
 }  // namespace mfree
