@@ -268,24 +268,12 @@ Report FluidSystem::candidates(const double *xn) {
   cand_.rowptr.assign(nb.rowptr.begin(), nb.rowptr.end());
   cand_.cols.assign(nb.cols.begin(), nb.cols.end());
   const int64_t cnnz = cand_.nnz();
-  // transposed entries: rows are sorted, so the rows i < j that hold j are met in the
-  // order of row j (next[j] walks it); a missing partner (an asymmetric pair at the
-  // edge of the lists) is -1 and may not become a pair of the tables
-  ctrans_.assign(cnnz, -1);
+  ctrans_valid_ = false;
   cpos_.assign(cnnz, -1);
-  std::vector<int64_t> next(cand_.rowptr.begin(), cand_.rowptr.end() - 1);
-  for (int32_t i = 0; i < nall; ++i)
-    for (int64_t e = cand_.rowptr[i]; e < cand_.rowptr[i + 1]; ++e) {
-      const int32_t j = cand_.cols[e];
-      int64_t &p = next[j];
-      while (p < cand_.rowptr[j + 1] && cand_.cols[p] < i) ++p;
-      if (p < cand_.rowptr[j + 1] && cand_.cols[p] == i) ctrans_[e] = p;
-    }
   // the tables never outgrow the candidates: no allocation until the next rebuild
   cols_.reserve(cnnz);
   N_.reserve(cnnz);
   G_.reserve(cnnz * dim);
-  NT_.reserve(cnnz * (dim + 1));
   rp_.resize(static_cast<size_t>(nall) + 1);
   cond_.resize(nall);
   maxrow_ = 0;
@@ -294,6 +282,7 @@ Report FluidSystem::candidates(const double *xn) {
   xref_.assign(xn, xn + nx);
   href_ = h_;
   ++rebuilds_;
+  color_chunks();
   if (walls_) {
     VectorArray xa;
     xa.ptr = xn;
@@ -307,6 +296,65 @@ Report FluidSystem::candidates(const double *xn) {
   }
   lists_valid_ = true;
   return Report();
+}
+
+void FluidSystem::transposed_candidates() {
+  const int32_t nall = nq();
+  // transposed entries: rows are sorted, so the rows i < j that hold j are met in the
+  // order of row j (next[j] walks it); a missing partner (an asymmetric pair at the
+  // edge of the lists) is -1 and may not become a pair of the tables
+  ctrans_.assign(cand_.nnz(), -1);
+  std::vector<int64_t> next(cand_.rowptr.begin(), cand_.rowptr.end() - 1);
+  for (int32_t i = 0; i < nall; ++i)
+    for (int64_t e = cand_.rowptr[i]; e < cand_.rowptr[i + 1]; ++e) {
+      const int32_t j = cand_.cols[e];
+      int64_t &p = next[j];
+      while (p < cand_.rowptr[j + 1] && cand_.cols[p] < i) ++p;
+      if (p < cand_.rowptr[j + 1] && cand_.cols[p] == i) ctrans_[e] = p;
+    }
+  NT_.reserve(cand_.nnz() * (dim_ + 1));
+  ctrans_valid_ = true;
+}
+
+// Greedy colouring of the row chunks in chunk order: color_mask_[j] holds the colours
+// of the chunks so far that touch node j (write to it in the scatter: the candidates of
+// their rows, a superset of the table rows until the next rebuild). The chunks and their
+// colours depend on the lists only, not on the thread count. A node ordering so scattered
+// that 64 colours do not suffice runs all chunks in one colour, in order, on one thread.
+void FluidSystem::color_chunks() {
+  const int32_t nall = nq();
+  const int32_t nch = (nall + kChunk - 1) / kChunk;
+  const int64_t *crp = cand_.rowptr.data();
+  const int32_t *ccols = cand_.cols.data();
+  color_mask_.assign(nall, 0);
+  std::vector<int32_t> color(nch, 0);
+  int ncolor = 0;
+  bool serial = false;
+  for (int32_t c = 0; c < nch && !serial; ++c) {
+    const int64_t e0 = crp[static_cast<int64_t>(c) * kChunk], e1 = crp[std::min<int64_t>(nall, (c + 1) * int64_t{kChunk})];
+    uint64_t used = 0;
+    for (int64_t e = e0; e < e1; ++e) used |= color_mask_[ccols[e]];
+    if (used == ~uint64_t{0}) {
+      serial = true;
+      break;
+    }
+    int col = 0;
+    while (used >> col & 1u) ++col;
+    color[c] = col;
+    ncolor = std::max(ncolor, col + 1);
+    for (int64_t e = e0; e < e1; ++e) color_mask_[ccols[e]] |= uint64_t{1} << col;
+  }
+  if (serial) {
+    ncolor = 1;
+    std::fill(color.begin(), color.end(), 0);
+  }
+  color_ptr_.assign(static_cast<size_t>(ncolor) + 1, 0);
+  for (int32_t c = 0; c < nch; ++c) ++color_ptr_[color[c] + 1];
+  for (int col = 0; col < ncolor; ++col) color_ptr_[col + 1] += color_ptr_[col];
+  chunk_order_.resize(nch);
+  std::vector<int32_t> fill(color_ptr_.begin(), color_ptr_.end() - 1);
+  for (int32_t c = 0; c < nch; ++c) chunk_order_[fill[color[c]]++] = c;
+  scatter_threads_ = !serial;
 }
 
 // Shepard functions N_j = o_j / S, S = sum o, of the weights o = w (the approximants'
@@ -336,13 +384,14 @@ void FluidSystem::shepard_row(int n, const double *w, const double *gf, double *
 }
 
 template <int D>
-bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch) {
+bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
+                             bool transpose) {
   constexpr int L = D + 1;
   const double ih = 1.0 / h_, tol = shepard_cond_;
   const int64_t *crp = cand_.rowptr.data();
   const int32_t *ccols = cand_.cols.data();
   const int32_t *cpos = cpos_.data();
-  const int64_t *ctr = ctrans_.data();
+  const int64_t *ctr = transpose ? ctrans_.data() : nullptr;
   const int64_t *rp = rp_.data();
   bool one_way = false;
   for (int32_t k = k0; k < k1; ++k) {
@@ -361,7 +410,7 @@ bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *s
     for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
       const int32_t j = ccols[e];
       js[q] = j;
-      ts[q] = ctr[e];
+      ts[q] = ctr ? ctr[e] : -1;
       for (int c = 0; c < D; ++c) s[c][q] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
       q += cpos[e] >= 0;
     }
@@ -479,9 +528,10 @@ bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *s
     }
     // columns, and the transposed copy: N_k(x_j) is entry (j, k) of the transpose
     int32_t *ck = cols_.data() + o;
+    for (int m = 0; m < n; ++m) ck[m] = static_cast<int32_t>(js[m]);
+    if (!transpose) continue;
     for (int m = 0; m < n; ++m) {
       const int32_t j = static_cast<int32_t>(js[m]);
-      ck[m] = j;
       const int64_t t = ts[m];
       if (t < 0 || cpos[t] < 0) {
         one_way = true;
@@ -533,7 +583,11 @@ Report FluidSystem::prepare(const double *y) {
   cols_.resize(nnz);
   N_.resize(nnz);
   G_.resize(nnz * dim);
-  NT_.resize(nnz * (dim + 1));
+  const bool transpose = vci_;  // only consistent integration reads NT_ (fluid_wall.cpp)
+  if (transpose) {
+    if (!ctrans_valid_) transposed_candidates();
+    NT_.resize(nnz * (dim + 1));
+  }
   const size_t per_thread = static_cast<size_t>(dim + 2) * maxrow_, iper_thread = 2 * static_cast<size_t>(maxrow_);
   if (rows_scratch_.size() < per_thread * nt) rows_scratch_.resize(per_thread * nt);
   if (rows_iscratch_.size() < iper_thread * nt) rows_iscratch_.resize(iper_thread * nt);
@@ -542,7 +596,8 @@ Report FluidSystem::prepare(const double *y) {
     double *scratch = rows_scratch_.data() + per_thread * t;
     int64_t *iscratch = rows_iscratch_.data() + iper_thread * t;
     const int32_t k0 = static_cast<int32_t>(b), k1 = static_cast<int32_t>(e);
-    one_way[t] = dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch) : table_rows<3>(k0, k1, xn, scratch, iscratch);
+    one_way[t] = dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch, transpose)
+                          : table_rows<3>(k0, k1, xn, scratch, iscratch, transpose);
   });
   if (std::any_of(one_way, one_way + 64, [](bool f) { return f; })) {
     // cannot happen with lists from one search radius; a failure rather than a wrong sum
@@ -585,111 +640,130 @@ Report FluidSystem::accel(const double *v, const double *rho, double *a) {
 
 // 003 eqs 56, 61, 67-68 with nodal quadrature: the force on node i is
 //   f_i = sum_k [-sigma_k grad N_i(x_k) V_k + N_i(x_k) M_k g],  m_i = sum_k N_i(x_k) M_k,
-// over the quadrature points k whose row holds i. Pass 1 computes per point k the stress
-// (times V_k), the interpolated velocity and the wall force; pass 2 gathers for each node
-// over its own row through trans_, so that both passes are split over threads and every
-// sum is taken in the same order whatever their number.
+// over the quadrature points k whose row holds i. One pass over the rows computes per
+// point k the stress (times V_k), the interpolated velocity and the wall force and
+// scatters the row's terms to the nodes i of the row (acc_); the chunks of rows of one
+// colour touch disjoint nodes and run in parallel, the colours one after another, so that
+// every node sums its terms in the same order whatever the number of threads.
 template <int D>
 Report FluidSystem::accel_dim(const double *v, const double *rho, double *a) {
   Report rep;
-  constexpr int P = D * D + 2 + D;  // per point: sigma V (D x D), M, lumping mass, wall force
+  constexpr int P = D * D + 2 + D;  // pack_ per point: sigma V (D x D), M, lumping mass, wall force
+  constexpr int A = 2 * D + 2;      // acc_ per node: force, mass sum_k N M, lumped mass, wall force
   const int32_t nall = nq();
   v = node_velocities(v);
   rho = node_densities(rho);
   const double *rho0 = dummy_.n ? dummy_.rho0.data() : rho0_.data();
   const double *mass = dummy_.n ? dummy_.mass.data() : mass_.data();
-  pack_.resize(static_cast<size_t>(nall) * P);
+  const bool keep_pack = vci_;  // vci_correct reads the points' stresses
+  if (keep_pack) pack_.resize(static_cast<size_t>(nall) * P);
   vhat_.resize(static_cast<size_t>(nall) * D);
+  acc_.assign(static_cast<size_t>(nall) * A, 0.0);
   const int64_t *rp = rp_.data();
   const int32_t *cols = cols_.data();
-  const double *N = N_.data(), *G = G_.data(), *NT = NT_.data();
-  const int nt = num_threads(nall);
-  parallel_blocks(nall, nt, [&](int, int64_t b, int64_t e) {
-    for (int64_t k = b; k < e; ++k) {
-      // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
-      double vh[D] = {}, L[D][D] = {};
-      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
-        const double *vj = v + static_cast<size_t>(cols[q]) * D;
-        const double *gq = G + q * D;
-        for (int c = 0; c < D; ++c) {
-          vh[c] += N[q] * vj[c];
-          for (int bb = 0; bb < D; ++bb) L[c][bb] += vj[c] * gq[bb];
-        }
-      }
-      double tr3 = 0.0;
-      for (int c = 0; c < D; ++c) tr3 += L[c][c];
-      tr3 /= 3.0;
-      const double p = kappa_ * (tait(rho[k], rho0[k]) - 1.0), Vk = vol_[k];
-      double *pk = &pack_[static_cast<size_t>(k) * P];
-      for (int aa = 0; aa < D; ++aa)
-        for (int bb = 0; bb < D; ++bb) {
-          const double d = 0.5 * (L[aa][bb] + L[bb][aa]) - (aa == bb ? tr3 : 0.0);  // d' (003 eq 61)
-          pk[aa * D + bb] = ((aa == bb ? -p : 0.0) + 2.0 * mu_ * d) * Vk;
-        }
-      pk[D * D] = mass[k];
-      pk[D * D + 1] = k < n_ ? mass[k] / share(static_cast<int32_t>(k)) : 0.0;  // dummies carry no fluid mass
-      double F[D] = {};
-      if (walls_ && k < n_) {
-        // wall force (003 eqs 122-124) on approaching particles, spread through N_i(x_k)
-        for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
-          const int32_t w = wall_nbr_.cols[q];
-          const double *nw = &wall_n_[static_cast<size_t>(w) * D];
-          double r2 = 0.0, approach = 0.0;
-          for (int c = 0; c < D; ++c) {
-            const double d = xbound_[k * D + c] - walls_->x(w, c);
-            r2 += d * d;
-            approach += vh[c] * nw[c];
-          }
-          const double r = std::sqrt(r2);
-          if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // f1 = 0: moving away
-          const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
-          for (int c = 0; c < D; ++c) F[c] += f2 * nw[c];
-        }
-      }
+  const double *N = N_.data(), *G = G_.data();
+  double *acc = acc_.data();
+  auto point = [&](int64_t k) {
+    // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
+    double vh[D] = {}, L[D][D] = {};
+    for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+      const double *vj = v + static_cast<size_t>(cols[q]) * D;
+      const double *gq = G + q * D;
       for (int c = 0; c < D; ++c) {
-        pk[D * D + 2 + c] = F[c];
-        vhat_[k * D + c] = vh[c];
+        vh[c] += N[q] * vj[c];
+        for (int bb = 0; bb < D; ++bb) L[c][bb] += vj[c] * gq[bb];
       }
     }
-  });
-  const double *pack = pack_.data();
+    double tr3 = 0.0;
+    for (int c = 0; c < D; ++c) tr3 += L[c][c];
+    tr3 /= 3.0;
+    const double p = kappa_ * (tait(rho[k], rho0[k]) - 1.0), Vk = vol_[k];
+    double S[D][D];
+    for (int aa = 0; aa < D; ++aa)
+      for (int bb = 0; bb < D; ++bb) {
+        const double d = 0.5 * (L[aa][bb] + L[bb][aa]) - (aa == bb ? tr3 : 0.0);  // d' (003 eq 61)
+        S[aa][bb] = ((aa == bb ? -p : 0.0) + 2.0 * mu_ * d) * Vk;
+      }
+    const double Mk = mass[k];
+    const double Lk = k < n_ ? mass[k] / share(static_cast<int32_t>(k)) : 0.0;  // dummies carry no fluid mass
+    double F[D] = {};
+    bool wall = false;
+    if (walls_ && k < n_) {
+      // wall force (003 eqs 122-124) on approaching particles, spread through N_i(x_k)
+      for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
+        const int32_t w = wall_nbr_.cols[q];
+        const double *nw = &wall_n_[static_cast<size_t>(w) * D];
+        double r2 = 0.0, approach = 0.0;
+        for (int c = 0; c < D; ++c) {
+          const double d = xbound_[k * D + c] - walls_->x(w, c);
+          r2 += d * d;
+          approach += vh[c] * nw[c];
+        }
+        const double r = std::sqrt(r2);
+        if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // f1 = 0: moving away
+        const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
+        for (int c = 0; c < D; ++c) F[c] += f2 * nw[c];
+        wall = true;
+      }
+    }
+    for (int c = 0; c < D; ++c) vhat_[k * D + c] = vh[c];
+    if (keep_pack) {
+      double *pk = &pack_[static_cast<size_t>(k) * P];
+      for (int aa = 0; aa < D; ++aa)
+        for (int bb = 0; bb < D; ++bb) pk[aa * D + bb] = S[aa][bb];
+      pk[D * D] = Mk;
+      pk[D * D + 1] = Lk;
+      for (int c = 0; c < D; ++c) pk[D * D + 2 + c] = F[c];
+    }
+    // the row's terms to its nodes i: -sigma_k V_k grad N_i(x_k), N_i(x_k) M_k (003 eq 56)
+    for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+      double *ai = acc + static_cast<size_t>(cols[q]) * A;
+      const double *gi = G + q * D, Ni = N[q];
+      for (int aa = 0; aa < D; ++aa) {
+        double sg = 0.0;
+        for (int bb = 0; bb < D; ++bb) sg += S[aa][bb] * gi[bb];
+        ai[aa] -= sg;
+      }
+      ai[D] += Ni * Mk;
+      ai[D + 1] += Ni * Lk;
+    }
+    if (wall)
+      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+        double *ai = acc + static_cast<size_t>(cols[q]) * A;
+        for (int c = 0; c < D; ++c) ai[D + 2 + c] += N[q] * F[c];
+      }
+  };
+  const int nt = scatter_threads_ ? num_threads(nall) : 1;
+  for (size_t col = 0; col + 1 < color_ptr_.size(); ++col) {
+    const int32_t *chunks = chunk_order_.data() + color_ptr_[col];
+    parallel_blocks(color_ptr_[col + 1] - color_ptr_[col], nt, [&](int, int64_t b, int64_t e) {
+      for (int64_t c = b; c < e; ++c) {
+        const int64_t k0 = static_cast<int64_t>(chunks[c]) * kChunk, k1 = std::min<int64_t>(nall, k0 + kChunk);
+        for (int64_t k = k0; k < k1; ++k) point(k);
+      }
+    });
+  }
   const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
   int32_t bad = n_;  // the first node without a positive mass
   int32_t first_bad[64];  // parallel_blocks runs at most 64 threads
   std::fill(first_bad, first_bad + 64, n_);
   parallel_blocks(n_, num_threads(n_), [&](int t, int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) {
-      double f[D] = {}, fb[D] = {}, nm = 0.0, lm = 0.0;
-      for (int64_t q = rp[i]; q < rp[i + 1]; ++q) {
-        const double *pk = pack + static_cast<size_t>(cols[q]) * P;
-        const double Ni = NT[q * (D + 1)], *gi = NT + q * (D + 1) + 1;  // N_i(x_k), grad N_i(x_k)
-        for (int aa = 0; aa < D; ++aa) {
-          double sg = 0.0;
-          for (int bb = 0; bb < D; ++bb) sg += pk[aa * D + bb] * gi[bb];
-          f[aa] -= sg;
-          fb[aa] += Ni * pk[D * D + 2 + aa];
-        }
-        nm += Ni * pk[D * D];
-        lm += Ni * pk[D * D + 1];  // 003 eq 56
-      }
-      const double m = galerkin ? lm : mass_[i];
+      const double *ai = acc + static_cast<size_t>(i) * A;
+      const double m = galerkin ? ai[D + 1] : mass_[i];
       if (!(m > 0.0)) {
         if (first_bad[t] == n_) first_bad[t] = static_cast<int32_t>(i);
         for (int c = 0; c < D; ++c) a[i * D + c] = 0.0;
         continue;
       }
       // the boundary force acts as an acceleration (003 Sect. 6.1 step 7)
-      for (int c = 0; c < D; ++c) a[i * D + c] = (f[c] + nm * g_[c]) / m + fb[c];
+      for (int c = 0; c < D; ++c) a[i * D + c] = (ai[c] + ai[D] * g_[c]) / m + ai[D + 2 + c];
     }
   });
-  vci_correct(pack, P, a);  // optional, fluid_wall.cpp
+  vci_correct(pack_.data(), P, a);  // optional, fluid_wall.cpp
   for (int32_t fbad : first_bad) bad = std::min(bad, fbad);
   if (bad < n_) {
-    double m = 0.0;
-    if (galerkin)
-      for (int64_t q = rp[bad]; q < rp[bad + 1]; ++q) m += NT[q * (D + 1)] * pack[static_cast<size_t>(cols[q]) * P + D * D + 1];
-    else
-      m = mass_[bad];
+    const double m = galerkin ? acc[static_cast<size_t>(bad) * A + D + 1] : mass_[bad];
     rep.fail(MFREE_FAIL_SINGULAR, "particle " + std::to_string(bad) + " has a non-positive lumped mass " +
                                       std::to_string(m));
   }

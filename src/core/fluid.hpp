@@ -55,10 +55,15 @@ class FluidSystem : public System {
   // Candidate neighbour lists (Verlet lists with a skin, see tables_) for the node
   // positions xn, rebuilt when a node moved more than half the skin since the last build.
   Report candidates(const double *xn);
-  // Tables rows [k0, k1): linear MLS at the nodes, Shepard rows where ill-conditioned.
-  // (true if a pair is in one node's row only, which the search rules out)
+  // Tables rows [k0, k1): linear MLS at the nodes, Shepard rows where ill-conditioned;
+  // with transpose, also NT_ (true if a pair is in one node's row only, which the search
+  // rules out).
   template <int D>
-  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch);
+  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  // Chunks of kChunk rows coloured so that no two chunks of a colour touch a common
+  // node (on the candidate pattern), for the scatter of accel (rebuilt with the lists).
+  void color_chunks();
+  void transposed_candidates();  // ctrans_, only for NT_ (consistent integration)
   template <int D>
   void shepard_row(int n, const double *w, const double *gf, double *const *s, double ih, bool volumes,
                    const int64_t *js, double *Nk, double *Gk) const;
@@ -102,10 +107,11 @@ class FluidSystem : public System {
 
   // Shape functions at the nodes, rebuilt at every prepare (003: linear MLS with the
   // cubic spline, nodal quadrature): CSR rows sorted by column, rp_/cols_; values N_
-  // and gradients G_ (dim per entry) of node cols_[e] at node k, and the transpose NT_
+  // and gradients G_ (dim per entry) of node cols_[e] at node k. Only with consistent
+  // integration (vci_, whose sums fluid_wall.cpp takes as gathers) also the transpose NT_
   // on the same pattern (it is symmetric: one h for all), value and gradient interleaved
-  // (dim + 1 per entry): entry e of row i holds N_i(x_j), j = cols_[e], so that sums over
-  // the quadrature points a node belongs to are gathers that read the tables in order.
+  // (dim + 1 per entry): entry e of row i holds N_i(x_j), j = cols_[e]. The force
+  // assembly itself scatters row by row (see chunk_order_) and needs no transpose.
   //
   // The rows come from candidate (Verlet) lists cand_ of radius 2h + skin built by ps_
   // at positions xref_; they are reused while no node has moved more than skin / 2 since
@@ -117,7 +123,8 @@ class FluidSystem : public System {
   std::vector<int32_t> cols_;
   std::vector<double> N_, G_, NT_, cond_;
   Csr cand_;
-  std::vector<int64_t> ctrans_;  // transposed candidate entry, -1 if none
+  std::vector<int64_t> ctrans_;  // transposed candidate entry, -1 if none (only with NT_)
+  bool ctrans_valid_ = false;
   std::vector<int32_t> cpos_;    // position of a candidate in its row of the tables, -1 if out
   std::vector<double> xref_;
   double skin_ = 0.25;  // in units of h
@@ -131,6 +138,15 @@ class FluidSystem : public System {
   Csr wall_nbr_;
   // per node (reused): packed quadrature-point data of accel, interpolated velocities
   std::vector<double> pack_, vhat_, work_state_, stage_;
+  // accel scatters row k's contributions to the nodes of the row; rows go in chunks of
+  // kChunk, chunk_order_[color_ptr_[c] .. color_ptr_[c + 1]) are the chunks of colour c,
+  // which no two of touch a common node. Colours run one after another, so every node
+  // sums its contributions in the same order (colour, then row) for any thread count.
+  static constexpr int32_t kChunk = 512;
+  std::vector<int32_t> chunk_order_, color_ptr_;
+  std::vector<uint64_t> color_mask_;  // scratch of color_chunks
+  bool scatter_threads_ = true;       // false: one colour, the chunks in order, one thread
+  std::vector<double> acc_;           // per node: force, mass, lumped mass, wall force
 };
 
 }  // namespace mfree
