@@ -17,7 +17,8 @@
  * Randles-Libersky and KB Method 1 have no Hessian; t404 checks them against an O(N^2)
  * oracle. The fast path's row kernels exist twice (baseline and AVX2 + FMA, chosen from
  * the CPU, src/core/simd.hpp): the whole group runs again with MFREE_SIMD=baseline, so
- * that both copies are checked on a machine with AVX2. */
+ * that both copies are checked on a machine with AVX2. The pattern copied from the set's
+ * rows (kernel support = search radius) equals the filtered one (test_shared_pattern). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -259,8 +260,41 @@ static void test_failing_sites(void **s) {
   mfree_particles_destroy(&ps);
 }
 
+/* The pattern: where the kernel's support equals the set's search radius (kappa = 2 for
+ * the cubic spline, gather, no periodic axis) setup copies the set's rows; with a larger
+ * kappa it filters them by distance. Both must give the same pattern, and so bitwise the
+ * same tables and condition numbers, in 2D and 3D with variable supports. */
+static void test_shared_pattern(void **state) {
+  (void)state;
+  const method_t *mls1 = &kMethods[3], *sph = &kMethods[0];
+  for (int dim = 2; dim <= 3; ++dim) {
+    cloud_t c;
+    make_cloud(&c, dim, dim == 2 ? 14 : 6, 1.4, 11);
+    mfree_particles_t *ps = particles(&c, MFREE_SEARCH_GATHER, 0);
+    for (int k = 0; k < 2; ++k) {
+      const method_t *m = k ? sph : mls1;
+      build(ps, m, MFREE_KERNEL_CUBIC_SPLINE, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT, 0, NULL, 0, NULL, &ta);
+      assert_ok(ctx, mfree_particles_set_search(ps, MFREE_SEARCH_GATHER, 2.6));
+      assert_ok(ctx, mfree_particles_setup(ps));
+      build(ps, m, MFREE_KERNEL_CUBIC_SPLINE, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT, 0, NULL, 0, NULL, &tb);
+      assert_ok(ctx, mfree_particles_set_search(ps, MFREE_SEARCH_GATHER, 2.0));
+      assert_ok(ctx, mfree_particles_setup(ps));
+      assert_int_equal(ta.nnz, tb.nnz);
+      assert_true(ta.nnz > 10 * c.n); /* real rows, not a degenerate cloud */
+      assert_memory_equal(ta.rowptr, tb.rowptr, sizeof(int64_t) * (size_t)(ta.nsites + 1));
+      assert_memory_equal(ta.cols, tb.cols, sizeof(int32_t) * (size_t)ta.nnz);
+      assert_memory_equal(ta.val, tb.val, sizeof(double) * (size_t)ta.nnz);
+      for (int d = 0; d < dim; ++d) assert_memory_equal(ta.grad[d], tb.grad[d], sizeof(double) * (size_t)ta.nnz);
+      assert_memory_equal(ta.cond, tb.cond, sizeof(double) * (size_t)ta.nsites);
+      assert_memory_equal(ta.status, tb.status, sizeof(int32_t) * (size_t)ta.nsites);
+    }
+    mfree_particles_destroy(&ps);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_shared_pattern),
       cmocka_unit_test(test_fast_vs_general_2d),
       cmocka_unit_test(test_fast_vs_general_3d),
       cmocka_unit_test(test_one_table),

@@ -313,6 +313,13 @@ void Approximant::build_pattern() {
   const int conv = ps_->search_convention();
   const bool any_periodic = per[0] || per[1] || per[2];
   const double tol = 1.0 + kEdgeTol2;
+  // The common case: the kernel's support is the set's search radius (R h_s = kappa h_s,
+  // gather, no periodic axis, lists found by the set's own search), so the filter below
+  // would keep every entry (same closed-edge test d^2 <= (R h_s)^2 (1 + kEdgeTol2)) and
+  // the pattern is the set's rows: copied, not rebuilt.
+  if (!points_ && !ps_->host_neighbors() && conv == MFREE_SEARCH_GATHER && !any_periodic &&
+      R == ps_->kappa() && share_rows(*src))
+    return;
   // One pass over static blocks of sites (the pattern is the same for any thread count):
   // row s is written at src->rowptr[s] + s (room for every candidate and an appended
   // self), then the rows are moved down to their final offsets.
@@ -396,6 +403,40 @@ void Approximant::build_pattern() {
     if (rp[s] != base) std::copy(cl + base, cl + base + cnt, cl + rp[s]);  // moves down
   }
   cols_.resize(static_cast<size_t>(rp[nsites_]));
+}
+
+bool Approximant::share_rows(const Csr &src) {
+  const auto &pst = ps_->site_status();
+  for (int32_t s = 0; s < nsites_; ++s)
+    if (pst[s] != 0) return false;  // failed particles get empty rows: filter
+  const int64_t nnz = src.nnz();
+  if (static_cast<int64_t>(src.rowptr.size()) != static_cast<int64_t>(nsites_) + 1) return false;
+  cols_.resize(static_cast<size_t>(nnz));
+  const int64_t *srp = src.rowptr.data();
+  const int32_t *scl = src.cols.data();
+  int32_t *cl = cols_.data(), *self = self_.data();
+  int64_t *rp = rowptr_.data();
+  // static blocks of sites, each copying its rows and finding the site in them (rows
+  // are sorted: a binary search)
+  const int nt = num_threads(nnz);
+  int missing[64] = {};
+  parallel_blocks(nsites_, nt, [&](int t, int64_t b, int64_t e) {
+    if (b >= e) return;
+    std::copy(srp + b + 1, srp + e + 1, rp + b + 1);
+    std::copy(scl + srp[b], scl + srp[e], cl + srp[b]);
+    int miss = 0;
+    for (int64_t s = b; s < e; ++s) {
+      const int32_t *r0 = scl + srp[s], *r1 = scl + srp[s + 1];
+      const int32_t *at = std::lower_bound(r0, r1, static_cast<int32_t>(s));
+      const bool found = at != r1 && *at == s;
+      self[s] = found ? static_cast<int32_t>(at - r0) : -1;
+      miss += !found;
+    }
+    missing[t < 64 ? t : 63] += miss;
+  });
+  for (int t = 0; t < 64; ++t)
+    if (missing[t]) return false;  // a row without its site (never from the set's search)
+  return true;
 }
 
 Report Approximant::compute(const char *what) {

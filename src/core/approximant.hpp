@@ -84,6 +84,9 @@ class Approximant {
  private:
   void validate_config() const;
   void build_pattern();
+  // The pattern as a copy of the particle set's rows (src); false when they do not
+  // qualify (a failed particle, a row without its site), and nothing is decided.
+  bool share_rows(const Csr &src);
   Report compute(const char *what);
   // Particle (and point) data as SoA arrays for the pattern and the fast path, re-read
   // from the (possibly borrowed) host arrays at every setup and update.

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "local.hpp"
 #include "simd.hpp"
@@ -31,6 +32,16 @@
 #endif
 #define MFREE_STR(x) #x
 #define MFREE_UNROLL _Pragma("GCC unroll 64")
+
+// Four neighbours at a time in GCC/Clang vector extensions: AVX2 registers in the AVX2
+// copy, pairs of SSE2 (or NEON) registers in the baseline one. Only in locals, never
+// passed by value (whose ABI would differ between the copies).
+#if defined(__GNUC__) || defined(__clang__)
+#define MFREE_VEC4 1
+typedef double V4 __attribute__((vector_size(32)));
+#else
+#define MFREE_VEC4 0
+#endif
 
 namespace mfree {
 
