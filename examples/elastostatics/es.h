@@ -27,6 +27,10 @@ typedef struct {
                       edges (non-uniform, dense at the hole), 2 = the same map with rings
                       graded to square cells and per-node supports; 0 = the cut regular
                       grid */
+  int traction_gauss; /* 1: tractions by 4 Gauss points per boundary segment for every
+                         scheme; 0 (default): nodal boundary quadrature Psi_J(x_I) dGamma_I
+                         (000 eq 95) for the nodal-quadrature schemes, Gauss points for EFG
+                         and with consistent integration (whose boundary rule they are) */
 } es_problem_t;
 
 /* Exact displacement u (2), strain eps (xx, yy, engineering gamma_xy) and stress sig
@@ -127,6 +131,7 @@ typedef struct {
   int32_t ndofs;
   es_bc_t bc;            /* the condition used */
   int vci;               /* consistent integration of the test functions was used */
+  int traction_nodal;    /* tractions by nodal boundary quadrature (000 eq 95), else Gauss */
   int warn;              /* a positive (data-dependent) status was reported */
 } es_result_t;
 
