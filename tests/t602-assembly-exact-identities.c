@@ -1,0 +1,381 @@
+/* Assembler: exact identities of the elasticity forms, the CSC view and Lagrange
+ * multipliers.
+ *  - Material matrices: with Bubnov MLS of order 1 (which reproduces linear fields and
+ *    their gradients to round-off at every quadrature point) and background Gauss cells
+ *    whose weights sum to the volume V, the stiffness of the linear fields u_a = e_a x
+ *    (e_a a unit Voigt strain) is u_a^T K u_b = V D_ab exactly, for every pair a, b:
+ *    plane stress, plane strain and 3D, against the textbook D (Lame constants);
+ *    rigid-body modes give K u = 0 and K is symmetric.
+ *  - The CSC view (mfree_matrix_get_csc) holds the same entries as the CSR view, also
+ *    after a refill on moved particles (same pattern id, new values).
+ *  - MFREE_BC_LAGRANGE: the multiplier rows are the trial values Phi_J(x_p) at the
+ *    points (an independent approximant evaluated there), the system is symmetric, and
+ *    the solved u^h satisfies u^h(x_p) = g(x_p) at every point to round-off.
+ * Small systems, solved densely; library only. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testutil.h"
+
+static mfree_context_t *ctx;
+static int setup(void **s) { (void)s; return mfree_context_create(&ctx) != MFREE_SUCCESS; }
+static int teardown(void **s) { (void)s; return mfree_context_destroy(&ctx) != MFREE_SUCCESS; }
+
+static const double YOUNG = 7.0, NU = 0.3;
+
+/* m^dim nodes on the unit square / cube, interior ones jittered by 20 % of the spacing.
+ * Positions are borrowed from xs (the caller keeps them alive). */
+static mfree_particles_t *cloud(int dim, int m, double hfac, double *xs, uint64_t seed) {
+  mfree_rng_t r;
+  mfree_rng_seed(&r, seed);
+  const int n = dim == 2 ? m * m : m * m * m;
+  for (int p = 0; p < n; ++p) {
+    int idx[3] = {p % m, (p / m) % m, p / (m * m)}, b = 0;
+    for (int d = 0; d < dim; ++d) b |= idx[d] == 0 || idx[d] == m - 1;
+    for (int d = 0; d < dim; ++d)
+      xs[dim * p + d] = (idx[d] + (b ? 0.0 : 0.2 * (2 * mfree_rng_uniform(&r) - 1))) / (m - 1);
+  }
+  static double h, v;
+  h = hfac / (m - 1);
+  v = pow(1.0 / (m - 1), dim);
+  mfree_particles_t *ps = NULL;
+  assert_ok(ctx, mfree_particles_create(ctx, dim, n, &ps));
+  assert_ok(ctx, mfree_particles_set_positions(ps, xs, MFREE_LAYOUT_AOS, dim, MFREE_BORROW));
+  assert_ok(ctx, mfree_particles_set_support(ps, &h, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_volumes(ps, &v, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_setup(ps));
+  return ps;
+}
+
+/* Voigt material matrix: 2D (xx, yy, gamma_xy), 3D (xx, yy, zz, gamma_yz, gamma_xz,
+ * gamma_xy); engineering shear strains. */
+static int material(mfree_form_t form, double D[6][6]) {
+  memset(D, 0, sizeof(double) * 36);
+  const double mu = YOUNG / (2 * (1 + NU));
+  if (form == MFREE_FORM_ELASTICITY_PLANE_STRESS) {
+    const double q = YOUNG / (1 - NU * NU);
+    D[0][0] = D[1][1] = q;
+    D[0][1] = D[1][0] = q * NU;
+    D[2][2] = mu;
+    return 3;
+  }
+  const double lam = YOUNG * NU / ((1 + NU) * (1 - 2 * NU));
+  const int nn = form == MFREE_FORM_ELASTICITY_3D ? 3 : 2;
+  for (int i = 0; i < nn; ++i)
+    for (int j = 0; j < nn; ++j) D[i][j] = lam + (i == j ? 2 * mu : 0.0);
+  const int nv = nn == 3 ? 6 : 3;
+  for (int i = nn; i < nv; ++i) D[i][i] = mu;
+  return nv;
+}
+
+/* u = grad-u-matrix G applied to x: G (dim x dim, row-major) for Voigt strain a. */
+static void voigt_gradient(int dim, int a, double G[3][3]) {
+  memset(G, 0, sizeof(double) * 9);
+  if (a < dim) {
+    G[a][a] = 1.0;
+    return;
+  }
+  /* shear pairs: 2D a = 2 -> (0,1); 3D a = 3 -> (1,2), 4 -> (0,2), 5 -> (0,1) */
+  int i = 0, j = 1;
+  if (dim == 3 && a == 3) i = 1, j = 2;
+  if (dim == 3 && a == 4) i = 0, j = 2;
+  G[i][j] = G[j][i] = 0.5; /* engineering shear strain 1 */
+}
+
+static void spmv(const mfree_matrix_t *K, const double *x, double *y) { assert_ok(ctx, mfree_matrix_apply(K, x, y)); }
+
+static void check_material(mfree_form_t form) {
+  const int dim = form == MFREE_FORM_ELASTICITY_3D ? 3 : 2, m = dim == 3 ? 5 : 8;
+  const int n = dim == 2 ? m * m : m * m * m;
+  double *xs = malloc(sizeof(double) * (size_t)(dim * n));
+  mfree_particles_t *ps = cloud(dim, m, 1.5, xs, 5 + (uint64_t)form);
+  mfree_approximant_t *a = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  assert_ok(ctx, mfree_approximant_set_order(a, 1));
+  mfree_assembler_t *as = NULL;
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, form, &as));
+  assert_ok(ctx, mfree_assembler_set_material(as, YOUNG, NU));
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const int32_t nc[3] = {m - 1, m - 1, m - 1};
+  assert_ok(ctx, mfree_assembler_set_quadrature_cells(as, lo, hi, nc, 2, NULL, NULL));
+  assert_ok(ctx, mfree_assembler_setup(as));
+  mfree_matrix_t *K = NULL;
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  int32_t nd = 0, sym = 0;
+  assert_ok(ctx, mfree_matrix_get_size(K, &nd, NULL, NULL));
+  assert_int_equal(nd, dim * n);
+  assert_ok(ctx, mfree_matrix_get_symmetric(K, &sym));
+  assert_int_equal(sym, 1);
+
+  double D[6][6];
+  const int nv = material(form, D);
+  double *u[6], *Ku = malloc(sizeof(double) * (size_t)nd);
+  for (int s = 0; s < nv; ++s) {
+    double G[3][3];
+    voigt_gradient(dim, s, G);
+    u[s] = malloc(sizeof(double) * (size_t)nd);
+    for (int p = 0; p < n; ++p)
+      for (int i = 0; i < dim; ++i) {
+        double v = 0.0;
+        for (int j = 0; j < dim; ++j) v += G[i][j] * xs[dim * p + j];
+        u[s][dim * p + i] = v;
+      }
+  }
+  const double V = 1.0; /* the unit square / cube */
+  for (int s = 0; s < nv; ++s) {
+    spmv(K, u[s], Ku);
+    for (int t = 0; t < nv; ++t) {
+      double e = 0.0;
+      for (int k = 0; k < nd; ++k) e += u[t][k] * Ku[k];
+      if (fabs(e - V * D[t][s]) > 1e-11 * YOUNG) fail_msg("form %d: u_%d^T K u_%d = %.15g, V D = %.15g", (int)form, t, s, e, V * D[t][s]);
+    }
+  }
+  /* rigid-body modes: translations and infinitesimal rotations */
+  const int nr = dim == 3 ? 6 : 3;
+  double kmax = 0.0;
+  {
+    const int64_t *rp;
+    const int32_t *ci;
+    const double *kv;
+    assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &kv));
+    for (int64_t k = 0; k < rp[nd]; ++k) kmax = fmax(kmax, fabs(kv[k]));
+  }
+  double *r = malloc(sizeof(double) * (size_t)nd);
+  for (int mode = 0; mode < nr; ++mode) {
+    for (int p = 0; p < n; ++p) {
+      const double *x = xs + dim * p;
+      double *v = r + dim * p;
+      for (int i = 0; i < dim; ++i) v[i] = mode == i ? 1.0 : 0.0;
+      if (mode >= dim) {
+        int i = 0, j = 1; /* rotation in the (i, j) plane */
+        if (mode == 4) i = 1, j = 2;
+        if (mode == 5) i = 0, j = 2;
+        v[i] = -x[j];
+        v[j] = x[i];
+      }
+    }
+    spmv(K, r, Ku);
+    for (int k = 0; k < nd; ++k)
+      if (fabs(Ku[k]) > 1e-11 * kmax) fail_msg("form %d: rigid mode %d, (K u)_%d = %g", (int)form, mode, k, Ku[k]);
+  }
+  for (int s = 0; s < nv; ++s) free(u[s]);
+  free(r);
+  free(Ku);
+  mfree_matrix_destroy(&K);
+  mfree_assembler_destroy(&as);
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+  free(xs);
+}
+
+static void test_material_plane_stress(void **s) { (void)s; check_material(MFREE_FORM_ELASTICITY_PLANE_STRESS); }
+static void test_material_plane_strain(void **s) { (void)s; check_material(MFREE_FORM_ELASTICITY_PLANE_STRAIN); }
+static void test_material_3d(void **s) { (void)s; check_material(MFREE_FORM_ELASTICITY_3D); }
+
+/* CSC and CSR views hold the same entries (each CSC column sorted by row). */
+static void compare_views(const mfree_matrix_t *K) {
+  int32_t nr, nc;
+  int64_t nnz;
+  assert_ok(ctx, mfree_matrix_get_size(K, &nr, &nc, &nnz));
+  const int64_t *rp, *cp;
+  const int32_t *ci, *ri;
+  const double *v, *w;
+  assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &v));
+  assert_ok(ctx, mfree_matrix_get_csc(K, &cp, &ri, &w));
+  assert_true(cp[0] == 0 && cp[nc] == nnz);
+  int64_t *pos = calloc((size_t)nc, sizeof(int64_t));
+  for (int32_t j = 0; j < nc; ++j) pos[j] = cp[j];
+  for (int32_t i = 0; i < nr; ++i) /* rows in order: each column's rows come sorted */
+    for (int64_t k = rp[i]; k < rp[i + 1]; ++k) {
+      const int32_t j = ci[k];
+      assert_true(pos[j] < cp[j + 1]);
+      assert_int_equal(ri[pos[j]], i);
+      assert_true(w[pos[j]] == v[k]);
+      ++pos[j];
+    }
+  for (int32_t j = 0; j < nc; ++j) assert_true(pos[j] == cp[j + 1]);
+  free(pos);
+}
+
+static void test_csc_view_and_refill(void **s) {
+  (void)s;
+  enum { m = 7, n = m * m };
+  double xs[2 * n];
+  mfree_particles_t *ps = cloud(2, m, 1.6, xs, 3);
+  mfree_approximant_t *trial = NULL, *test = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_KB_METHOD1, &trial));
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_SHEPARD, &test));
+  mfree_assembler_t *as = NULL; /* Petrov-Galerkin: an unsymmetric matrix */
+  assert_ok(ctx, mfree_assembler_create(ctx, trial, test, MFREE_FORM_ELASTICITY_PLANE_STRESS, &as));
+  assert_ok(ctx, mfree_assembler_set_material(as, YOUNG, NU));
+  assert_ok(ctx, mfree_assembler_setup(as));
+  mfree_matrix_t *K = NULL;
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  int32_t sym = 1;
+  assert_ok(ctx, mfree_matrix_get_symmetric(K, &sym));
+  assert_int_equal(sym, 0);
+  compare_views(K);
+  int64_t id0, id1;
+  assert_ok(ctx, mfree_matrix_get_pattern_id(K, &id0));
+  const int64_t *cp;
+  const int32_t *ri;
+  const double *w;
+  assert_ok(ctx, mfree_matrix_get_csc(K, &cp, &ri, &w));
+  const double w0 = w[0];
+  for (int i = 0; i < n; ++i) xs[2 * i + 1] += 2e-3 * cos(3.0 * i) / (m - 1); /* small move */
+  assert_ok(ctx, mfree_particles_update(ps));
+  assert_ok(ctx, mfree_assembler_update(as));
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  assert_ok(ctx, mfree_matrix_get_pattern_id(K, &id1));
+  assert_true(id1 == id0);
+  compare_views(K); /* the cached CSC follows the refill */
+  assert_ok(ctx, mfree_matrix_get_csc(K, &cp, &ri, &w));
+  assert_true(w[0] != w0);
+  mfree_matrix_destroy(&K);
+  mfree_assembler_destroy(&as);
+  mfree_approximant_destroy(&trial);
+  mfree_approximant_destroy(&test);
+  mfree_particles_destroy(&ps);
+}
+
+static void g_lin(void *u, const double *x, double *v) {
+  (void)u;
+  v[0] = 0.3 + 1.5 * x[0] - 0.7 * x[1] + 0.4 * x[0] * x[0];
+}
+static void b_const(void *u, const double *x, double *v) {
+  (void)u;
+  (void)x;
+  v[0] = 0.8; /* -Lap g */
+}
+
+static void test_lagrange(void **s) {
+  (void)s;
+  enum { m = 7, n = m * m, per = 6, np = 4 * per };
+  double xs[2 * n], bp[2 * np], bw[np];
+  mfree_particles_t *ps = cloud(2, m, 1.6, xs, 9);
+  for (int e = 0; e < 4; ++e) /* points inside each edge (corners excluded) */
+    for (int k = 0; k < per; ++k) {
+      const double t = (k + 0.5) / per;
+      double *x = bp + 2 * (e * per + k);
+      x[0] = e == 0 ? t : e == 1 ? 1.0 : e == 2 ? 1.0 - t : 0.0;
+      x[1] = e == 0 ? 0.0 : e == 1 ? t : e == 2 ? 1.0 : 1.0 - t;
+      bw[e * per + k] = 1.0 / per;
+    }
+  mfree_approximant_t *a = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  assert_ok(ctx, mfree_approximant_set_order(a, 1));
+  mfree_assembler_t *as = NULL;
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_LAPLACE, &as));
+  const double lo[2] = {0, 0}, hi[2] = {1, 1};
+  const int32_t nc[2] = {m - 1, m - 1};
+  assert_ok(ctx, mfree_assembler_set_quadrature_cells(as, lo, hi, nc, 3, NULL, NULL));
+  assert_ok(ctx, mfree_assembler_set_body_force(as, b_const, NULL));
+  assert_ok(ctx, mfree_assembler_add_dirichlet(as, MFREE_BC_LAGRANGE, np, bp, MFREE_LAYOUT_AOS, 2, bw, NULL, 1,
+                                               g_lin, NULL));
+  assert_ok(ctx, mfree_assembler_setup(as));
+  int32_t nd = 0;
+  assert_ok(ctx, mfree_assembler_get_size(as, &nd, NULL));
+  assert_int_equal(nd, n + np);
+  mfree_matrix_t *K = NULL;
+  assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+  int32_t sym = 0;
+  assert_ok(ctx, mfree_matrix_get_symmetric(K, &sym));
+  assert_int_equal(sym, 1);
+
+  /* the multiplier rows hold the trial values at the points (up to one sign) */
+  mfree_approximant_t *ev = NULL;
+  const double h = 1.6 / (m - 1);
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &ev));
+  assert_ok(ctx, mfree_approximant_set_order(ev, 1));
+  assert_ok(ctx, mfree_approximant_set_points(ev, np, bp, MFREE_LAYOUT_AOS, 2, &h, 0, MFREE_BORROW));
+  assert_ok(ctx, mfree_approximant_setup(ev));
+  double *Phi = calloc((size_t)np * n, sizeof(double));
+  {
+    int64_t nnz;
+    assert_ok(ctx, mfree_approximant_get_nnz(ev, &nnz));
+    int64_t *rp = malloc(sizeof(int64_t) * (np + 1));
+    int32_t *ci = malloc(sizeof(int32_t) * (size_t)nnz);
+    double *v = malloc(sizeof(double) * (size_t)nnz);
+    assert_ok(ctx, mfree_approximant_assemble_csr(ev, MFREE_DERIV_VALUE, 0, rp, ci, v));
+    for (int p = 0; p < np; ++p)
+      for (int64_t k = rp[p]; k < rp[p + 1]; ++k) Phi[(size_t)p * n + ci[k]] = v[k];
+    free(rp), free(ci), free(v);
+  }
+  double *A = calloc((size_t)nd * nd, sizeof(double));
+  {
+    const int64_t *rp;
+    const int32_t *ci;
+    const double *v;
+    assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &v));
+    for (int32_t i = 0; i < nd; ++i)
+      for (int64_t k = rp[i]; k < rp[i + 1]; ++k) A[(size_t)i * nd + ci[k]] = v[k];
+  }
+  double sign = 0.0;
+  for (int p = 0; p < np; ++p) {
+    for (int J = 0; J < n; ++J) {
+      const double kij = A[(size_t)(n + p) * nd + J];
+      if (sign == 0.0 && fabs(Phi[(size_t)p * n + J]) > 0.1) sign = kij / Phi[(size_t)p * n + J] > 0 ? 1.0 : -1.0;
+      assert_true(fabs(kij - sign * Phi[(size_t)p * n + J]) < 1e-13);
+    }
+    for (int q = 0; q < np; ++q) assert_true(A[(size_t)(n + p) * nd + n + q] == 0.0);
+  }
+  assert_true(sign != 0.0);
+
+  /* solve densely; the constraint holds at every point */
+  double *f = malloc(sizeof(double) * (size_t)nd);
+  assert_ok(ctx, mfree_assembler_assemble_rhs(as, f));
+  for (int k = 0; k < nd; ++k) { /* Gaussian elimination with partial pivoting */
+    int piv = k;
+    for (int i = k + 1; i < nd; ++i)
+      if (fabs(A[(size_t)i * nd + k]) > fabs(A[(size_t)piv * nd + k])) piv = i;
+    assert_true(fabs(A[(size_t)piv * nd + k]) > 1e-300);
+    if (piv != k) {
+      for (int j = 0; j < nd; ++j) {
+        const double t = A[(size_t)k * nd + j];
+        A[(size_t)k * nd + j] = A[(size_t)piv * nd + j];
+        A[(size_t)piv * nd + j] = t;
+      }
+      const double t = f[k];
+      f[k] = f[piv];
+      f[piv] = t;
+    }
+    for (int i = k + 1; i < nd; ++i) {
+      const double c = A[(size_t)i * nd + k] / A[(size_t)k * nd + k];
+      if (c == 0.0) continue;
+      for (int j = k; j < nd; ++j) A[(size_t)i * nd + j] -= c * A[(size_t)k * nd + j];
+      f[i] -= c * f[k];
+    }
+  }
+  for (int i = nd - 1; i >= 0; --i) {
+    double t = f[i];
+    for (int j = i + 1; j < nd; ++j) t -= A[(size_t)i * nd + j] * f[j];
+    f[i] = t / A[(size_t)i * nd + i];
+  }
+  double uq[np];
+  assert_ok(ctx, mfree_approximant_apply(ev, MFREE_OP_VALUE, 1, f, MFREE_LAYOUT_AOS, 1, uq, MFREE_LAYOUT_AOS, 1));
+  for (int p = 0; p < np; ++p) {
+    double g;
+    g_lin(NULL, bp + 2 * p, &g);
+    if (fabs(uq[p] - g) > 1e-11) fail_msg("Lagrange point %d: u^h = %.15g, g = %.15g", p, uq[p], g);
+  }
+  free(f);
+  free(A);
+  free(Phi);
+  mfree_matrix_destroy(&K);
+  mfree_assembler_destroy(&as);
+  mfree_approximant_destroy(&ev);
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_material_plane_stress),
+      cmocka_unit_test(test_material_plane_strain),
+      cmocka_unit_test(test_material_3d),
+      cmocka_unit_test(test_csc_view_and_refill),
+      cmocka_unit_test(test_lagrange),
+  };
+  return cmocka_run_group_tests(tests, setup, teardown);
+}
