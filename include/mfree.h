@@ -910,12 +910,14 @@ MFREE_API mfree_status_t mfree_assembler_set_fe_layer(mfree_assembler_t *as, int
 MFREE_API mfree_status_t mfree_assembler_set_penalty(mfree_assembler_t *as, double alpha);
 /**
  * Variationally consistent integration (VCI; Chen, Hillman and Rueter, IJNME 93 (2013)
- * 245-267), first order, for the Galerkin stiffness forms (elasticity, Laplace): the test
- * gradients at the quadrature points of each test function J get a constant correction
- * xi_J (over J's support) such that the quadrature satisfies the divergence theorem,
- * sum_q grad Psi_J(x_q) w_q = sum_p Psi_J(x_p) n_p w_p on the boundary points given here.
- * Trial functions that reproduce linear fields then pass the linear patch test with any
- * domain quadrature, nodal quadrature included, and the finite-element layer's strip
+ * 245-267), second order, for the Galerkin stiffness forms (elasticity, Laplace): the
+ * test gradients at the quadrature points of each test function J get a correction
+ * xi_J + eta_J (x - x_J)/h_J, constant and linear over J's support, such that the
+ * quadrature satisfies the divergence theorem for Psi_J and Psi_J (x - x_J)/h_J:
+ * sum_q grad(Psi_J P)(x_q) w_q = sum_p (Psi_J P)(x_p) n_p w_p on the boundary points
+ * given here (P = 1, (x - x_J)/h_J). Trial functions that reproduce linear (quadratic)
+ * fields then pass the linear (quadratic) patch test with any domain quadrature, nodal
+ * quadrature included, and the finite-element layer's strip
  * (mfree_assembler_set_fe_layer) is consistent too. Not in paper 000: an option beside
  * its schemes. The assembled matrix is then unsymmetric even for Bubnov-Galerkin.
  * @param[in] npts     boundary points (copied); 0 switches the correction off

@@ -603,6 +603,11 @@ static void test_bad_input(void **s) {
   const double far[4] = {5.0, 5.0, 0.5, 0.5}, fw[2] = {1.0, 1.0};
   assert_ok(ctx, mfree_assembler_set_quadrature_points(as, 2, far, MFREE_LAYOUT_AOS, 2, fw));
   assert_error(ctx, mfree_assembler_setup(as), MFREE_FAIL_NEIGHBORS, "quadrature point");
+  /* every point inside some support, but particles far from them are seen by none: their
+   * rows would be zero (a singular matrix); reported with the particle */
+  const double near[2] = {0.05, 0.05}, nw[1] = {1.0};
+  assert_ok(ctx, mfree_assembler_set_quadrature_points(as, 1, near, MFREE_LAYOUT_AOS, 2, nw));
+  assert_error(ctx, mfree_assembler_setup(as), MFREE_FAIL_NEIGHBORS, "seen by no quadrature point");
   /* nodal quadrature again: a clean setup after the failures */
   assert_ok(ctx, mfree_assembler_set_quadrature_nodal(as));
   assert_ok(ctx, mfree_assembler_setup(as));

@@ -35,8 +35,9 @@ class Assembler {
   void add_traction_nodes(int32_t n, const int32_t *nodes, const double *normals, mfree_field_fn t,
                           void *user);
   void set_penalty(double alpha);
-  // Variationally consistent integration (Chen, Hillman, Rueter 2013), first order: the
-  // whole boundary as points, weights and outward normals; npts = 0 switches it off.
+  // Variationally consistent integration (Chen, Hillman, Rueter 2013), second order
+  // (constant and linear corrections of the test gradients): the whole boundary as
+  // points, weights and outward normals; npts = 0 switches it off.
   void set_consistent_integration(int32_t npts, const double *x, int layout, int64_t ld, const double *w,
                                   const double *normals);
   void set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, int32_t ngu, const int32_t *gu,
@@ -114,7 +115,7 @@ class Assembler {
     std::vector<double> bmin, bmax;  // element bounding boxes
   };
   void build_qtables();
-  // First-order VCI of the test gradients in t from the boundary values b with normals.
+  // Second-order VCI of the test gradients in t from the boundary values b with normals.
   void correct_test_gradients(QTable &t, const QTable &b, const std::vector<double> &normals) const;
   // The test table of the assembly: its own when the test functions differ from the
   // trial functions or their gradients were corrected, else the trial table.
