@@ -406,6 +406,98 @@ static void test_consistent_integration(void **s) {
   free(y);
 }
 
+/* Velocity smoothing (mfree_system_set_velocity_smoothing): on the jittered free patch
+ * with random velocities and densities, the extra forces M_i (a_i(beta) - a_i(0)) are
+ * pairwise equal and opposite, so they sum to zero (linear momentum, to round-off, with
+ * Galerkin and physical lumping) and are not small; a uniform velocity gets no extra force
+ * at all; on the regular lattice a linear velocity field (shear and rotation) gets none
+ * at the particles 2h from the edges (symmetric neighbourhoods, to round-off), and a
+ * checkerboard of velocities (a zero-energy mode of nodal integration, t702 test 1) is
+ * opposed at every interior particle. Positions and densities do not see the term. */
+static void rhs_pair(mfree_system_t *sys, const double *y, double beta, double *y0, double *y1) {
+  assert_ok(ctx, mfree_system_set_velocity_smoothing(sys, 0.0));
+  assert_ok(ctx, mfree_system_rhs(sys, 0.0, y, y0));
+  assert_ok(ctx, mfree_system_set_velocity_smoothing(sys, beta));
+  assert_ok(ctx, mfree_system_rhs(sys, 0.0, y, y1));
+  for (int q = 0; q < 2 * N; ++q) assert_true(y1[q] == y0[q]);
+  for (int q = 4 * N; q < 5 * N; ++q) assert_true(y1[q] == y0[q]);
+}
+
+static void test_velocity_smoothing(void **s) {
+  (void)s;
+  double m[N];
+  const double beta = 0.1, c = sqrt(GAMMA * kappa_of(NZ * D) / RHO0);
+  const double aref = beta * c / (1.5 * D) * 0.3; /* beta c / h times the velocity scale */
+  double *y0 = calloc(5 * (size_t)N, sizeof(double)), *y1 = calloc(5 * (size_t)N, sizeof(double));
+  for (int lump = MFREE_LUMP_GALERKIN; lump <= MFREE_LUMP_PHYSICAL; ++lump) {
+    double *y = patch(m, 1, 0);
+    mfree_system_t *sys = fluid(m, NZ * D, 0.5, 0);
+    assert_ok(ctx, mfree_system_set_lumping(sys, (mfree_lumping_t)lump));
+    rhs_pair(sys, y, beta, y0, y1);
+    mfree_matrix_t *M = NULL;
+    assert_ok(ctx, mfree_system_assemble_mass(sys, y, 0, &M));
+    const int64_t *rp;
+    const int32_t *ci;
+    const double *v;
+    assert_ok(ctx, mfree_matrix_get_csr(M, &rp, &ci, &v));
+    double P[2] = {0, 0}, scale = 0.0, amax = 0.0;
+    for (int i = 0; i < N; ++i) {
+      const double Mi = v[rp[2 * N + 2 * i]];
+      const double ax = y1[2 * N + 2 * i] - y0[2 * N + 2 * i], az = y1[2 * N + 2 * i + 1] - y0[2 * N + 2 * i + 1];
+      P[0] += Mi * ax;
+      P[1] += Mi * az;
+      scale += Mi * (fabs(ax) + fabs(az));
+      amax = fmax(amax, hypot(ax, az));
+    }
+    mfree_matrix_destroy(&M);
+    if (amax < 0.1 * aref) fail_msg("lumping %d: smoothing acceleration only %g (scale %g)", lump, amax, aref);
+    if (fabs(P[0]) > 1e-12 * scale || fabs(P[1]) > 1e-12 * scale)
+      fail_msg("lumping %d: momentum rate (%g, %g), scale %g", lump, P[0], P[1], scale);
+    for (int p = 0; p < N; ++p) { /* uniform velocity */
+      y[2 * N + 2 * p] = 0.2;
+      y[2 * N + 2 * p + 1] = -0.1;
+    }
+    rhs_pair(sys, y, beta, y0, y1);
+    for (int q = 2 * N; q < 4 * N; ++q)
+      if (fabs(y1[q] - y0[q]) > 1e-12 * aref) fail_msg("uniform velocity: smoothing acceleration %g", y1[q] - y0[q]);
+    mfree_system_destroy(&sys);
+    free(y);
+  }
+  /* regular lattice at rest density: linear field, then checkerboard */
+  double *y = patch(m, 0, 1);
+  for (int p = 0; p < N; ++p) {
+    y[4 * N + p] = RHO0;
+    m[p] = RHO0 * D * D;
+    y[2 * N + 2 * p] = 0.1 + 20.0 * y[2 * p] - 30.0 * y[2 * p + 1];
+    y[2 * N + 2 * p + 1] = -0.2 + 40.0 * y[2 * p] + 10.0 * y[2 * p + 1];
+  }
+  mfree_system_t *sys = fluid(m, NZ * D, 0.5, 0);
+  rhs_pair(sys, y, beta, y0, y1);
+  for (int j = 3; j < NZ - 3; ++j)
+    for (int i = 3; i < NX - 3; ++i)
+      for (int c2 = 0; c2 < 2; ++c2) {
+        const int q = 2 * N + 2 * (j * NX + i) + c2;
+        if (fabs(y1[q] - y0[q]) > 1e-10 * aref) fail_msg("linear field, particle %d: smoothing acceleration %g", j * NX + i, y1[q] - y0[q]);
+      }
+  for (int p = 0; p < N; ++p) {
+    y[2 * N + 2 * p] = ((p % NX) + (p / NX)) % 2 ? -0.01 : 0.01;
+    y[2 * N + 2 * p + 1] = 0.0;
+  }
+  rhs_pair(sys, y, beta, y0, y1);
+  for (int j = 2; j < NZ - 2; ++j)
+    for (int i = 2; i < NX - 2; ++i) {
+      const int p = j * NX + i;
+      const double da = y1[2 * N + 2 * p] - y0[2 * N + 2 * p];
+      if (!(da * y[2 * N + 2 * p] < 0.0)) fail_msg("particle %d: velocity %g, smoothing acceleration %g", p, y[2 * N + 2 * p], da);
+    }
+  assert_error(ctx, mfree_system_set_velocity_smoothing(sys, -1.0), MFREE_ERR_ARG, "velocity-smoothing");
+  assert_error(ctx, mfree_system_set_velocity_smoothing(sys, NAN), MFREE_ERR_ARG, "velocity-smoothing");
+  mfree_system_destroy(&sys);
+  free(y0);
+  free(y1);
+  free(y);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_conservation),
@@ -415,6 +507,7 @@ int main(void) {
       cmocka_unit_test(test_dummy_walls),
       cmocka_unit_test(test_density_diffusion),
       cmocka_unit_test(test_consistent_integration),
+      cmocka_unit_test(test_velocity_smoothing),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

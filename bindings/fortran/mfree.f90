@@ -1102,6 +1102,13 @@ module mfree
       integer(c_int32_t), value :: on
     end function mfree_system_set_consistent_integration_c
 
+    integer(c_int) function mfree_system_set_velocity_smoothing_c(sys, beta) &
+        bind(C, name="mfree_system_set_velocity_smoothing")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), value :: beta
+    end function mfree_system_set_velocity_smoothing_c
+
     integer(c_int) function mfree_system_set_box_c(sys, lo, hi) &
         bind(C, name="mfree_system_set_box")
       import :: c_int, c_double, c_ptr
@@ -1272,7 +1279,7 @@ module mfree
   public :: mfree_system_set_gravity_c, mfree_system_set_lumping_c
   public :: mfree_system_set_walls_c, mfree_system_set_box_c, mfree_system_get_size_c
   public :: mfree_system_set_dummy_particles_c, mfree_system_set_density_diffusion_c
-  public :: mfree_system_set_consistent_integration_c
+  public :: mfree_system_set_consistent_integration_c, mfree_system_set_velocity_smoothing_c
   public :: mfree_system_rhs_c, mfree_system_assemble_mass_c
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c

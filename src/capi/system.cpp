@@ -138,6 +138,9 @@ mfree_status_t mfree_system_set_density_diffusion(mfree_system_t *sys, double de
 mfree_status_t mfree_system_set_consistent_integration(mfree_system_t *sys, int32_t on) {
   MFREE_SYS_SETTER("mfree_system_set_consistent_integration", f.set_consistent_integration(on));
 }
+mfree_status_t mfree_system_set_velocity_smoothing(mfree_system_t *sys, double beta) {
+  MFREE_SYS_SETTER("mfree_system_set_velocity_smoothing", f.set_velocity_smoothing(beta));
+}
 
 mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
   return mfree::with_handle(sys, "mfree_system_get_size", [&](const mfree::System &f) {

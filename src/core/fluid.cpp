@@ -761,6 +761,7 @@ Report FluidSystem::accel_dim(const double *v, const double *rho, double *a) {
     }
   });
   vci_correct(pack_.data(), P, a);  // optional, fluid_wall.cpp
+  velocity_smoothing(v, galerkin ? acc + D + 1 : mass_.data(), galerkin ? A : 1, a);  // optional, fluid_wall.cpp
   for (int32_t fbad : first_bad) bad = std::min(bad, fbad);
   if (bad < n_) {
     const double m = galerkin ? acc[static_cast<size_t>(bad) * A + D + 1] : mass_[bad];

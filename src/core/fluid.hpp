@@ -35,6 +35,7 @@ class FluidSystem : public System {
   void set_dummy_particles(int32_t n, const double *x, const double *vol, int64_t stride);
   void set_density_diffusion(double delta);
   void set_consistent_integration(int on);  // 0 (default) or 1: constant VCI correction
+  void set_velocity_smoothing(double beta);  // 0 (default): off
 
   int dim() const { return dim_; }
   int32_t size() const { return n_; }
@@ -88,6 +89,7 @@ class FluidSystem : public System {
   void density_diffusion(const double *rho, double *drho) const;  // adds the delta-SPH term
   void vci_setup();  // after the tables
   void vci_correct(const double *pack, int per_point, double *a) const;  // end of accel
+  void velocity_smoothing(const double *v, const double *m, int stride, double *a) const;  // end of accel
 
   int dim_;
   int32_t n_;
@@ -102,6 +104,7 @@ class FluidSystem : public System {
   mutable DummyWall dummy_;  // scratch node arrays are refilled by const evaluations
   double delta_ = 0.0;
   bool vci_ = false;
+  double vsmooth_ = 0.0;
   bool box_ = false;
   double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
 

@@ -889,6 +889,10 @@ static void rows_system(void) {
   ROW0(MFREE_ERR_NULL, mfree_system_set_consistent_integration(NULL, 1));
   ROW(MFREE_ERR_ARG, mfree_system_set_consistent_integration(F.sys, -1));
   ROW(MFREE_ERR_ARG, mfree_system_set_consistent_integration(F.sys, 2));
+  ROW0(MFREE_ERR_NULL, mfree_system_set_velocity_smoothing(NULL, 0.1));
+  ROW(MFREE_ERR_ARG, mfree_system_set_velocity_smoothing(F.sys, -0.1));
+  ROW(MFREE_ERR_ARG, mfree_system_set_velocity_smoothing(F.sys, NAN));
+  ROW(MFREE_ERR_ARG, mfree_system_set_velocity_smoothing(F.sys, INFINITY));
   ROW0(MFREE_ERR_NULL, mfree_system_set_box(NULL, lo, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, NULL, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, lo, NULL));
