@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "parallel.hpp"
+
 namespace mfree {
 
 namespace {
@@ -193,6 +195,26 @@ void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int3
 Report ParticleSet::validate() {
   Report rep;
   site_status_.assign(n_, 0);
+  // Common case first, over the context's threads: every particle valid (a search is
+  // otherwise parallel, and this pass would bound its speed-up); the messages below are
+  // built only when some particle fails.
+  {
+    const int nt = std::min(num_threads(n_), 64);
+    char fail[64] = {0};
+    parallel_blocks(n_, nt, [&](int t, int64_t b, int64_t e) {
+      bool f = false;
+      for (int64_t i = b; i < e; ++i) {
+        const int32_t p = static_cast<int32_t>(i);
+        for (int c = 0; c < dim_; ++c) f = f || !std::isfinite(pos_(p, c));
+        auto bad = [&](const ScalarArray &a) { return a.set() && !(std::isfinite(a(p)) && a(p) > 0.0); };
+        f = f || bad(h_) || bad(vol_) || bad(mass_) || bad(rho_);
+      }
+      fail[t] = f;
+    });
+    bool any = false;
+    for (int t = 0; t < nt; ++t) any = any || fail[t];
+    if (!any) return rep;
+  }
   int64_t bad = 0;
   for (int32_t i = 0; i < n_; ++i) {
     int32_t st = 0;
