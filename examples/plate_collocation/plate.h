@@ -101,8 +101,10 @@ int plate_rings(double a, double b, int nt);
 int plate_ray_particles(int nt);
 
 /* Defaults of paper 001 Sect. 6.3 (a = 1, b = 10, SSPH, E = 1, nu = 0.25, sigma0 = 1,
- * revised super Gauss a = 1.6, h_i = 1.5 Delta_i) with nt particles on the hole and nr
- * rings (nr <= 0: plate_rings(1, 10, nt); set it again after changing a or b). */
+ * revised super Gauss a = 1.6, h_i = 1.5 Delta_i, PLATE_LAYOUT_RINGS,
+ * PLATE_CORNER_DIRICHLET) with nt particles on the hole and nr rings (nr <= 0:
+ * plate_rings(1, 10, nt); set it again after changing a or b). For the ray layouts set
+ * layout and nr = plate_ray_particles(nt) afterwards. */
 void plate_config_default(plate_config_t *cfg, int nt, int nr);
 
 /* Builds the particles, assembles the collocation system, solves it with UMFPACK and
