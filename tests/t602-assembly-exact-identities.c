@@ -6,6 +6,10 @@
  *    (e_a a unit Voigt strain) is u_a^T K u_b = V D_ab exactly, for every pair a, b:
  *    plane stress, plane strain and 3D, against the textbook D (Lame constants);
  *    rigid-body modes give K u = 0 and K is symmetric.
+ *  - Quadratures: host points and weights equal to the background cells' Gauss points
+ *    give the cells' matrix to round-off, also with an inside-test that drops two
+ *    thirds of the cells (particles seen by no point are then reported,
+ *    MFREE_FAIL_NEIGHBORS).
  *  - The CSC view (mfree_matrix_get_csc) holds the same entries as the CSR view, also
  *    after a refill on moved particles (same pattern id, new values).
  *  - MFREE_BC_LAGRANGE: the multiplier rows are the trial values Phi_J(x_p) at the
@@ -239,6 +243,84 @@ static void test_csc_view_and_refill(void **s) {
   mfree_particles_destroy(&ps);
 }
 
+static int32_t left_half(void *u, const double *x) {
+  (void)u;
+  return x[0] < 1.0 / 3.0;
+}
+
+/* K as a dense matrix (n x n). */
+static double *dense_of(const mfree_matrix_t *K, int32_t n) {
+  const int64_t *rp;
+  const int32_t *ci;
+  const double *v;
+  assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &v));
+  double *A = calloc((size_t)n * n, sizeof(double));
+  for (int32_t i = 0; i < n; ++i)
+    for (int64_t k = rp[i]; k < rp[i + 1]; ++k) A[(size_t)i * n + ci[k]] = v[k];
+  return A;
+}
+
+/* The three domain quadratures agree where they must: host points and weights equal to
+ * the background cells' Gauss points give the same matrix to round-off, also when the
+ * cells' inside-test keeps only x < 1/3 (host points filtered the same way). */
+static void test_quadrature_equivalence(void **s) {
+  (void)s;
+  enum { m = 7, n = m * m, nc1 = m - 1, ng = 3 };
+  double xs[2 * n];
+  mfree_particles_t *ps = cloud(2, m, 1.6, xs, 21);
+  mfree_approximant_t *a = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  const double gp[ng] = {-sqrt(0.6), 0.0, sqrt(0.6)}, gw[ng] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+  static double qx[2 * nc1 * nc1 * ng * ng], qw[nc1 * nc1 * ng * ng];
+  const double hc = 1.0 / nc1;
+  for (int half = 0; half < 2; ++half) {
+    int32_t nq = 0;
+    for (int cj = 0; cj < nc1; ++cj)
+      for (int ci = 0; ci < nc1; ++ci)
+        for (int b = 0; b < ng; ++b)
+          for (int c = 0; c < ng; ++c) {
+            const double x = (ci + 0.5 + 0.5 * gp[c]) * hc, y = (cj + 0.5 + 0.5 * gp[b]) * hc;
+            if (half && !(x < 1.0 / 3.0)) continue;
+            qx[2 * nq] = x, qx[2 * nq + 1] = y;
+            qw[nq++] = 0.25 * hc * hc * gw[b] * gw[c];
+          }
+    mfree_assembler_t *ac = NULL, *ap = NULL;
+    mfree_matrix_t *Kc = NULL, *Kp = NULL;
+    const double lo[2] = {0, 0}, hi[2] = {1, 1};
+    const int32_t nc[2] = {nc1, nc1};
+    assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_ELASTICITY_PLANE_STRESS, &ac));
+    assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_ELASTICITY_PLANE_STRESS, &ap));
+    assert_ok(ctx, mfree_assembler_set_material(ac, YOUNG, NU));
+    assert_ok(ctx, mfree_assembler_set_material(ap, YOUNG, NU));
+    assert_ok(ctx, mfree_assembler_set_quadrature_cells(ac, lo, hi, nc, ng, half ? left_half : NULL, NULL));
+    assert_ok(ctx, mfree_assembler_set_quadrature_points(ap, nq, qx, MFREE_LAYOUT_AOS, 2, qw));
+    /* with x > 1/3 dropped, the particles near x = 1 are seen by no point: reported */
+    const mfree_status_t expect = half ? MFREE_FAIL_NEIGHBORS : MFREE_SUCCESS;
+    assert_int_equal(mfree_assembler_setup(ac), expect);
+    assert_int_equal(mfree_assembler_setup(ap), expect);
+    int32_t nqc = 0, nqp = 0;
+    assert_ok(ctx, mfree_assembler_get_size(ac, NULL, &nqc));
+    assert_ok(ctx, mfree_assembler_get_size(ap, NULL, &nqp));
+    assert_int_equal(nqc, nq);
+    assert_int_equal(nqp, nq);
+    assert_ok(ctx, mfree_assembler_assemble_matrix(ac, &Kc));
+    assert_ok(ctx, mfree_assembler_assemble_matrix(ap, &Kp));
+    double *A = dense_of(Kc, 2 * n), *B = dense_of(Kp, 2 * n), amax = 0.0, diff = 0.0;
+    for (size_t k = 0; k < (size_t)4 * n * n; ++k) {
+      amax = fmax(amax, fabs(A[k]));
+      diff = fmax(diff, fabs(A[k] - B[k]));
+    }
+    if (!(diff <= 1e-13 * amax)) fail_msg("half %d: cells and host points differ by %g (max %g)", half, diff, amax);
+    free(A), free(B);
+    mfree_matrix_destroy(&Kc);
+    mfree_matrix_destroy(&Kp);
+    mfree_assembler_destroy(&ac);
+    mfree_assembler_destroy(&ap);
+  }
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
 static void g_lin(void *u, const double *x, double *v) {
   (void)u;
   v[0] = 0.3 + 1.5 * x[0] - 0.7 * x[1] + 0.4 * x[0] * x[0];
@@ -375,6 +457,7 @@ int main(void) {
       cmocka_unit_test(test_material_plane_strain),
       cmocka_unit_test(test_material_3d),
       cmocka_unit_test(test_csc_view_and_refill),
+      cmocka_unit_test(test_quadrature_equivalence),
       cmocka_unit_test(test_lagrange),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
