@@ -1,11 +1,13 @@
 #include "fluid.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <sstream>
 
 #include "kernel.hpp"
 #include "parallel.hpp"
+#include "simd.hpp"
 
 #ifdef __SSE2__
 #include <emmintrin.h>
@@ -134,16 +136,34 @@ Report FluidSystem::check_state(const double *y, int64_t step) const {
     rep.fail(status, s.str());
     return rep;
   };
-  for (int32_t i = 0; i < n_; ++i) {
-    bool finite = std::isfinite(rho[i]);
-    for (int c = 0; c < dim_; ++c) finite = finite && std::isfinite(x[i * dim_ + c]) && std::isfinite(v[i * dim_ + c]);
-    if (!finite) return fail(MFREE_FAIL_NONFINITE, i, " has a non-finite position, velocity or density", 0.0, -1);
-    if (!(rho[i] > 0.0)) return fail(MFREE_FAIL_INVALID_DATA, i, " has density ", rho[i], -1);
-    if (box_)
-      for (int c = 0; c < dim_; ++c)
-        if (x[i * dim_ + c] < lo_[c] || x[i * dim_ + c] > hi_[c])
-          return fail(MFREE_FAIL_DOMAIN, i, " left the box (coordinate ", x[i * dim_ + c], c);
-  }
+  const int dim = dim_;
+  auto valid = [&](int64_t i) {
+    bool ok = rho[i] > 0.0 && rho[i] <= DBL_MAX;  // false for NaN
+    for (int c = 0; c < dim; ++c) {
+      const double xc = x[i * dim + c];
+      ok = ok && std::isfinite(xc) && std::isfinite(v[i * dim + c]) && (!box_ || (xc >= lo_[c] && xc <= hi_[c]));
+    }
+    return ok;
+  };
+  // the first invalid particle: the lowest of the threads' first ones
+  int32_t first[64];  // parallel_blocks runs at most 64 threads
+  std::fill(first, first + 64, n_);
+  parallel_blocks(n_, num_threads(n_), [&](int t, int64_t b, int64_t e) {
+    for (int64_t i = b; i < e; ++i)
+      if (!valid(i)) {
+        first[t] = static_cast<int32_t>(i);
+        break;
+      }
+  });
+  const int32_t i = *std::min_element(first, first + 64);
+  if (i == n_) return rep;
+  bool finite = std::isfinite(rho[i]);
+  for (int c = 0; c < dim; ++c) finite = finite && std::isfinite(x[i * dim + c]) && std::isfinite(v[i * dim + c]);
+  if (!finite) return fail(MFREE_FAIL_NONFINITE, i, " has a non-finite position, velocity or density", 0.0, -1);
+  if (!(rho[i] > 0.0)) return fail(MFREE_FAIL_INVALID_DATA, i, " has density ", rho[i], -1);
+  for (int c = 0; c < dim && box_; ++c)
+    if (x[i * dim + c] < lo_[c] || x[i * dim + c] > hi_[c])
+      return fail(MFREE_FAIL_DOMAIN, i, " left the box (coordinate ", x[i * dim + c], c);
   return rep;
 }
 
@@ -189,7 +209,7 @@ constexpr double kMinRcond = 1e-12;
 // column by column) and its exact 1-norm condition number ||A||_1 ||X||_1; false when a
 // pivot is not positive or the system is singular to kMinRcond.
 template <int L>
-bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
+MFREE_ALWAYS_INLINE bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
   double U[L][L] = {}, D[L];
   for (int j = 0; j < L; ++j) {
     for (int i = 0; i < j; ++i) {
@@ -384,8 +404,8 @@ void FluidSystem::shepard_row(int n, const double *w, const double *gf, double *
 }
 
 template <int D>
-bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
-                             bool transpose) {
+MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch,
+                                                     int64_t *iscratch, bool transpose) {
   constexpr int L = D + 1;
   const double ih = 1.0 / h_, tol = shepard_cond_;
   const int64_t *crp = cand_.rowptr.data();
@@ -430,7 +450,7 @@ bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *s
     }
     // moments: M = sum w p p^T and M_,c = sum w_,c p p^T, p = (1, s), w_,c = gf s_c / h
     // (the 1/h is applied after the sums)
-    double m0[L][L] = {}, mc[D][L][L] = {};
+    double m0[L][L], mc[D][L][L];  // every entry is set below
     if (D == 2) {
       double a0 = 0, a1 = 0, a2 = 0, a11 = 0, a12 = 0, a22 = 0;
       double b1 = 0, b2 = 0, b11 = 0, b12 = 0, b22 = 0, b111 = 0, b112 = 0, b122 = 0, b222 = 0;
@@ -545,6 +565,20 @@ bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *s
   return one_way;
 }
 
+template <int D>
+bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
+                             bool transpose) {
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose);
+}
+
+#if MFREE_SIMD_X86
+template <int D>
+MFREE_TARGET_AVX2 bool FluidSystem::table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch,
+                                                    int64_t *iscratch, bool transpose) {
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose);
+}
+#endif
+
 Report FluidSystem::prepare(const double *y) {
   check_ready();
   Report rep = check_state(y, -1);
@@ -552,7 +586,9 @@ Report FluidSystem::prepare(const double *y) {
   const int dim = dim_;
   const int32_t nall = nq();
   const double *rho = y + 2 * static_cast<size_t>(dim) * n_;
-  for (int32_t i = 0; i < n_; ++i) vol_[i] = mass_[i] / rho[i];
+  parallel_blocks(n_, num_threads(n_), [&](int, int64_t b, int64_t e) {
+    for (int64_t i = b; i < e; ++i) vol_[i] = mass_[i] / rho[i];
+  });
   const double *xn = node_positions(y);  // + dummies (fluid_wall.cpp)
   Report r = candidates(xn);
   if (!r.ok()) return r;
@@ -592,10 +628,19 @@ Report FluidSystem::prepare(const double *y) {
   if (rows_scratch_.size() < per_thread * nt) rows_scratch_.resize(per_thread * nt);
   if (rows_iscratch_.size() < iper_thread * nt) rows_iscratch_.resize(iper_thread * nt);
   bool one_way[64] = {};  // parallel_blocks runs at most 64 threads
+  const bool avx2 = simd::use_avx2();  // once per step: every thread runs the same copy
+  (void)avx2;
   parallel_blocks(nall, nt, [&](int t, int64_t b, int64_t e) {
     double *scratch = rows_scratch_.data() + per_thread * t;
     int64_t *iscratch = rows_iscratch_.data() + iper_thread * t;
     const int32_t k0 = static_cast<int32_t>(b), k1 = static_cast<int32_t>(e);
+#if MFREE_SIMD_X86
+    if (avx2) {
+      one_way[t] = dim == 2 ? table_rows_avx2<2>(k0, k1, xn, scratch, iscratch, transpose)
+                            : table_rows_avx2<3>(k0, k1, xn, scratch, iscratch, transpose);
+      return;
+    }
+#endif
     one_way[t] = dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch, transpose)
                           : table_rows<3>(k0, k1, xn, scratch, iscratch, transpose);
   });
@@ -883,12 +928,17 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
 double FluidSystem::stable_dt(const double *y) const {
   const size_t nd = static_cast<size_t>(dim_) * n_;
   const double *v = y + nd, *rho = y + 2 * nd;
-  double cmax = 0.0;
-  for (int32_t i = 0; i < n_; ++i) {
-    double vv = 0.0;
-    for (int c = 0; c < dim_; ++c) vv += v[i * dim_ + c] * v[i * dim_ + c];
-    cmax = std::max(cmax, std::sqrt(gamma_ * kappa_ / rho[i]) + std::sqrt(vv));  // 003 eqs 120-121
-  }
+  double tmax[64] = {};  // per thread (parallel_blocks runs at most 64): a maximum is exact in any order
+  parallel_blocks(n_, num_threads(n_), [&](int t, int64_t b, int64_t e) {
+    double cm = 0.0;
+    for (int64_t i = b; i < e; ++i) {
+      double vv = 0.0;
+      for (int c = 0; c < dim_; ++c) vv += v[i * dim_ + c] * v[i * dim_ + c];
+      cm = std::max(cm, std::sqrt(gamma_ * kappa_ / rho[i]) + std::sqrt(vv));  // 003 eqs 120-121
+    }
+    tmax[t] = cm;
+  });
+  const double cmax = *std::max_element(tmax, tmax + 64);
   return cmax > 0.0 ? h_ / cmax : INFINITY;
 }
 
@@ -931,10 +981,15 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
       // and interpolated velocities with v^{k+1/2} on the tables at x^k
       Report r = accel(v, rho, rate.data());
       if (!r.ok()) return r;
-      for (size_t q = 0; q < nd; ++q) yn[nd + q] = v[q] + dt * rate[q];
+      const int nt = num_threads(n_);
+      parallel_blocks(static_cast<int64_t>(nd), nt, [&](int, int64_t b, int64_t e) {
+        for (int64_t q = b; q < e; ++q) yn[nd + q] = v[q] + dt * rate[q];
+      });
       kinematics(yn + nd, rho, vh.data(), dr.data());
-      for (size_t q = 0; q < nd; ++q) yn[q] = x[q] + dt * vh[q];
-      for (int32_t i = 0; i < n_; ++i) yn[2 * nd + i] = rho[i] + dt * dr[i];
+      parallel_blocks(n_, nt, [&](int, int64_t b, int64_t e) {
+        for (int64_t q = b * dim; q < e * dim; ++q) yn[q] = x[q] + dt * vh[q];
+        for (int64_t i = b; i < e; ++i) yn[2 * nd + i] = rho[i] + dt * dr[i];
+      });
     } else {
       // 003 eqs 111-119
       Report r = rhs(t, y, rate.data());

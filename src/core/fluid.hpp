@@ -59,8 +59,13 @@ class FluidSystem : public System {
   // Tables rows [k0, k1): linear MLS at the nodes, Shepard rows where ill-conditioned;
   // with transpose, also NT_ (true if a pair is in one node's row only, which the search
   // rules out).
+  // table_rows_avx2 is the same code compiled for AVX2 + FMA (simd.hpp), chosen per step.
   template <int D>
   bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  template <int D>
+  bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  template <int D>
+  bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
   // Chunks of kChunk rows coloured so that no two chunks of a colour touch a common
   // node (on the candidate pattern), for the scatter of accel (rebuilt with the lists).
   void color_chunks();
