@@ -11,7 +11,13 @@
  *    thirds of the cells (particles seen by no point are then reported,
  *    MFREE_FAIL_NEIGHBORS).
  *  - The CSC view (mfree_matrix_get_csc) holds the same entries as the CSR view, also
- *    after a refill on moved particles (same pattern id, new values).
+ *    after a refill on moved particles (same pattern id, new values); the 32- and
+ *    64-bit CSR views share the CSR view's values (zero-copy).
+ *  - Loads: tractions on segments equal the same Gauss points given as host points,
+ *    and with partition-of-unity test functions the load's resultant and moment are the
+ *    Gauss rule's, exact for the quadratic traction here.
+ *  - MFREE_BC_PENALTY adds alpha sum_p w_p Phi_J(x_p) Phi_K(x_p) to the matrix and
+ *    alpha sum_p w_p Phi_J(x_p) g(x_p) to the load (independent approximant at x_p).
  *  - MFREE_BC_LAGRANGE: the multiplier rows are the trial values Phi_J(x_p) at the
  *    points (an independent approximant evaluated there), the system is symmetric, and
  *    the solved u^h satisfies u^h(x_p) = g(x_p) at every point to round-off.
@@ -234,6 +240,22 @@ static void test_csc_view_and_refill(void **s) {
   assert_ok(ctx, mfree_matrix_get_pattern_id(K, &id1));
   assert_true(id1 == id0);
   compare_views(K); /* the cached CSC follows the refill */
+  { /* zero-copy: the 32- and 64-bit views share the values array of the CSR view, and
+       their index arrays hold the same indices */
+    int32_t nr;
+    int64_t nnz;
+    assert_ok(ctx, mfree_matrix_get_size(K, &nr, NULL, &nnz));
+    const int64_t *rp, *rp64, *ci64;
+    const int32_t *ci, *rp32, *ci32;
+    const double *v, *v32, *v64;
+    assert_ok(ctx, mfree_matrix_get_csr(K, &rp, &ci, &v));
+    assert_ok(ctx, mfree_matrix_get_csr_i32(K, &rp32, &ci32, &v32));
+    assert_ok(ctx, mfree_matrix_get_csr_i64(K, &rp64, &ci64, &v64));
+    assert_ptr_equal(v32, v);
+    assert_ptr_equal(v64, v);
+    for (int32_t i = 0; i <= nr; ++i) assert_true(rp32[i] == rp[i] && rp64[i] == rp[i]);
+    for (int64_t k = 0; k < nnz; ++k) assert_true(ci32[k] == ci[k] && ci64[k] == ci[k]);
+  }
   assert_ok(ctx, mfree_matrix_get_csc(K, &cp, &ri, &w));
   assert_true(w[0] != w0);
   mfree_matrix_destroy(&K);
@@ -317,6 +339,58 @@ static void test_quadrature_equivalence(void **s) {
     mfree_assembler_destroy(&ac);
     mfree_assembler_destroy(&ap);
   }
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
+static void t_quad(void *u, const double *x, double *v) {
+  (void)u;
+  v[0] = 1.0 + 0.5 * x[1] - 2.0 * x[1] * x[1];
+  v[1] = 0.3 - x[1] * x[1];
+}
+
+static void test_traction_loads(void **s) {
+  (void)s;
+  enum { m = 7, n = m * m, nseg = m - 1, ng = 3 };
+  double xs[2 * n];
+  mfree_particles_t *ps = cloud(2, m, 1.6, xs, 13);
+  mfree_approximant_t *a = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  double seg[4 * nseg], px[2 * nseg * ng], pw[nseg * ng];
+  const double gp[ng] = {-sqrt(0.6), 0.0, sqrt(0.6)}, gw[ng] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+  for (int k = 0; k < nseg; ++k) { /* the edge x = 1, bottom to top */
+    const double y0 = (double)k / nseg, y1 = (double)(k + 1) / nseg;
+    seg[4 * k] = 1.0, seg[4 * k + 1] = y0, seg[4 * k + 2] = 1.0, seg[4 * k + 3] = y1;
+    for (int g = 0; g < ng; ++g) {
+      px[2 * (ng * k + g)] = 1.0;
+      px[2 * (ng * k + g) + 1] = 0.5 * (y0 + y1) + 0.5 * (y1 - y0) * gp[g];
+      pw[ng * k + g] = 0.5 * (y1 - y0) * gw[g];
+    }
+  }
+  mfree_assembler_t *as = NULL, *ap = NULL;
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_ELASTICITY_PLANE_STRESS, &as));
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_ELASTICITY_PLANE_STRESS, &ap));
+  assert_ok(ctx, mfree_assembler_add_traction_segments(as, nseg, seg, ng, t_quad, NULL));
+  assert_ok(ctx, mfree_assembler_add_traction(ap, nseg * ng, px, MFREE_LAYOUT_AOS, 2, pw, t_quad, NULL));
+  assert_ok(ctx, mfree_assembler_setup(as));
+  assert_ok(ctx, mfree_assembler_setup(ap));
+  double fs[2 * n], fp[2 * n];
+  assert_ok(ctx, mfree_assembler_assemble_rhs(as, fs));
+  assert_ok(ctx, mfree_assembler_assemble_rhs(ap, fp));
+  for (int k = 0; k < 2 * n; ++k) assert_true(fabs(fs[k] - fp[k]) <= 1e-15);
+  /* resultant and moment about the origin: int t ds and int (x t_y - y t_x) ds over
+   * x = 1, y in [0, 1] (MLS values sum to 1 and reproduce x, y) */
+  double R[2] = {0, 0}, Mz = 0;
+  for (int J = 0; J < n; ++J) {
+    R[0] += fs[2 * J], R[1] += fs[2 * J + 1];
+    Mz += xs[2 * J] * fs[2 * J + 1] - xs[2 * J + 1] * fs[2 * J];
+  }
+  const double Rx = 1.0 + 0.25 - 2.0 / 3.0, Ry = 0.3 - 1.0 / 3.0;
+  const double Mexact = Ry - (0.5 + 0.5 / 3.0 - 2.0 / 4.0); /* x t_y - y t_x with x = 1 */
+  if (fabs(R[0] - Rx) > 1e-13 || fabs(R[1] - Ry) > 1e-13 || fabs(Mz - Mexact) > 1e-13)
+    fail_msg("resultant (%.15g, %.15g) vs (%.15g, %.15g), moment %.15g vs %.15g", R[0], R[1], Rx, Ry, Mz, Mexact);
+  mfree_assembler_destroy(&as);
+  mfree_assembler_destroy(&ap);
   mfree_approximant_destroy(&a);
   mfree_particles_destroy(&ps);
 }
@@ -451,6 +525,76 @@ static void test_lagrange(void **s) {
   mfree_particles_destroy(&ps);
 }
 
+/* Penalty: K_pen - K_0 = alpha sum_p w_p Phi_J(x_p) Phi_K(x_p), f_pen - f_0 = alpha
+ * sum_p w_p Phi_J(x_p) g(x_p), with Phi from an independent approximant at the points. */
+static void test_penalty(void **s) {
+  (void)s;
+  enum { m = 6, n = m * m, np = 10 };
+  double xs[2 * n], bp[2 * np], bw[np];
+  mfree_particles_t *ps = cloud(2, m, 1.6, xs, 17);
+  for (int p = 0; p < np; ++p) {
+    bp[2 * p] = (p + 0.5) / np;
+    bp[2 * p + 1] = 0.0;
+    bw[p] = 1.0 / np;
+  }
+  mfree_approximant_t *a = NULL, *ev = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  const double alpha = 250.0, h = 1.6 / (m - 1);
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &ev));
+  assert_ok(ctx, mfree_approximant_set_points(ev, np, bp, MFREE_LAYOUT_AOS, 2, &h, 0, MFREE_BORROW));
+  assert_ok(ctx, mfree_approximant_setup(ev));
+  double Phi[np][n];
+  memset(Phi, 0, sizeof Phi);
+  {
+    int64_t nnz;
+    assert_ok(ctx, mfree_approximant_get_nnz(ev, &nnz));
+    int64_t rp[np + 1];
+    int32_t *ci = malloc(sizeof(int32_t) * (size_t)nnz);
+    double *v = malloc(sizeof(double) * (size_t)nnz);
+    assert_ok(ctx, mfree_approximant_assemble_csr(ev, MFREE_DERIV_VALUE, 0, rp, ci, v));
+    for (int p = 0; p < np; ++p)
+      for (int64_t k = rp[p]; k < rp[p + 1]; ++k) Phi[p][ci[k]] = v[k];
+    free(ci), free(v);
+  }
+  double *A[2], f[2][n];
+  for (int with = 0; with < 2; ++with) {
+    mfree_assembler_t *as = NULL;
+    mfree_matrix_t *K = NULL;
+    assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_LAPLACE, &as));
+    assert_ok(ctx, mfree_assembler_set_coefficient(as, 2.0));
+    if (with) {
+      assert_ok(ctx, mfree_assembler_set_penalty(as, alpha));
+      assert_ok(ctx, mfree_assembler_add_dirichlet(as, MFREE_BC_PENALTY, np, bp, MFREE_LAYOUT_AOS, 2, bw, NULL, 1,
+                                                   g_lin, NULL));
+    }
+    assert_ok(ctx, mfree_assembler_setup(as));
+    assert_ok(ctx, mfree_assembler_assemble_matrix(as, &K));
+    assert_ok(ctx, mfree_assembler_assemble_rhs(as, f[with]));
+    A[with] = dense_of(K, n);
+    mfree_matrix_destroy(&K);
+    mfree_assembler_destroy(&as);
+  }
+  for (int J = 0; J < n; ++J) {
+    double fe = 0.0;
+    for (int p = 0; p < np; ++p) {
+      double g;
+      g_lin(NULL, bp + 2 * p, &g);
+      fe += alpha * bw[p] * Phi[p][J] * g;
+    }
+    if (fabs(f[1][J] - f[0][J] - fe) > 1e-12 * alpha) fail_msg("penalty load %d: %.15g vs %.15g", J, f[1][J] - f[0][J], fe);
+    for (int K = 0; K < n; ++K) {
+      double ke = 0.0;
+      for (int p = 0; p < np; ++p) ke += alpha * bw[p] * Phi[p][J] * Phi[p][K];
+      const double d = A[1][(size_t)J * n + K] - A[0][(size_t)J * n + K];
+      if (fabs(d - ke) > 1e-12 * alpha) fail_msg("penalty K[%d][%d]: %.15g vs %.15g", J, K, d, ke);
+    }
+  }
+  free(A[0]), free(A[1]);
+  mfree_approximant_destroy(&ev);
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_material_plane_stress),
@@ -458,7 +602,9 @@ int main(void) {
       cmocka_unit_test(test_material_3d),
       cmocka_unit_test(test_csc_view_and_refill),
       cmocka_unit_test(test_quadrature_equivalence),
+      cmocka_unit_test(test_traction_loads),
       cmocka_unit_test(test_lagrange),
+      cmocka_unit_test(test_penalty),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
