@@ -21,6 +21,37 @@
 
 namespace mfree {
 
+namespace {
+
+// The cubic spline W(r, h) = c / h^dim f(r / h) and dW/dr as Kernel::eval computes them
+// (same expressions, same results), without its dispatch over kernels: these loops run
+// over every pair at every evaluation.
+struct CubicSpline {
+  double ih, s;  // 1 / h, c / h^dim
+  CubicSpline(int dim, double h) : ih(1.0 / h) {
+    s = Kernel(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0).norm();
+    for (int d = 0; d < dim; ++d) s *= ih;
+  }
+  void eval(double r, double &w, double &dw) const {
+    const double q = r * ih;
+    double f, df;
+    if (q < 1.0) {
+      f = 1.0 - 1.5 * q * q + 0.75 * q * q * q;
+      df = -3.0 * q + 2.25 * q * q;
+    } else if (q < 2.0) {
+      const double t = 2.0 - q;
+      f = 0.25 * t * t * t;
+      df = -0.75 * t * t;
+    } else {
+      f = df = 0.0;
+    }
+    w = s * f;
+    dw = s * ih * df;
+  }
+};
+
+}  // namespace
+
 void FluidSystem::set_dummy_particles(int32_t n, const double *x, const double *vol, int64_t stride) {
   if (n < 0) throw Error(MFREE_ERR_ARG, "negative dummy particle count " + std::to_string(n));
   if (n > 0 && (!x || !vol)) throw Error(MFREE_ERR_NULL, "dummy positions or volumes are NULL");
@@ -93,7 +124,7 @@ const double *FluidSystem::node_densities(const double *rho) const {
     dummy_.p[f] = kappa_ * (std::pow(rho[f] / rho0_[f], gamma_) - 1.0);
     dummy_.level[f] = 1;
   }
-  const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0);
+  const CubicSpline kern(dim, h_);
   const double fallback_rho0 = rho0_.empty() ? 1000.0 : rho0_[0];
   bool progress = true;
   // pass 2: dummies with fluid neighbours; passes 3, 4 reach 4h into the wall, as deep as
@@ -113,8 +144,8 @@ const double *FluidSystem::node_densities(const double *rho) const {
           r2 += d * d;
           gr += g_[c] * d;
         }
-        double W, dW, d2W;
-        kern.eval(std::sqrt(r2), h_, W, dW, d2W);
+        double W, dW;
+        kern.eval(std::sqrt(r2), W, dW);
         if (!(W > 0.0)) continue;
         sw += W;
         sp += W * (dummy_.p[f] + dummy_.rho[f] * gr);
@@ -177,7 +208,7 @@ void FluidSystem::density_diffusion(const double *rho, double *drho) const {
     for (int64_t e = rp[k]; e < rp[k + 1]; ++e)
       for (int c = 0; c < dim; ++c) dummy_.grad_rho[static_cast<size_t>(k) * dim + c] += G_[e * dim + c] * r[cols[e]];
   const double *gr = dummy_.grad_rho.data();
-  const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0);
+  const CubicSpline kern(dim, h_);
   for (int32_t i = 0; i < n_; ++i) {
     const double c0 = std::sqrt(gamma_ * kappa_ / rho0_[i]);
     double s = 0.0;
@@ -192,8 +223,8 @@ void FluidSystem::density_diffusion(const double *rho, double *drho) const {
       }
       const double rr = std::sqrt(r2);
       if (!(rr > 0.0)) continue;
-      double W, dW, d2W;
-      kern.eval(rr, h_, W, dW, d2W);
+      double W, dW;
+      kern.eval(rr, W, dW);
       s += -dW / rr * (2.0 * (r[j] - r[i]) - gx) * vol_[j];
     }
     drho[i] += delta_ * h_ * c0 * s;
@@ -219,7 +250,7 @@ void FluidSystem::density_diffusion(const double *rho, double *drho) const {
 void FluidSystem::vci_setup() {
   if (!vci_) return;
   const int dim = dim_;
-  const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0);
+  const CubicSpline kern(dim, h_);
   dummy_.xi.assign(static_cast<size_t>(n_) * dim, 0.0);
   dummy_.blend.assign(n_, 0.0);
   for (int32_t i = 0; i < n_; ++i) {
@@ -228,14 +259,14 @@ void FluidSystem::vci_setup() {
       const int32_t k = cols_[q];
       double r2 = 0.0;
       for (int c = 0; c < dim; ++c) r2 += (ps_.x(i, c) - ps_.x(k, c)) * (ps_.x(i, c) - ps_.x(k, c));
-      double W, dW, d2W;
-      kern.eval(std::sqrt(r2), h_, W, dW, d2W);
+      double W, dW;
+      kern.eval(std::sqrt(r2), W, dW);
       K += vol_[k] * W;
     }
     dummy_.blend[i] = std::min(1.0, std::max(0.0, (K - 0.8) / 0.05));
   }
-  double W15, dW, d2W;
-  kern.eval(1.5 * h_, h_, W15, dW, d2W);
+  double W15, dW;
+  kern.eval(1.5 * h_, W15, dW);
   for (int32_t i = 0; i < n_; ++i) {
     double blend = 1.0, S = 0.0, b[3] = {0, 0, 0};
     for (int64_t q = rp_[i]; q < rp_[i + 1]; ++q) {
@@ -243,7 +274,7 @@ void FluidSystem::vci_setup() {
       if (k < n_ && dummy_.blend[k] < 1.0) {  // dummies count as complete
         double r2 = 0.0, W;
         for (int c = 0; c < dim; ++c) r2 += (ps_.x(i, c) - ps_.x(k, c)) * (ps_.x(i, c) - ps_.x(k, c));
-        kern.eval(std::sqrt(r2), h_, W, dW, d2W);
+        kern.eval(std::sqrt(r2), W, dW);
         blend = std::min(blend, 1.0 - (1.0 - dummy_.blend[k]) * std::min(1.0, W / W15));
       }
       const double Vk = vol_[k], *nt = &NT_[static_cast<size_t>(q) * (dim + 1)];
