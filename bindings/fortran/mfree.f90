@@ -1359,7 +1359,7 @@ module mfree
   public :: mfree_system_set_masses, mfree_system_set_smoothing, mfree_system_set_gravity
   public :: mfree_system_set_lumping, mfree_system_set_walls, mfree_system_set_box
   public :: mfree_system_set_dummy_particles, mfree_system_set_density_diffusion
-  public :: mfree_system_set_consistent_integration
+  public :: mfree_system_set_consistent_integration, mfree_system_set_velocity_smoothing
   public :: mfree_system_get_size, mfree_system_rhs, mfree_system_assemble_mass
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
@@ -2533,6 +2533,13 @@ contains
     integer(c_int32_t), intent(in) :: on
     st = mfree_system_set_consistent_integration_c(sys%ptr, on)
   end function mfree_system_set_consistent_integration
+
+  !> Conservative velocity smoothing coefficient beta of the fluid (default 0 = off; 0.1).
+  integer(c_int) function mfree_system_set_velocity_smoothing(sys, beta) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: beta
+    st = mfree_system_set_velocity_smoothing_c(sys%ptr, beta)
+  end function mfree_system_set_velocity_smoothing
 
   integer(c_int) function mfree_system_set_box(sys, lo, hi) result(st)
     type(mfree_system), intent(in) :: sys
