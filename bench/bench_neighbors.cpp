@@ -71,11 +71,30 @@ long long oracle_diff(int dim, int n, const double *x, double r, const int64_t *
   return bad;
 }
 
+// Counting allocator on the context: bytes currently held through the hook.
+struct Held {
+  long long bytes = 0;
+};
+void *held_alloc(void *user, int64_t bytes) {
+  static_cast<Held *>(user)->bytes += bytes;
+  return std::malloc(static_cast<size_t>(bytes));
+}
+void held_free(void *user, void *p, int64_t bytes) {
+  static_cast<Held *>(user)->bytes -= bytes;
+  std::free(p);
+}
+
+// Best of reps setups of one particle set (the repeated search of a moving-particle
+// code: from the second setup on the set reuses its grid and buffers); *held = bytes
+// held by the set-up set (lists + search scratch + copied supports), per particle.
 double time_mfree(int dim, int n, const double *x, double h, int threads, int reps, int64_t *nnz,
-                  mfree_particles_t **keep) {
+                  mfree_particles_t **keep, double *held) {
   mfree_context_t *ctx = nullptr;
   mfree_particles_t *ps = nullptr;
+  static Held count;  // outlives a kept set (destroyed after this context)
+  count.bytes = 0;
   mfree_context_create(&ctx);
+  mfree_context_set_allocator(ctx, held_alloc, held_free, &count);
   mfree_context_set_num_threads(ctx, threads);
   mfree_particles_create(ctx, dim, n, &ps);
   mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
@@ -90,6 +109,7 @@ double time_mfree(int dim, int n, const double *x, double h, int threads, int re
     best = std::min(best, bench_now() - t0);
   }
   mfree_particles_get_neighbor_nnz(ps, nnz);
+  if (held) *held = static_cast<double>(count.bytes) / n;
   if (keep) *keep = ps;
   else mfree_particles_destroy(&ps);
   mfree_context_destroy(&ctx);
@@ -104,12 +124,15 @@ void run(int dim, double n_target) {
   const int reps = n <= 200000 ? 5 : 2;
   int64_t nnz = 0, nnz_t = 0;
   mfree_particles_t *ps = nullptr;
-  const double t1 = time_mfree(dim, n, x, h, 1, reps, &nnz, n <= 20000 ? &ps : nullptr);
-  const double tn = time_mfree(dim, n, x, h, bench_threads(), reps, &nnz_t, nullptr);
+  double held = 0;
+  const double tn = time_mfree(dim, n, x, h, bench_threads(), reps, &nnz_t, nullptr, nullptr);
+  const double t1 = time_mfree(dim, n, x, h, 1, reps, &nnz, n <= 20000 ? &ps : nullptr, &held);
   std::printf("%dD n=%8d  neighbours %5.1f  mfree 1 thread %8.4f s %9.3g p/s | all threads %8.4f s"
               " %9.3g p/s (x%.2f)%s\n",
               dim, n, static_cast<double>(nnz) / n, t1, n / t1, tn, n / tn, t1 / tn,
               nnz_t == nnz ? "" : "  THREADED COUNT DIFFERS");
+  std::printf("      memory held by the set-up particle set: %.0f bytes per particle (lists %.0f)\n", held,
+              4.0 * static_cast<double>(nnz) / n + 8.0);
 #ifdef MFREE_BENCH_HAVE_NANOFLANN
   long long pairs = 0;
   double tk = 1e300;
