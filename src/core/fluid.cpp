@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include "kernel.hpp"
 #include "parallel.hpp"
@@ -290,6 +291,7 @@ Report FluidSystem::candidates(const double *xn) {
   const int64_t cnnz = cand_.nnz();
   ctrans_valid_ = false;
   cpos_.assign(cnnz, -1);
+  kept_.resize(cnnz);
   // the tables never outgrow the candidates: no allocation until the next rebuild
   cols_.reserve(cnnz);
   N_.reserve(cnnz);
@@ -426,13 +428,22 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
     double *s[D], *w = scratch + D * static_cast<size_t>(maxrow_), *gf = w + maxrow_;
     for (int c = 0; c < D; ++c) s[c] = scratch + c * static_cast<size_t>(maxrow_);
     int64_t *js = iscratch, *ts = iscratch + maxrow_;
-    int q = 0;
-    for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
-      const int32_t j = ccols[e];
-      js[q] = j;
-      ts[q] = ctr ? ctr[e] : -1;
-      for (int c = 0; c < D; ++c) s[c][q] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
-      q += cpos[e] >= 0;
+    if (transpose) {
+      int q = 0;
+      for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
+        const int32_t j = ccols[e];
+        js[q] = j;
+        ts[q] = ctr[e];
+        for (int c = 0; c < D; ++c) s[c][q] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
+        q += cpos[e] >= 0;
+      }
+    } else {
+      const int32_t *kk = kept_.data() + crp[k];  // the row's columns, from the filter
+      for (int m = 0; m < n; ++m) {
+        const int32_t j = kk[m];
+        js[m] = j;
+        for (int c = 0; c < D; ++c) s[c][m] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
+      }
     }
     const double *s0 = s[0], *s1 = s[1], *s2 = s[D - 1];
     for (int m = 0; m < n; ++m) w[m] = s0[m] * s0[m] + s1[m] * s1[m] + (D == 3 ? s2[m] * s2[m] : 0.0);
@@ -598,28 +609,37 @@ Report FluidSystem::prepare(const double *y) {
   const int nt = num_threads(nall);
   const int64_t *crp = cand_.rowptr.data();
   const int32_t *ccols = cand_.cols.data();
-  parallel_blocks(nall, nt, [&](int, int64_t b, int64_t e) {
-    for (int64_t k = b; k < e; ++k) {
-      const double *xk = xn + k * dim;
-      int32_t cnt = 0;
-      for (int64_t q = crp[k]; q < crp[k + 1]; ++q) {
-        const double *xj = xn + static_cast<size_t>(ccols[q]) * dim;
-        double r2 = 0.0;
-        for (int c = 0; c < dim; ++c) r2 += (xj[c] - xk[c]) * (xj[c] - xk[c]);
-        const int32_t keep = r2 < R2;  // no branch: a quarter of the candidates fall out
-        cpos_[q] = keep ? cnt : -1;
-        cnt += keep;
+  const bool transpose = vci_;  // only consistent integration reads NT_ (fluid_wall.cpp)
+  // the kept columns of row k go to kept_[crp[k] ...] (cpos_ only for the transpose)
+  auto filter = [&](auto dimc) {
+    constexpr int D = decltype(dimc)::value;
+    int32_t *kept = kept_.data(), *cpos = cpos_.data();
+    parallel_blocks(nall, nt, [&](int, int64_t b, int64_t e) {
+      for (int64_t k = b; k < e; ++k) {
+        const double *xk = xn + k * D;
+        int32_t cnt = 0;
+        for (int64_t q = crp[k]; q < crp[k + 1]; ++q) {
+          const int32_t j = ccols[q];
+          const double *xj = xn + static_cast<size_t>(j) * D;
+          double r2 = 0.0;
+          for (int c = 0; c < D; ++c) r2 += (xj[c] - xk[c]) * (xj[c] - xk[c]);
+          const int32_t keep = r2 < R2;  // no branch: a quarter of the candidates fall out
+          kept[crp[k] + cnt] = j;         // written always, kept only if counted
+          if (transpose) cpos[q] = keep ? cnt : -1;
+          cnt += keep;
+        }
+        rp_[k + 1] = cnt;
       }
-      rp_[k + 1] = cnt;
-    }
-  });
+    });
+  };
+  if (dim == 2) filter(std::integral_constant<int, 2>());
+  else filter(std::integral_constant<int, 3>());
   rp_[0] = 0;
   for (int32_t k = 0; k < nall; ++k) rp_[k + 1] += rp_[k];
   const size_t nnz = static_cast<size_t>(rp_[nall]);
   cols_.resize(nnz);
   N_.resize(nnz);
   G_.resize(nnz * dim);
-  const bool transpose = vci_;  // only consistent integration reads NT_ (fluid_wall.cpp)
   if (transpose) {
     if (!ctrans_valid_) transposed_candidates();
     NT_.resize(nnz * (dim + 1));

@@ -133,7 +133,8 @@ class FluidSystem : public System {
   Csr cand_;
   std::vector<int64_t> ctrans_;  // transposed candidate entry, -1 if none (only with NT_)
   bool ctrans_valid_ = false;
-  std::vector<int32_t> cpos_;    // position of a candidate in its row of the tables, -1 if out
+  std::vector<int32_t> cpos_;    // position of a candidate in its row of the tables, -1 if out (only with NT_)
+  std::vector<int32_t> kept_;    // per candidate row: the columns of the table row, then junk
   std::vector<double> xref_;
   double skin_ = 0.25;  // in units of h
   bool lists_valid_ = false;
