@@ -19,6 +19,10 @@
 #include "local.hpp"
 #include "simd.hpp"
 
+#if MFREE_SIMD_X86
+#include <immintrin.h>
+#endif
+
 // Loops over the neighbours of a site: vectorised even at -O2 when OpenMP is on (the
 // simd loops carry no dependence between neighbours); loops of compile-time length over
 // monomials and small matrices: unrolled, so that their indices fold and the
@@ -58,6 +62,16 @@ namespace base {
 MFREE_AVX2_BEGIN
 namespace avx2 {
 #include "shape_fast_rows.inc"
+
+// The caller (baseline code) goes on with SSE instructions: return with the upper
+// halves of the vector registers zeroed.
+template <int D, class Kern>
+int site_fn_ret(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, int &support,
+                double &cond) {
+  const int r = site_fn<D, Kern>(fp, t, s, w, support, cond);
+  _mm256_zeroupper();
+  return r;
+}
 }  // namespace avx2
 MFREE_AVX2_END
 #endif
@@ -100,9 +114,9 @@ FastPath::FastPath(int dim, int method, int order, const Kernel &kernel, int fla
   if (simd::use_avx2()) {
     using namespace avx2;
     switch (dim) {
-      case 1: fn_ = cubic ? &site_fn<1, CubicSpline> : &site_fn<1, AnyShape>; break;
-      case 2: fn_ = cubic ? &site_fn<2, CubicSpline> : &site_fn<2, AnyShape>; break;
-      default: fn_ = cubic ? &site_fn<3, CubicSpline> : &site_fn<3, AnyShape>; break;
+      case 1: fn_ = cubic ? &site_fn_ret<1, CubicSpline> : &site_fn_ret<1, AnyShape>; break;
+      case 2: fn_ = cubic ? &site_fn_ret<2, CubicSpline> : &site_fn_ret<2, AnyShape>; break;
+      default: fn_ = cubic ? &site_fn_ret<3, CubicSpline> : &site_fn_ret<3, AnyShape>; break;
     }
     return;
   }
