@@ -684,12 +684,30 @@ void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, d
   parallel_blocks(n_, num_threads(n_), [&](int, int64_t b, int64_t e) {
     for (int64_t k = b; k < e; ++k) {
       double vh[3] = {0, 0, 0}, div = 0.0;
-      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
-        const double *vj = v + static_cast<size_t>(cols[q]) * dim;
-        for (int c = 0; c < dim; ++c) {
-          vh[c] += N[q] * vj[c];
-          div += vj[c] * G[q * dim + c];
+      if (dim == 2) {
+        // five independent sums in scalars (one chain through div was the bottleneck)
+        double v0 = 0, v1 = 0, d0 = 0, d1 = 0;
+        for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+          const double *vj = v + static_cast<size_t>(cols[q]) * 2;
+          const double a0 = vj[0], a1 = vj[1], nq = N[q];
+          v0 += nq * a0;
+          v1 += nq * a1;
+          d0 += a0 * G[2 * q];
+          d1 += a1 * G[2 * q + 1];
         }
+        vh[0] = v0;
+        vh[1] = v1;
+        div = d0 + d1;
+      } else {
+        double d[3] = {0, 0, 0};
+        for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+          const double *vj = v + static_cast<size_t>(cols[q]) * dim;
+          for (int c = 0; c < dim; ++c) {
+            vh[c] += N[q] * vj[c];
+            d[c] += vj[c] * G[q * dim + c];
+          }
+        }
+        div = d[0] + d[1] + d[2];
       }
       if (vhat)
         for (int c = 0; c < dim; ++c) vhat[k * dim + c] = vh[c];
@@ -731,12 +749,33 @@ Report FluidSystem::accel_dim(const double *v, const double *rho, double *a) {
   auto point = [&](int64_t k) {
     // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
     double vh[D] = {}, L[D][D] = {};
-    for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
-      const double *vj = v + static_cast<size_t>(cols[q]) * D;
-      const double *gq = G + q * D;
-      for (int c = 0; c < D; ++c) {
-        vh[c] += N[q] * vj[c];
-        for (int bb = 0; bb < D; ++bb) L[c][bb] += vj[c] * gq[bb];
+    if constexpr (D == 2) {
+      // six independent sums in scalars (the vectoriser's pairing made one dependent chain)
+      double v0 = 0, v1 = 0, l00 = 0, l01 = 0, l10 = 0, l11 = 0;
+      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+        const double *vj = v + static_cast<size_t>(cols[q]) * 2;
+        const double a0 = vj[0], a1 = vj[1], nq = N[q], g0 = G[2 * q], g1 = G[2 * q + 1];
+        v0 += nq * a0;
+        v1 += nq * a1;
+        l00 += a0 * g0;
+        l01 += a0 * g1;
+        l10 += a1 * g0;
+        l11 += a1 * g1;
+      }
+      vh[0] = v0;
+      vh[1] = v1;
+      L[0][0] = l00;
+      L[0][1] = l01;
+      L[1][0] = l10;
+      L[1][1] = l11;
+    } else {
+      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+        const double *vj = v + static_cast<size_t>(cols[q]) * D;
+        const double *gq = G + q * D;
+        for (int c = 0; c < D; ++c) {
+          vh[c] += N[q] * vj[c];
+          for (int bb = 0; bb < D; ++bb) L[c][bb] += vj[c] * gq[bb];
+        }
       }
     }
     double tr3 = 0.0;
