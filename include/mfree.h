@@ -754,7 +754,10 @@ MFREE_API mfree_status_t mfree_matrix_create_csr(mfree_context_t *ctx, int32_t n
                                                  int32_t ncols, const int64_t *rowptr,
                                                  const int32_t *cols, const double *vals,
                                                  mfree_matrix_t **A);
+/** Free the matrix and set *A = NULL (NULL and *A == NULL accepted); views into it
+ * become invalid. */
 MFREE_API mfree_status_t mfree_matrix_destroy(mfree_matrix_t **A);
+/** Rows, columns and stored entries; each output may be NULL. */
 MFREE_API mfree_status_t mfree_matrix_get_size(const mfree_matrix_t *A, int32_t *nrows,
                                                int32_t *ncols, int64_t *nnz);
 /** Zero-copy CSR view with the ABI index types. */
@@ -802,6 +805,8 @@ MFREE_API mfree_status_t mfree_assembler_create(mfree_context_t *ctx,
                                                 const mfree_approximant_t *trial,
                                                 const mfree_approximant_t *test,
                                                 mfree_form_t form, mfree_assembler_t **as);
+/** Free the assembler and set *as = NULL (NULL and *as == NULL accepted); matrices it
+ * assembled stay valid (they are separate objects). */
 MFREE_API mfree_status_t mfree_assembler_destroy(mfree_assembler_t **as);
 
 /** Young's modulus and Poisson ratio (elasticity forms). Default 1, 0. */
