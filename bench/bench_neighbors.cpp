@@ -94,7 +94,7 @@ double time_mfree(int dim, int n, const double *x, double h, int threads, int re
   static Held count;  // outlives a kept set (destroyed after this context)
   count.bytes = 0;
   mfree_context_create(&ctx);
-  mfree_context_set_allocator(ctx, held_alloc, held_free, &count);
+  if (held) mfree_context_set_allocator(ctx, held_alloc, held_free, &count);  // (not thread-safe: 1-thread run)
   mfree_context_set_num_threads(ctx, threads);
   mfree_particles_create(ctx, dim, n, &ps);
   mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);

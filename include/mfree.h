@@ -484,7 +484,10 @@ MFREE_API mfree_status_t mfree_particles_set_neighbors(mfree_particles_t *ps,
  * host's lists). A particle whose borrowed data are non-finite or out of range is
  * isolated: its row is empty and no other row lists it; the call then returns
  * MFREE_FAIL_NONFINITE or MFREE_FAIL_INVALID_DATA and mfree_particles_get_site_status
- * names the particles.
+ * names the particles. The set keeps the search's grid and buffers (through the
+ * context's allocator; 1.5-2.5 times the size of the lists) so that the next setup of
+ * the same set, e.g. every time step, allocates nothing once the sizes have settled;
+ * they are freed with the set.
  */
 MFREE_API mfree_status_t mfree_particles_setup(mfree_particles_t *ps);
 
