@@ -13,6 +13,9 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
+#if MFREE_SIMD_X86
+#include <immintrin.h>
+#endif
 
 // Loops over a row's neighbours written for the vectoriser (any OpenMP: omp simd).
 #define FLUID_PRAGMA(x) _Pragma(#x)
@@ -202,6 +205,16 @@ inline void sqrt_n(double *a, int n) {
 #endif
   for (; m < n; ++m) a[m] = std::sqrt(a[m]);
 }
+
+#if MFREE_SIMD_X86
+// sqrt_n four at a time, for the AVX2 copy of the row kernel (same correctly rounded values)
+MFREE_TARGET_AVX2 void sqrt_n_avx2(double *a, int n) {
+  int m = 0;
+  for (; m + 4 <= n; m += 4) _mm256_storeu_pd(a + m, _mm256_sqrt_pd(_mm256_loadu_pd(a + m)));
+  for (; m + 2 <= n; m += 2) _mm_storeu_pd(a + m, _mm_sqrt_pd(_mm_loadu_pd(a + m)));
+  for (; m < n; ++m) a[m] = std::sqrt(a[m]);
+}
+#endif
 
 // The approximants' singularity threshold on 1 / cond (local.cpp, shape_fast.cpp).
 constexpr double kMinRcond = 1e-12;
@@ -407,7 +420,8 @@ void FluidSystem::shepard_row(int n, const double *w, const double *gf, double *
 
 template <int D>
 MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch,
-                                                     int64_t *iscratch, bool transpose) {
+                                                     int64_t *iscratch, bool transpose, bool wide) {
+  (void)wide;
   constexpr int L = D + 1;
   const double ih = 1.0 / h_, tol = shepard_cond_;
   const int64_t *crp = cand_.rowptr.data();
@@ -447,7 +461,12 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
     }
     const double *s0 = s[0], *s1 = s[1], *s2 = s[D - 1];
     for (int m = 0; m < n; ++m) w[m] = s0[m] * s0[m] + s1[m] * s1[m] + (D == 3 ? s2[m] * s2[m] : 0.0);
-    sqrt_n(w, n);  // |x_j - x| / h < 2
+#if MFREE_SIMD_X86
+    if (wide) sqrt_n_avx2(w, n);  // |x_j - x| / h < 2
+    else sqrt_n(w, n);
+#else
+    sqrt_n(w, n);
+#endif
     FLUID_SIMD()
     for (int m = 0; m < n; ++m) {
       // the cubic spline as B-spline pieces, f = (2 - r)_+^3 / 4 - (1 - r)_+^3, with
@@ -579,14 +598,14 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
 template <int D>
 bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
                              bool transpose) {
-  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose);
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, false);
 }
 
 #if MFREE_SIMD_X86
 template <int D>
 MFREE_TARGET_AVX2 bool FluidSystem::table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch,
                                                     int64_t *iscratch, bool transpose) {
-  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose);
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, true);
 }
 #endif
 

@@ -65,7 +65,8 @@ class FluidSystem : public System {
   template <int D>
   bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
   template <int D>
-  bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
+                       bool wide);  // wide: the AVX2 copy (256-bit sqrt)
   // Chunks of kChunk rows coloured so that no two chunks of a colour touch a common
   // node (on the candidate pattern), for the scatter of accel (rebuilt with the lists).
   void color_chunks();
