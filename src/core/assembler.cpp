@@ -1016,6 +1016,10 @@ void Assembler::build_pattern() {
         ++nmult_;
       }
   }
+  // unknowns are int32 indices in the ABI (mfree_matrix_t columns)
+  const int64_t nunknowns = static_cast<int64_t>(n) * nc + static_cast<int64_t>(mcols.size());
+  if (nunknowns > INT32_MAX)
+    throw Error(MFREE_ERR_ARG, "too many unknowns (" + std::to_string(nunknowns) + ") for int32 indices");
   const int32_t nbase = n * nc;
   ndofs_ = nbase + nmult_;
   // transpose of the multiplier columns: for each dof, the multipliers touching it
