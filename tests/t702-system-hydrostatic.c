@@ -22,7 +22,8 @@
  *    never settles. Letting the wall force act on receding particles too (f1 = 1 in 003
  *    eq 123) made it worse (54 % at 0.3 s). Holding a still column needs a wall treatment
  *    that supplies the missing pressure support, which paper 003 does not have: test 3
- *    does it with dummy wall particles and density diffusion. */
+ *    does it with dummy wall particles, and holds the column to 2 s with density
+ *    diffusion, consistent integration and velocity smoothing on top. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
