@@ -27,6 +27,12 @@
 
 namespace mfree {
 
+namespace {
+// Threads for a loop of a few operations per particle (checks, volumes, updates): a team
+// (and its barrier, costly on a loaded machine) pays off only from ~30,000 particles.
+inline int light_threads(int64_t n) { return num_threads(n / 16); }
+}  // namespace
+
 FluidSystem::FluidSystem(int dim, int32_t n) : dim_(dim), n_(n), ps_(dim, n) {
   if (dim != 2 && dim != 3) throw Error(MFREE_ERR_ARG, "the fluid system is 2D or 3D, not " + std::to_string(dim) + "D");
   rho0_.assign(n, 1000.0);
@@ -152,7 +158,7 @@ Report FluidSystem::check_state(const double *y, int64_t step) const {
   // the first invalid particle: the lowest of the threads' first ones
   int32_t first[64];  // parallel_blocks runs at most 64 threads
   std::fill(first, first + 64, n_);
-  parallel_blocks(n_, num_threads(n_), [&](int t, int64_t b, int64_t e) {
+  parallel_blocks(n_, light_threads(n_), [&](int t, int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i)
       if (!valid(i)) {
         first[t] = static_cast<int32_t>(i);
@@ -616,7 +622,7 @@ Report FluidSystem::prepare(const double *y) {
   const int dim = dim_;
   const int32_t nall = nq();
   const double *rho = y + 2 * static_cast<size_t>(dim) * n_;
-  parallel_blocks(n_, num_threads(n_), [&](int, int64_t b, int64_t e) {
+  parallel_blocks(n_, light_threads(n_), [&](int, int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) vol_[i] = mass_[i] / rho[i];
   });
   const double *xn = node_positions(y);  // + dummies (fluid_wall.cpp)
@@ -1007,7 +1013,7 @@ double FluidSystem::stable_dt(const double *y) const {
   const size_t nd = static_cast<size_t>(dim_) * n_;
   const double *v = y + nd, *rho = y + 2 * nd;
   double tmax[64] = {};  // per thread (parallel_blocks runs at most 64): a maximum is exact in any order
-  parallel_blocks(n_, num_threads(n_), [&](int t, int64_t b, int64_t e) {
+  parallel_blocks(n_, light_threads(n_), [&](int t, int64_t b, int64_t e) {
     double cm = 0.0;
     for (int64_t i = b; i < e; ++i) {
       double vv = 0.0;
@@ -1059,7 +1065,7 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
       // and interpolated velocities with v^{k+1/2} on the tables at x^k
       Report r = accel(v, rho, rate.data());
       if (!r.ok()) return r;
-      const int nt = num_threads(n_);
+      const int nt = light_threads(n_);
       parallel_blocks(static_cast<int64_t>(nd), nt, [&](int, int64_t b, int64_t e) {
         for (int64_t q = b; q < e; ++q) yn[nd + q] = v[q] + dt * rate[q];
       });
