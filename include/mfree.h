@@ -858,6 +858,15 @@ MFREE_API mfree_status_t mfree_assembler_add_traction_segments(mfree_assembler_t
                                                                const double *x,
                                                                int32_t ngauss,
                                                                mfree_field_fn t, void *user);
+/** Traction on 3D boundary triangles (vertices a_f, b_f, c_f at x[9 f .. 9 f + 8]),
+ * with ngauss x ngauss points per triangle (collapsed Gauss product rule, exact for
+ * polynomials of degree 2 ngauss - 2 over the triangle); a triangle of zero area is an
+ * input error. Quadrilateral facets: split them into two triangles. */
+MFREE_API mfree_status_t mfree_assembler_add_traction_facets(mfree_assembler_t *as,
+                                                             int32_t nfacet,
+                                                             const double *x,
+                                                             int32_t ngauss,
+                                                             mfree_field_fn t, void *user);
 /**
  * Essential boundary condition u_c = g_c for the components c set in component_mask
  * (bit c), on boundary quadrature points (copied) with weights w.

@@ -395,6 +395,70 @@ static void test_traction_loads(void **s) {
   mfree_particles_destroy(&ps);
 }
 
+static void t_quad3(void *u, const double *x, double *v) {
+  (void)u;
+  v[0] = 1.0 + 0.5 * x[1] - 2.0 * x[2] * x[2];
+  v[1] = 0.3 - x[1] * x[2];
+  v[2] = 0.2 * x[1] * x[1] + 0.7 * x[2];
+}
+
+/* 3D facets: the face x = 1 of the unit cube as 2 k^2 triangles (diagonals alternating),
+ * 3 x 3 points each (exact to degree 4). With MLS test functions (a partition of unity
+ * that reproduces x, y, z) the loads' resultant and moment about the origin equal the
+ * integrals of t and x cross t over the face, computed here by a 4 x 4 Gauss product
+ * rule on the square (exact to degree 7 in each variable). */
+static void test_traction_facets(void **s) {
+  (void)s;
+  enum { m = 5, n = m * m * m, k = 3, nf = 2 * k * k, ng = 3 };
+  double xs[3 * n], tri[9 * nf];
+  mfree_particles_t *ps = cloud(3, m, 1.8, xs, 21);
+  mfree_approximant_t *a = NULL;
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
+  for (int i = 0, f = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j) {
+      const double y0 = (double)i / k, y1 = (double)(i + 1) / k, z0 = (double)j / k, z1 = (double)(j + 1) / k;
+      const double c[4][3] = {{1, y0, z0}, {1, y1, z0}, {1, y1, z1}, {1, y0, z1}};
+      const int split = (i + j) % 2; /* diagonal 0-2 or 1-3 */
+      const int t0[3] = {0, 1, split ? 2 : 3}, t1[3] = {split ? 0 : 1, 2, 3};
+      for (int v = 0; v < 3; ++v)
+        for (int d = 0; d < 3; ++d) tri[9 * f + 3 * v + d] = c[t0[v]][d], tri[9 * (f + 1) + 3 * v + d] = c[t1[v]][d];
+      f += 2;
+    }
+  mfree_assembler_t *as = NULL;
+  assert_ok(ctx, mfree_assembler_create(ctx, a, NULL, MFREE_FORM_ELASTICITY_3D, &as));
+  assert_ok(ctx, mfree_assembler_add_traction_facets(as, nf, tri, ng, t_quad3, NULL));
+  assert_ok(ctx, mfree_assembler_setup(as));
+  double f[3 * n];
+  assert_ok(ctx, mfree_assembler_assemble_rhs(as, f));
+  double R[3] = {0, 0, 0}, M[3] = {0, 0, 0};
+  for (int J = 0; J < n; ++J) {
+    const double *x = xs + 3 * J, *fj = f + 3 * J;
+    for (int c = 0; c < 3; ++c) R[c] += fj[c];
+    M[0] += x[1] * fj[2] - x[2] * fj[1];
+    M[1] += x[2] * fj[0] - x[0] * fj[2];
+    M[2] += x[0] * fj[1] - x[1] * fj[0];
+  }
+  const double gp[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+  const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
+  double Re[3] = {0, 0, 0}, Me[3] = {0, 0, 0};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const double x[3] = {1.0, 0.5 * (1 + gp[i]), 0.5 * (1 + gp[j])}, w = 0.25 * gw[i] * gw[j];
+      double t[3];
+      t_quad3(NULL, x, t);
+      for (int c = 0; c < 3; ++c) Re[c] += w * t[c];
+      Me[0] += w * (x[1] * t[2] - x[2] * t[1]);
+      Me[1] += w * (x[2] * t[0] - x[0] * t[2]);
+      Me[2] += w * (x[0] * t[1] - x[1] * t[0]);
+    }
+  for (int c = 0; c < 3; ++c)
+    if (fabs(R[c] - Re[c]) > 1e-12 || fabs(M[c] - Me[c]) > 1e-12)
+      fail_msg("component %d: resultant %.15g vs %.15g, moment %.15g vs %.15g", c, R[c], Re[c], M[c], Me[c]);
+  mfree_assembler_destroy(&as);
+  mfree_approximant_destroy(&a);
+  mfree_particles_destroy(&ps);
+}
+
 static void g_lin(void *u, const double *x, double *v) {
   (void)u;
   v[0] = 0.3 + 1.5 * x[0] - 0.7 * x[1] + 0.4 * x[0] * x[0];
@@ -603,6 +667,7 @@ int main(void) {
       cmocka_unit_test(test_csc_view_and_refill),
       cmocka_unit_test(test_quadrature_equivalence),
       cmocka_unit_test(test_traction_loads),
+      cmocka_unit_test(test_traction_facets),
       cmocka_unit_test(test_lagrange),
       cmocka_unit_test(test_penalty),
   };

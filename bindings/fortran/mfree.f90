@@ -900,6 +900,18 @@ module mfree
       type(c_ptr), value :: user
     end function mfree_assembler_add_traction_segments_c
 
+    integer(c_int) function mfree_assembler_add_traction_facets_c(as, nfacet, x, ngauss, t, &
+                                                                  user) &
+        bind(C, name="mfree_assembler_add_traction_facets")
+      import :: c_int, c_int32_t, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: as
+      integer(c_int32_t), value :: nfacet
+      real(c_double), intent(in) :: x(*)
+      integer(c_int32_t), value :: ngauss
+      type(c_funptr), value :: t
+      type(c_ptr), value :: user
+    end function mfree_assembler_add_traction_facets_c
+
     integer(c_int) function mfree_assembler_add_dirichlet_c(as, method, npts, x, layout, &
                                                             ld, w, normals, component_mask, &
                                                             g, user) &
@@ -1268,6 +1280,7 @@ module mfree
   public :: mfree_assembler_set_quadrature_cells_c
   public :: mfree_assembler_set_quadrature_points_c, mfree_assembler_set_body_force_c
   public :: mfree_assembler_add_traction_c, mfree_assembler_add_traction_segments_c
+  public :: mfree_assembler_add_traction_facets_c
   public :: mfree_assembler_add_dirichlet_c, mfree_assembler_add_dirichlet_nodes_c
   public :: mfree_assembler_add_traction_nodes_c, mfree_assembler_set_fe_layer_c
   public :: mfree_assembler_set_penalty_c, mfree_assembler_setup_c
@@ -1350,6 +1363,7 @@ module mfree
   public :: mfree_assembler_set_quadrature_cells, mfree_assembler_set_quadrature_points
   public :: mfree_assembler_set_body_force, mfree_assembler_add_traction
   public :: mfree_assembler_add_traction_segments, mfree_assembler_add_dirichlet
+  public :: mfree_assembler_add_traction_facets
   public :: mfree_assembler_add_dirichlet_nodes, mfree_assembler_add_traction_nodes
   public :: mfree_assembler_set_fe_layer, mfree_assembler_set_penalty
   public :: mfree_assembler_set_consistent_integration
@@ -2318,6 +2332,18 @@ contains
     st = mfree_assembler_add_traction_segments_c(as%ptr, nseg, x, ngauss, c_funloc(t), &
                                                  user_ptr(user))
   end function mfree_assembler_add_traction_segments
+
+  !> Traction on 3D triangles (9 coordinates each), ngauss x ngauss points per triangle.
+  integer(c_int) function mfree_assembler_add_traction_facets(as, nfacet, x, ngauss, t, &
+                                                              user) result(st)
+    type(mfree_assembler), intent(in) :: as
+    integer(c_int32_t), intent(in) :: nfacet, ngauss
+    real(c_double), intent(in) :: x(*)
+    procedure(mfree_field_fn) :: t
+    type(c_ptr), intent(in), optional :: user
+    st = mfree_assembler_add_traction_facets_c(as%ptr, nfacet, x, ngauss, c_funloc(t), &
+                                               user_ptr(user))
+  end function mfree_assembler_add_traction_facets
 
   !> Essential condition on boundary points; normals (dim per point) only for Nitsche.
   integer(c_int) function mfree_assembler_add_dirichlet(as, method, npts, x, layout, ld, w, &

@@ -81,6 +81,11 @@ mfree_status_t mfree_assembler_add_traction_segments(mfree_assembler_t *as, int3
                                                      mfree_field_fn t, void *user) {
   MFREE_AS_SETTER("mfree_assembler_add_traction_segments", a.add_traction_segments(nseg, x, ngauss, t, user));
 }
+mfree_status_t mfree_assembler_add_traction_facets(mfree_assembler_t *as, int32_t nfacet,
+                                                   const double *x, int32_t ngauss,
+                                                   mfree_field_fn t, void *user) {
+  MFREE_AS_SETTER("mfree_assembler_add_traction_facets", a.add_traction_facets(nfacet, x, ngauss, t, user));
+}
 mfree_status_t mfree_assembler_add_dirichlet(mfree_assembler_t *as, mfree_bc_t method, int32_t npts,
                                              const double *x, mfree_layout_t layout, int64_t ld,
                                              const double *w, const double *normals,

@@ -233,7 +233,7 @@ void Assembler::add_traction(int32_t npts, const double *x, int layout, int64_t 
 }
 
 void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss, mfree_field_fn t, void *user) {
-  if (dim_ != 2) throw Error(MFREE_ERR_UNSUPPORTED, "boundary segments are 2D; give 3D facets as points and weights");
+  if (dim_ != 2) throw Error(MFREE_ERR_UNSUPPORTED, "boundary segments are 2D; give 3D boundaries as facets");
   if (nseg < 0) throw Error(MFREE_ERR_ARG, "negative segment count");
   if (nseg > 0 && !x) throw Error(MFREE_ERR_NULL, "segments are NULL");
   if (ngauss < 1 || ngauss > 20) throw Error(MFREE_ERR_ARG, "ngauss must be 1..20");
@@ -253,6 +253,39 @@ void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss,
     }
   }
   add_traction(static_cast<int32_t>(w.size()), pts.data(), MFREE_LAYOUT_AOS, 2, w.data(), t, user);
+}
+
+void Assembler::add_traction_facets(int32_t nfacet, const double *x, int ngauss, mfree_field_fn t, void *user) {
+  if (dim_ != 3) throw Error(MFREE_ERR_UNSUPPORTED, "boundary facets are 3D; give 2D boundaries as segments");
+  if (nfacet < 0) throw Error(MFREE_ERR_ARG, "negative facet count");
+  if (nfacet > 0 && !x) throw Error(MFREE_ERR_NULL, "facets are NULL");
+  if (ngauss < 1 || ngauss > 20) throw Error(MFREE_ERR_ARG, "ngauss must be 1..20");
+  // Collapsed (Duffy) product rule: (xi, eta) = (u, v (1 - u)) with Gauss-Legendre in u
+  // and v on [0, 1]; dA = |(b - a) x (c - a)| (1 - u) du dv.
+  std::vector<double> g, gw, pts, w;
+  gauss_legendre(ngauss, g, gw);
+  for (int32_t f = 0; f < nfacet; ++f) {
+    const double *a = x + 9 * f, *b = a + 3, *c = a + 6;
+    for (int k = 0; k < 9; ++k)
+      if (!std::isfinite(a[k])) throw Error(MFREE_ERR_INPUT, "facet " + std::to_string(f) + " is not finite");
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double nx = e1[1] * e2[2] - e1[2] * e2[1], ny = e1[2] * e2[0] - e1[0] * e2[2],
+                 nz = e1[0] * e2[1] - e1[1] * e2[0];
+    const double jac = std::sqrt(nx * nx + ny * ny + nz * nz);
+    const double scale = std::max(std::hypot(e1[0], e1[1], e1[2]), std::hypot(e2[0], e2[1], e2[2]));
+    if (!(jac > 1e-14 * scale * scale))
+      throw Error(MFREE_ERR_INPUT, "facet " + std::to_string(f) + " has zero area");
+    for (int i = 0; i < ngauss; ++i) {
+      const double u = 0.5 * (1.0 + g[i]);
+      for (int j = 0; j < ngauss; ++j) {
+        const double v = 0.5 * (1.0 + g[j]), xi = u, eta = v * (1.0 - u);
+        for (int d = 0; d < 3; ++d) pts.push_back(a[d] + xi * e1[d] + eta * e2[d]);
+        w.push_back(0.25 * gw[i] * gw[j] * (1.0 - u) * jac);
+      }
+    }
+  }
+  add_traction(static_cast<int32_t>(w.size()), pts.data(), MFREE_LAYOUT_AOS, 3, w.data(), t, user);
 }
 
 void Assembler::add_dirichlet(int method, int32_t npts, const double *x, int layout, int64_t ld,

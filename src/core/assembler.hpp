@@ -28,6 +28,7 @@ class Assembler {
   void add_traction(int32_t npts, const double *x, int layout, int64_t ld, const double *w,
                     mfree_field_fn t, void *user);
   void add_traction_segments(int32_t nseg, const double *x, int ngauss, mfree_field_fn t, void *user);
+  void add_traction_facets(int32_t nfacet, const double *x, int ngauss, mfree_field_fn t, void *user);
   void add_dirichlet(int method, int32_t npts, const double *x, int layout, int64_t ld,
                      const double *w, const double *normals, int32_t mask, mfree_field_fn g,
                      void *user);

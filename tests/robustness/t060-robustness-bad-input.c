@@ -753,6 +753,22 @@ static void rows_assembler(void) {
   ROW(MFREE_ERR_NULL, mfree_assembler_add_traction_segments(F.as_new, 1, seg, 2, NULL, NULL));
   ROW(MFREE_ERR_ARG, mfree_assembler_add_traction_segments(F.as_new, 1, seg, 0, host_field, NULL));
   ROW(MFREE_ERR_INPUT, mfree_assembler_add_traction_segments(F.as_new, 1, segzero, 2, host_field, NULL));
+  { /* 3D facets: a 3D elasticity assembler on the 3D set */
+    const double tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const double trizero[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2}, trinan[9] = {0, 0, 0, 1, 0, 0, 0, NAN, 0};
+    mfree_assembler_t *as3 = NULL;
+    ROW(MFREE_SUCCESS, mfree_assembler_create(F.ctx, F.a3, NULL, MFREE_FORM_ELASTICITY_3D, &as3));
+    ROW0(MFREE_ERR_NULL, mfree_assembler_add_traction_facets(NULL, 1, tri, 2, host_field, NULL));
+    ROW(MFREE_ERR_UNSUPPORTED, mfree_assembler_add_traction_facets(F.as_new, 1, tri, 2, host_field, NULL));
+    ROW(MFREE_ERR_ARG, mfree_assembler_add_traction_facets(as3, -1, tri, 2, host_field, NULL));
+    ROW(MFREE_ERR_NULL, mfree_assembler_add_traction_facets(as3, 1, NULL, 2, host_field, NULL));
+    ROW(MFREE_ERR_NULL, mfree_assembler_add_traction_facets(as3, 1, tri, 2, NULL, NULL));
+    ROW(MFREE_ERR_ARG, mfree_assembler_add_traction_facets(as3, 1, tri, 0, host_field, NULL));
+    ROW(MFREE_ERR_ARG, mfree_assembler_add_traction_facets(as3, 1, tri, 21, host_field, NULL));
+    ROW(MFREE_ERR_INPUT, mfree_assembler_add_traction_facets(as3, 1, trizero, 2, host_field, NULL));
+    ROW(MFREE_ERR_INPUT, mfree_assembler_add_traction_facets(as3, 1, trinan, 2, host_field, NULL));
+    mfree_assembler_destroy(&as3);
+  }
 
   ROW0(MFREE_ERR_NULL, mfree_assembler_add_dirichlet(NULL, MFREE_BC_PENALTY, 2, px, MFREE_LAYOUT_AOS, 2, pw, NULL, 1, host_field, NULL));
   ROW(MFREE_ERR_ARG, mfree_assembler_add_dirichlet(F.as_new, (mfree_bc_t)0, 2, px, MFREE_LAYOUT_AOS, 2, pw, NULL, 1, host_field, NULL));
