@@ -122,16 +122,7 @@ mfree_status_t mfree_approximant_set_points(mfree_approximant_t *a, int32_t npts
   });
 }
 
-mfree_status_t mfree_approximant_setup(mfree_approximant_t *a) {
-  return mfree::with_handle(a, "mfree_approximant_setup", [&](mfree::Approximant &ap) {
-    mfree::ParticleSet &set = a->ps->set;
-    mfree::Report pre;
-    if (!set.is_setup()) pre = set.setup();
-    mfree::Report rep = ap.setup();
-    if (!rep.ok()) return mfree::finish(a->ctx, "mfree_approximant_setup", rep);
-    return mfree::finish(a->ctx, "mfree_approximant_setup", pre);
-  });
-}
+mfree_status_t mfree_approximant_setup(mfree_approximant_t *a) { return mfree::setup_on_set(a, "mfree_approximant_setup"); }
 
 mfree_status_t mfree_approximant_update(mfree_approximant_t *a) {
   return mfree::with_handle(a, "mfree_approximant_update", [&](mfree::Approximant &ap) {

@@ -120,16 +120,7 @@ mfree_status_t mfree_assembler_set_consistent_integration(mfree_assembler_t *as,
                   a.set_consistent_integration(npts, x, layout, ld, w, normals));
 }
 
-mfree_status_t mfree_assembler_setup(mfree_assembler_t *as) {
-  return mfree::with_handle(as, "mfree_assembler_setup", [&](mfree::Assembler &a) {
-    mfree::ParticleSet &set = as->ps->set;
-    mfree::Report pre;
-    if (!set.is_setup()) pre = set.setup();
-    mfree::Report rep = a.setup();
-    if (!rep.ok()) return mfree::finish(as->ctx, "mfree_assembler_setup", rep);
-    return mfree::finish(as->ctx, "mfree_assembler_setup", pre);
-  });
-}
+mfree_status_t mfree_assembler_setup(mfree_assembler_t *as) { return mfree::setup_on_set(as, "mfree_assembler_setup"); }
 
 mfree_status_t mfree_assembler_update(mfree_assembler_t *as) {
   return mfree::with_handle(as, "mfree_assembler_update", [&](mfree::Assembler &a) {

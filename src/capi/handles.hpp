@@ -125,6 +125,21 @@ inline mfree_status_t finish(mfree_context_t *ctx, const char *fn, const Report 
   return MFREE_SUCCESS;
 }
 
+// setup() of an object built on a particle set (approximant, assembler): sets the
+// particle set up first if it is not, then the object; the object's failure wins, else
+// the set's (positive) outcome is reported.
+template <class H>
+mfree_status_t setup_on_set(H *h, const char *fn) noexcept {
+  return with_handle(h, fn, [&](auto &obj) {
+    ParticleSet &set = h->ps->set;
+    Report pre;
+    if (!set.is_setup()) pre = set.setup();
+    Report rep = obj.setup();
+    if (!rep.ok()) return finish(h->ctx, fn, rep);
+    return finish(h->ctx, fn, pre);
+  });
+}
+
 }  // namespace mfree
 
 #define MFREE_REQUIRE(cond, status, msg)          \

@@ -232,17 +232,27 @@ void Assembler::add_traction(int32_t npts, const double *x, int layout, int64_t 
   setup_done_ = false;
 }
 
-void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss, mfree_field_fn t, void *user) {
-  if (dim_ != 2) throw Error(MFREE_ERR_UNSUPPORTED, "boundary segments are 2D; give 3D boundaries as facets");
-  if (nseg < 0) throw Error(MFREE_ERR_ARG, "negative segment count");
-  if (nseg > 0 && !x) throw Error(MFREE_ERR_NULL, "segments are NULL");
+// Checks shared by the boundary pieces (2D segments, 3D facets): dimension, count,
+// pointer, rule order, and that every coordinate of every piece is finite.
+static void check_boundary_pieces(int dim, int want_dim, int32_t count, const double *x, int ncoord,
+                                  int ngauss, const char *what, const char *other) {
+  if (dim != want_dim)
+    throw Error(MFREE_ERR_UNSUPPORTED, std::string("boundary ") + what + "s are " + std::to_string(want_dim) +
+                                           "D; give " + std::to_string(5 - want_dim) + "D boundaries as " + other);
+  if (count < 0) throw Error(MFREE_ERR_ARG, std::string("negative ") + what + " count");
+  if (count > 0 && !x) throw Error(MFREE_ERR_NULL, std::string(what) + "s are NULL");
   if (ngauss < 1 || ngauss > 20) throw Error(MFREE_ERR_ARG, "ngauss must be 1..20");
+  for (int64_t k = 0; k < int64_t(count) * ncoord; ++k)
+    if (!std::isfinite(x[k]))
+      throw Error(MFREE_ERR_INPUT, std::string(what) + " " + std::to_string(k / ncoord) + " is not finite");
+}
+
+void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss, mfree_field_fn t, void *user) {
+  check_boundary_pieces(dim_, 2, nseg, x, 4, ngauss, "segment", "facets");
   std::vector<double> g, gw, pts, w;
   gauss_legendre(ngauss, g, gw);
   for (int32_t s = 0; s < nseg; ++s) {
     const double *a = x + 4 * s, *b = a + 2;
-    for (int c = 0; c < 4; ++c)
-      if (!std::isfinite(a[c])) throw Error(MFREE_ERR_INPUT, "segment " + std::to_string(s) + " is not finite");
     const double len = std::hypot(b[0] - a[0], b[1] - a[1]);
     if (!(len > 0.0)) throw Error(MFREE_ERR_INPUT, "segment " + std::to_string(s) + " has zero length");
     for (int q = 0; q < ngauss; ++q) {
@@ -256,18 +266,13 @@ void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss,
 }
 
 void Assembler::add_traction_facets(int32_t nfacet, const double *x, int ngauss, mfree_field_fn t, void *user) {
-  if (dim_ != 3) throw Error(MFREE_ERR_UNSUPPORTED, "boundary facets are 3D; give 2D boundaries as segments");
-  if (nfacet < 0) throw Error(MFREE_ERR_ARG, "negative facet count");
-  if (nfacet > 0 && !x) throw Error(MFREE_ERR_NULL, "facets are NULL");
-  if (ngauss < 1 || ngauss > 20) throw Error(MFREE_ERR_ARG, "ngauss must be 1..20");
+  check_boundary_pieces(dim_, 3, nfacet, x, 9, ngauss, "facet", "segments");
   // Collapsed (Duffy) product rule: (xi, eta) = (u, v (1 - u)) with Gauss-Legendre in u
   // and v on [0, 1]; dA = |(b - a) x (c - a)| (1 - u) du dv.
   std::vector<double> g, gw, pts, w;
   gauss_legendre(ngauss, g, gw);
   for (int32_t f = 0; f < nfacet; ++f) {
     const double *a = x + 9 * f, *b = a + 3, *c = a + 6;
-    for (int k = 0; k < 9; ++k)
-      if (!std::isfinite(a[k])) throw Error(MFREE_ERR_INPUT, "facet " + std::to_string(f) + " is not finite");
     const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     const double nx = e1[1] * e2[2] - e1[2] * e2[1], ny = e1[2] * e2[0] - e1[0] * e2[2],
