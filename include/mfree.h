@@ -729,9 +729,11 @@ MFREE_API mfree_status_t mfree_approximant_check_reproduction(const mfree_approx
                                                               double *deriv_err);
 
 /** Per-site diagnostics, nsites entries each: status (0 or a positive status), number
- * of neighbours with non-zero weight, condition estimate of the local system (1 where
- * the method solves none), order used (differs from the set order after a fallback;
- * -1 for a failed site). */
+ * of neighbours with non-zero weight, condition number of the local system (the larger
+ * of the exact 1-norm condition number ||A||_1 ||A^-1||_1 and the ratio of the largest to
+ * the smallest pivot; infinite for a singular system; above 1e12 the site falls back or
+ * fails; 1 where the method solves none), order used (differs from the set order after a
+ * fallback; -1 for a failed site). */
 MFREE_API mfree_status_t mfree_approximant_get_site_status(const mfree_approximant_t *a,
                                                            int32_t *status,
                                                            int32_t *nfailed);
