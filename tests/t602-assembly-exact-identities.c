@@ -343,6 +343,20 @@ static void test_quadrature_equivalence(void **s) {
   mfree_particles_destroy(&ps);
 }
 
+/* Resultant sum_J f_J and moment sum_J x_J cross f_J about the origin of nodal loads
+ * (dim per node); in 2D the moment is M[2] (about z) and M[0] = M[1] = 0. */
+static void resultant_moment(int dim, int n, const double *xs, const double *f, double R[3], double M[3]) {
+  for (int c = 0; c < 3; ++c) R[c] = M[c] = 0.0;
+  for (int J = 0; J < n; ++J) {
+    const double *x = xs + dim * J, *fj = f + dim * J;
+    const double X[3] = {x[0], x[1], dim == 3 ? x[2] : 0.0}, F[3] = {fj[0], fj[1], dim == 3 ? fj[2] : 0.0};
+    for (int c = 0; c < 3; ++c) R[c] += F[c];
+    M[0] += X[1] * F[2] - X[2] * F[1];
+    M[1] += X[2] * F[0] - X[0] * F[2];
+    M[2] += X[0] * F[1] - X[1] * F[0];
+  }
+}
+
 static void t_quad(void *u, const double *x, double *v) {
   (void)u;
   v[0] = 1.0 + 0.5 * x[1] - 2.0 * x[1] * x[1];
@@ -380,11 +394,9 @@ static void test_traction_loads(void **s) {
   for (int k = 0; k < 2 * n; ++k) assert_true(fabs(fs[k] - fp[k]) <= 1e-15);
   /* resultant and moment about the origin: int t ds and int (x t_y - y t_x) ds over
    * x = 1, y in [0, 1] (MLS values sum to 1 and reproduce x, y) */
-  double R[2] = {0, 0}, Mz = 0;
-  for (int J = 0; J < n; ++J) {
-    R[0] += fs[2 * J], R[1] += fs[2 * J + 1];
-    Mz += xs[2 * J] * fs[2 * J + 1] - xs[2 * J + 1] * fs[2 * J];
-  }
+  double R[3], M[3];
+  resultant_moment(2, n, xs, fs, R, M);
+  const double Mz = M[2];
   const double Rx = 1.0 + 0.25 - 2.0 / 3.0, Ry = 0.3 - 1.0 / 3.0;
   const double Mexact = Ry - (0.5 + 0.5 / 3.0 - 2.0 / 4.0); /* x t_y - y t_x with x = 1 */
   if (fabs(R[0] - Rx) > 1e-13 || fabs(R[1] - Ry) > 1e-13 || fabs(Mz - Mexact) > 1e-13)
@@ -430,14 +442,8 @@ static void test_traction_facets(void **s) {
   assert_ok(ctx, mfree_assembler_setup(as));
   double f[3 * n];
   assert_ok(ctx, mfree_assembler_assemble_rhs(as, f));
-  double R[3] = {0, 0, 0}, M[3] = {0, 0, 0};
-  for (int J = 0; J < n; ++J) {
-    const double *x = xs + 3 * J, *fj = f + 3 * J;
-    for (int c = 0; c < 3; ++c) R[c] += fj[c];
-    M[0] += x[1] * fj[2] - x[2] * fj[1];
-    M[1] += x[2] * fj[0] - x[0] * fj[2];
-    M[2] += x[0] * fj[1] - x[1] * fj[0];
-  }
+  double R[3], M[3];
+  resultant_moment(3, n, xs, f, R, M);
   const double gp[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
   const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
   double Re[3] = {0, 0, 0}, Me[3] = {0, 0, 0};

@@ -188,20 +188,6 @@ double FluidSystem::tait(double rho, double rho0) const {
 
 namespace {
 
-// Cubic B-spline of support 2h (the model's kernel, 003) as f(q) and f'(q), q = r/h,
-// without the normalisation constant sigma / h^dim: MLS and Shepard functions and the
-// moment-matrix condition number do not change when all weights are scaled alike.
-inline void cubic_spline(double q, double &f, double &df) {
-  if (q < 1.0) {
-    f = 1.0 - 1.5 * q * q + 0.75 * q * q * q;
-    df = -3.0 * q + 2.25 * q * q;
-  } else {
-    const double t = 2.0 - q;
-    f = 0.25 * t * t * t;
-    df = -0.75 * t * t;
-  }
-}
-
 // a[m] = sqrt(a[m]), m < n, two at a time where SSE2 is there (compilers vectorise sqrt
 // only without errno, which the library does not switch off); correctly rounded either way.
 inline void sqrt_n(double *a, int n) {

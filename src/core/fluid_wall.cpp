@@ -48,6 +48,11 @@ struct CubicSpline {
     w = s * f;
     dw = s * ih * df;
   }
+  double value(double r) const {
+    double w, dw;
+    eval(r, w, dw);
+    return w;
+  }
 };
 
 }  // namespace
@@ -316,10 +321,6 @@ void FluidSystem::set_consistent_integration(int on) {
   vci_ = on != 0;
 }
 
-}  // namespace mfree
-
-namespace mfree {
-
 void FluidSystem::set_velocity_smoothing(double beta) {
   if (!(std::isfinite(beta) && beta >= 0.0))
     throw Error(MFREE_ERR_ARG, "the velocity-smoothing coefficient must be finite and >= 0, not " + std::to_string(beta));
@@ -341,10 +342,10 @@ void FluidSystem::set_velocity_smoothing(double beta) {
 void FluidSystem::velocity_smoothing(const double *v, const double *lumped, int stride, double *a) const {
   if (!(vsmooth_ > 0.0)) return;
   const int dim = dim_;
-  const Kernel kern(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0);
+  const CubicSpline kern(dim, h_);
   const double *mass = dummy_.n ? dummy_.mass.data() : mass_.data();
   const double *rho0 = dummy_.n ? dummy_.rho0.data() : rho0_.data();
-  const double ih = 1.0 / h_, wnorm = kern.norm() * std::pow(ih, dim), gk = gamma_ * kappa_;
+  const double gk = gamma_ * kappa_;
   parallel_blocks(n_, num_threads(n_), [&](int, int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) {
       double f[3] = {0, 0, 0};
@@ -354,9 +355,7 @@ void FluidSystem::velocity_smoothing(const double *v, const double *lumped, int 
         if (j == i) continue;
         double r2 = 0.0;
         for (int c = 0; c < dim; ++c) r2 += (ps_.x(j, c) - ps_.x(i, c)) * (ps_.x(j, c) - ps_.x(i, c));
-        // the cubic spline W(r, h) (rows hold the pairs closer than 2h)
-        const double qq = std::sqrt(r2) * ih, t1 = std::max(0.0, 1.0 - qq), t2 = std::max(0.0, 2.0 - qq);
-        const double W = wnorm * (0.25 * t2 * t2 * t2 - t1 * t1 * t1);
+        const double W = kern.value(std::sqrt(r2));  // rows hold the pairs closer than 2h
         const double cbar = j < n_ && rho0[j] == rho0[i] ? ci : 0.5 * (ci + std::sqrt(gk / rho0[j]));
         const double cij = vsmooth_ * cbar / h_ * 0.5 * (mass[i] * vol_[j] + mass[j] * vol_[i]) * W;
         for (int c = 0; c < dim; ++c) f[c] += cij * (v[static_cast<size_t>(j) * dim + c] - v[i * dim + c]);

@@ -37,6 +37,13 @@ typedef struct { uint64_t s; } mfree_rng_t;
 void mfree_rng_seed(mfree_rng_t *r, uint64_t seed);
 double mfree_rng_uniform(mfree_rng_t *r);
 
+/* The lumped masses M_i (n values) of a fluid system at state y: the velocity block of
+ * mfree_system_assemble_mass (consistent = 0). Fails the test unless every velocity row
+ * holds one diagonal entry, equal for all components of a particle, and the position and
+ * density rows are identity rows. */
+void mfree_test_lumped_masses(mfree_context_t *ctx, mfree_system_t *sys, const double *y, int dim, int n,
+                              double *Mi);
+
 /* Fluid systems: the Galerkin lumped masses of mfree_system_assemble_mass (row sums at the
  * first velocity component of each particle) summed over the n particles, and the total
  * of the particle masses m; returns |lumped - total| / total (003 eq 57 makes it zero). */
