@@ -1,6 +1,7 @@
 #include "approximant.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
 #include <type_traits>
@@ -419,8 +420,8 @@ bool Approximant::share_rows(const Csr &src) {
   // static blocks of sites, each copying its rows and finding the site in them (rows
   // are sorted: a binary search)
   const int nt = num_threads(nnz);
-  int missing[64] = {};
-  parallel_blocks(nsites_, nt, [&](int t, int64_t b, int64_t e) {
+  std::atomic<int64_t> missing{0};
+  parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
     if (b >= e) return;
     std::copy(srp + b + 1, srp + e + 1, rp + b + 1);
     std::copy(scl + srp[b], scl + srp[e], cl + srp[b]);
@@ -432,11 +433,9 @@ bool Approximant::share_rows(const Csr &src) {
       self[s] = found ? static_cast<int32_t>(at - r0) : -1;
       miss += !found;
     }
-    missing[t < 64 ? t : 63] += miss;
+    if (miss) missing += miss;
   });
-  for (int t = 0; t < 64; ++t)
-    if (missing[t]) return false;  // a row without its site (never from the set's search)
-  return true;
+  return missing == 0;  // else a row lacks its site (never from the set's search): filter
 }
 
 Report Approximant::compute(const char *what) {
