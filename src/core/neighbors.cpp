@@ -70,9 +70,10 @@ struct Rule {
   }
 };
 
-// Work split into `nchunks` fixed chunks (chunk v: thread_block(count, v, nchunks)), run
-// by however many threads the runtime grants: passes that must see the same blocks
-// (histogram, then scatter) agree even if a team comes out smaller than asked.
+// Work split into `nchunks` <= kMaxBlocks fixed chunks (chunk v: thread_block(count, v,
+// nchunks)), run by however many threads the runtime grants (parallel_blocks keeps the
+// block layout): passes that must see the same blocks (histogram, then scatter) agree
+// even if a team comes out smaller than asked.
 template <class Body>
 void for_chunks(int nchunks, Body &&body) {
   parallel_blocks(nchunks, nchunks, [&](int, int64_t b, int64_t e) {

@@ -53,36 +53,57 @@ inline void thread_block(int64_t count, int t, int nt, int64_t &begin, int64_t &
   end = begin + q + (t < r ? 1 : 0);
 }
 
-// Run body(t, begin, end) on nt threads over static blocks of count items, with the
-// caller's allocator hook installed on every thread. Exceptions are caught per thread
-// and the first (lowest thread) is rethrown after the region.
+// Most blocks (and threads) a parallel region uses; per-block arrays of this size are
+// always large enough.
+constexpr int kMaxBlocks = 64;
+
+// The block count parallel_blocks(count, nt, ...) splits into: nt clamped to
+// [1, kMaxBlocks]. Block t is thread_block(count, t, block_count(nt)), whatever team the
+// OpenMP runtime grants, so a later pass that re-derives the blocks from nt agrees with
+// what an earlier one wrote per block.
+inline int block_count(int nt) { return nt < 1 ? 1 : (nt > kMaxBlocks ? kMaxBlocks : nt); }
+
+// Run body(t, begin, end) over the static blocks t = 0 .. block_count(nt) - 1 of count
+// items, with the caller's allocator hook installed on every thread. The layout never
+// depends on the team size: if the runtime grants fewer threads than asked (thread
+// limit, nested region, OMP_DYNAMIC), each thread runs several whole blocks in turn
+// (thread k: blocks k, k + team, ...), so `t` is always a block index below
+// block_count(nt), and per-block buffers indexed by it are never shared by two threads
+// at once. Exceptions are caught per block and the first (lowest block) is rethrown
+// after the region.
 template <class Body>
 void parallel_blocks(int64_t count, int nt, Body &&body) {
-  if (nt <= 1) {
+  nt = block_count(nt);
+  if (nt == 1) {
     body(0, int64_t{0}, count);
     return;
   }
 #ifdef _OPENMP
   const AllocHook *hook = current_alloc_hook();
-  std::exception_ptr err[64];
-  if (nt > 64) nt = 64;
+  std::exception_ptr err[kMaxBlocks];
 #pragma omp parallel num_threads(nt)
   {
-    const int t = omp_get_thread_num(), team = omp_get_num_threads();
+    const int team = omp_get_num_threads();
     AllocScope scope(hook);
     ThreadScope one(1);
-    int64_t b, e;
-    thread_block(count, t, team, b, e);
-    try {
-      body(t, b, e);
-    } catch (...) {
-      err[t] = std::current_exception();
+    for (int t = omp_get_thread_num(); t < nt; t += team) {
+      int64_t b, e;
+      thread_block(count, t, nt, b, e);
+      try {
+        body(t, b, e);
+      } catch (...) {
+        err[t] = std::current_exception();
+      }
     }
   }
   for (int t = 0; t < nt; ++t)
     if (err[t]) std::rethrow_exception(err[t]);
 #else
-  body(0, int64_t{0}, count);
+  for (int t = 0; t < nt; ++t) {
+    int64_t b, e;
+    thread_block(count, t, nt, b, e);
+    body(t, b, e);
+  }
 #endif
 }
 
