@@ -41,8 +41,10 @@
  * Volumes: spacing along the ring times the spacing across the rings, halved on the
  * boundary. Supports: h_i = hfac Delta_i, Delta_i the distance from particle i to its
  * nearest neighbour (spec 001 8.3: "the smallest distance between particle i and other
- * particles in its compact support"); gather search with kappa = 2 (the kernel support
- * is 2 h_i).
+ * particles in its compact support"; the nearest particle always lies in the support
+ * 2 h_i = 3 Delta_i, so the two readings agree); gather search with kappa = 2 (the kernel
+ * support is 2 h_i), W_ij = W(x_i - x_j, h_i) as in spec 001 3 (cfg->search can make it
+ * symmetric, a measurement only).
  *
  * Boundary rows (spec 001 8.3 table; mixed conditions as in (6.24)/(6.25)):
  *  - hole r = a: traction rows sigma n = 0 for both components, n = -(x, y)/a (the
@@ -85,6 +87,7 @@ void plate_config_default(plate_config_t *cfg, int nt, int nr) {
   cfg->hfac = 1.5;
   cfg->layout = PLATE_LAYOUT_RINGS;
   cfg->hole_corner = PLATE_CORNER_DIRICHLET;
+  cfg->search = MFREE_SEARCH_GATHER;
   cfg->patch = 0;
 }
 
@@ -241,7 +244,8 @@ int plate_particles(const plate_config_t *cfg, int *nout, double **xout, double 
   const int nt = cfg->nt, nr = cfg->nr, m0 = (nt - 1) / 2;
   const double a = cfg->a, b = cfg->b;
   if (nt < 3 || nt % 2 == 0 || nr < 3 || !(b > a && a > 0) || !(cfg->hfac > 0) ||
-      cfg->hole_corner < PLATE_CORNER_DIRICHLET || cfg->hole_corner > PLATE_CORNER_HOLE)
+      cfg->hole_corner < PLATE_CORNER_DIRICHLET || cfg->hole_corner > PLATE_CORNER_HOLE ||
+      cfg->search < MFREE_SEARCH_GATHER || cfg->search > MFREE_SEARCH_SYMMETRIC_MEAN)
     return 1;
   if (cfg->layout == PLATE_LAYOUT_RAYS || cfg->layout == PLATE_LAYOUT_POLAR)
     return rays_particles(cfg, nout, xout, vout, hout, tagout);
@@ -420,7 +424,8 @@ mfree_status_t plate_solve(mfree_context_t *ctx, const plate_config_t *cfg,
   if (plate_particles(cfg, &n, &x, &vol, &h, &tag))
     return mfree_context_set_error(ctx, MFREE_ERR_ARG,
                                    "plate: needs odd nt >= 3, nr >= 3, b > a > 0, hfac > 0, "
-                                   "a PLATE_LAYOUT_* and a PLATE_CORNER_* value");
+                                   "a PLATE_LAYOUT_*, a PLATE_CORNER_* and an "
+                                   "MFREE_SEARCH_* value");
   const int neq = 2 * n;
   res->n = n;
   res->neq = neq;
@@ -453,7 +458,7 @@ mfree_status_t plate_solve(mfree_context_t *ctx, const plate_config_t *cfg,
   CHECK(mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, 2, MFREE_COPY));
   CHECK(mfree_particles_set_volumes(ps, vol, 1, MFREE_COPY));
   CHECK(mfree_particles_set_support(ps, h, 1, MFREE_COPY));
-  CHECK(mfree_particles_set_search(ps, MFREE_SEARCH_GATHER, 2.0));
+  CHECK(mfree_particles_set_search(ps, (mfree_search_t)cfg->search, 2.0));
   CHECK(mfree_particles_setup(ps));
 
   /* The approximant for the post-processing; the assembler copies its configuration

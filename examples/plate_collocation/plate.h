@@ -48,6 +48,10 @@ typedef struct {
   double hfac;            /* h_i = hfac * Delta_i, 1.5 */
   int layout;             /* PLATE_LAYOUT_* */
   int hole_corner;        /* PLATE_CORNER_* */
+  int search;             /* pair support: MFREE_SEARCH_GATHER, W(x_i - x_j, h_i) with
+                             particle i's own h_i (spec 001 3, "W_i"; the default), or
+                             MFREE_SEARCH_SYMMETRIC_MEAN / _MAX, h_ij = (h_i + h_j)/2 or
+                             max(h_i, h_j) (measured, not the paper's reading) */
   int patch;              /* nonzero: uniform tension sigma_11 = sigma0 everywhere (its
                              tractions also on the hole) instead of Kirsch, a patch test
                              that quadratic shape functions must pass to round-off */
@@ -102,7 +106,7 @@ int plate_ray_particles(int nt);
 
 /* Defaults of paper 001 Sect. 6.3 (a = 1, b = 10, SSPH, E = 1, nu = 0.25, sigma0 = 1,
  * revised super Gauss a = 1.6, h_i = 1.5 Delta_i, PLATE_LAYOUT_RINGS,
- * PLATE_CORNER_DIRICHLET) with nt particles on the hole and nr rings (nr <= 0:
+ * PLATE_CORNER_DIRICHLET, MFREE_SEARCH_GATHER) with nt particles on the hole and nr rings (nr <= 0:
  * plate_rings(1, 10, nt); set it again after changing a or b). For the ray layouts set
  * layout and nr = plate_ray_particles(nt) afterwards. */
 void plate_config_default(plate_config_t *cfg, int nt, int nr);
