@@ -58,7 +58,13 @@
  *   MSPH at both resolutions (closest: rings, "hole" corners, 1.01 / 0.97);
  *   plate sizes b = 8 ... 15 a: rings 1.98-3.26 at ~200 and 0.99-1.68 at ~700, rays
  *   0.94-1.15 at 187 and 1.24-1.42 at 693; SSPH's SCF at ~200 is 3.9-4.7 on all of them
- *   (MSPH 2.8-3.2).
+ *   (MSPH 2.8-3.2);
+ *   rings with the first radial step a dtheta on every ray (square cells along the whole
+ *   hole; the default rings have them only on the axes, and at 45 degrees the hole
+ *   particles' supports reach one ring inwards, the normal curvature of their fit then
+ *   coming from the hole's own curvature): 193 / 655 / 1438: 1.87 / 1.28 / 1.13;
+ *   V_j = 1 instead of the cell areas: rings 0.71 / 3.88, rays 1.70 / 1.42, log-polar
+ *   1.89 / 1.25.
  * Checked and not the cause: the fit at every particle (boundary and hole included)
  * reproduces value, gradient and Hessian of a quadratic (test below), MSPH's weights are
  * W and its first and second xi-derivatives (001 eq 2.9) and the 1D tables anchor both
