@@ -13,6 +13,11 @@ namespace mfree {
 
 namespace {
 
+// Tables (values + gradients) above this size are written with streaming stores: they
+// do not fit the last-level cache of the machines we measure on (issue 8: 32 MiB shared
+// L3, 2 cores), so caching them would only cost a read of every line before its write.
+constexpr double kStreamTableBytes = 16.0 * 1024 * 1024;
+
 bool needs_volumes(int m) {
   return m == MFREE_METHOD_SPH || m == MFREE_METHOD_SPH_SYMMETRIC || m == MFREE_METHOD_RKPM ||
          m == MFREE_METHOD_SSPH || m == MFREE_METHOD_MSPH || m == MFREE_METHOD_JOHNSON_BEISSEL ||
@@ -398,8 +403,10 @@ void Approximant::build_pattern() {
       rp[s + 1] = k - base;
     }
   });
+  maxrow_ = 0;
   for (int32_t s = 0; s < nsites_; ++s) {
     const int64_t base = srp[s] + s, cnt = rp[s + 1];
+    maxrow_ = std::max(maxrow_, static_cast<int>(cnt));
     rp[s + 1] = rp[s] + cnt;
     if (rp[s] != base) std::copy(cl + base, cl + base + cnt, cl + rp[s]);  // moves down
   }
@@ -421,20 +428,27 @@ bool Approximant::share_rows(const Csr &src) {
   // are sorted: a binary search)
   const int nt = num_threads(nnz);
   std::atomic<int64_t> missing{0};
+  std::atomic<int> longest{0};
   parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
     if (b >= e) return;
     std::copy(srp + b + 1, srp + e + 1, rp + b + 1);
     std::copy(scl + srp[b], scl + srp[e], cl + srp[b]);
     int miss = 0;
+    int64_t big = 0;
     for (int64_t s = b; s < e; ++s) {
       const int32_t *r0 = scl + srp[s], *r1 = scl + srp[s + 1];
       const int32_t *at = std::lower_bound(r0, r1, static_cast<int32_t>(s));
       const bool found = at != r1 && *at == s;
       self[s] = found ? static_cast<int32_t>(at - r0) : -1;
       miss += !found;
+      big = std::max<int64_t>(big, r1 - r0);
     }
     if (miss) missing += miss;
+    int cur = longest.load();
+    while (big > cur && !longest.compare_exchange_weak(cur, static_cast<int>(big))) {
+    }
   });
+  maxrow_ = longest;
   return missing == 0;  // else a row lacks its site (never from the set's search): filter
 }
 
@@ -449,9 +463,10 @@ Report Approximant::compute(const char *what) {
   val_.resize(fv ? nnz : 0);
   grad_.resize(fg ? nnz * dim : 0);
   hess_.resize(fh ? nnz * nh : 0);
-  support_.assign(nsites_, 0);
-  cond_.assign(nsites_, 1.0);
-  order_used_.assign(nsites_, -1);
+  // per-site results: every site's entries are written in the parallel loop below
+  support_.resize(nsites_);
+  cond_.resize(nsites_);
+  order_used_.resize(nsites_);
   const bool have_vol = ps_->has_volumes();
 
   LocalConfig base;
@@ -468,8 +483,7 @@ Report Approximant::compute(const char *what) {
   // not depend on the thread count.
   const int nt = num_threads(nsites_);
   if (scratch_.size() < static_cast<size_t>(nt)) scratch_.resize(nt);
-  int maxrow = 0;
-  for (int32_t s = 0; s < nsites_; ++s) maxrow = std::max<int>(maxrow, static_cast<int>(rowptr_[s + 1] - rowptr_[s]));
+  const int maxrow = maxrow_;
   const int maxL = basis_size(dim, std::max(has_order(method_) ? order_ : 1, 1));
   for (int t = 0; t < nt; ++t) {
     SiteScratch &w = scratch_[t];
@@ -503,30 +517,39 @@ Report Approximant::compute(const char *what) {
     ft.val = fv ? val_.data() : nullptr;
     ft.grad = fg ? grad_.data() : nullptr;
   }
-  const int fast_order = has_order(method_) ? order_ : fixed_order(method_);
   const auto &pst = ps_->site_status();
+  FastSites fs;
+  fs.status = status_.data();
+  fs.support = support_.data();
+  fs.cond = cond_.data();
+  fs.order = order_used_.data();
+  fs.pst = points_ ? nullptr : pst.data();
+  fs.order_used = has_order(method_) ? order_ : fixed_order(method_);
+  // Tables larger than the last-level cache go out with streaming stores (no read of
+  // every destination line before it is written); smaller ones stay cached for apply.
+  fs.stream = static_cast<double>(val_.size() + grad_.size()) * sizeof(double) > kStreamTableBytes;
   bool periodic = false;
   for (int c = 0; c < dim; ++c) periodic = periodic || ps_->periodic(c);
   const bool gather = ps_->search_convention() == MFREE_SEARCH_GATHER;
+  std::atomic<int64_t> nfailed{0};
   parallel_blocks(nsites_, nt, [&](int t, int64_t b, int64_t e) {
     SiteScratch &w = scratch_[t];
     LocalConfig cfg = base;
+    if (fast.ok()) fast.run(ft, b, e, w.fast, fs);
+    int64_t bad = 0;
     for (int32_t s = static_cast<int32_t>(b); s < e; ++s) {
+      if (fast.ok() && status_[s] != kFastPending) {
+        bad += status_[s] != 0;
+        continue;
+      }
       const int32_t me = site_particle(s);
       if (me >= 0 && pst[me] != 0) {
         status_[s] = pst[me];
+        support_[s] = 0;
+        cond_[s] = 1.0;
+        order_used_[s] = -1;
+        ++bad;
         continue;
-      }
-      if (fast.ok()) {
-        int sup = 0;
-        double cnd = 1.0;
-        if (fast.site(ft, s, w.fast, sup, cnd) == 0) {
-          status_[s] = 0;
-          support_[s] = sup;
-          cond_[s] = cnd;
-          order_used_[s] = fast_order;
-          continue;
-        }
       }
       const int64_t k0 = rowptr_[s];
       const int n = static_cast<int>(rowptr_[s + 1] - k0);
@@ -582,19 +605,15 @@ Report Approximant::compute(const char *what) {
       support_[s] = out.support;
       cond_[s] = out.cond;
       order_used_[s] = out.order_used;
+      bad += out.status != 0;
     }
+    if (bad) nfailed += bad;
   });
 
   Report rep;
-  int64_t nfailed = 0;
-  int32_t first_bad = -1;
-  for (int32_t s = 0; s < nsites_; ++s)
-    if (status_[s]) {
-      ++nfailed;
-      if (first_bad < 0) first_bad = s;
-    }
   if (nfailed) {
-    const int32_t s = first_bad;
+    int32_t s = 0;
+    while (!status_[s]) ++s;  // the first failed site
     std::ostringstream msg;
     msg << method_name(method_) << ": site " << s;
     if (status_[s] == MFREE_FAIL_NEIGHBORS)
@@ -604,7 +623,8 @@ Report Approximant::compute(const char *what) {
           << "; collinear, coincident or too few neighbours)";
     else
       msg << " has invalid particle data";
-    msg << " (" << nfailed << (nfailed == 1 ? " site" : " sites") << " failed; their rows are zero)";
+    const int64_t nf = nfailed;
+    msg << " (" << nf << (nf == 1 ? " site" : " sites") << " failed; their rows are zero)";
     rep.fail(static_cast<mfree_status_t>(status_[s]), msg.str());
   }
   return rep;

@@ -122,6 +122,7 @@ class Approximant {
   int32_t nsites_ = 0;
   // tables and per-site data come from the context's allocator hook (alloc.hpp)
   HVec<int64_t> rowptr_ = HVec<int64_t>(1, 0);
+  int maxrow_ = 0;  // the longest row of the pattern
   HVec<int32_t> cols_;
   HVec<int32_t> self_;  // position of the site itself in its row, or -1
   HVec<double> val_, grad_, hess_;

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #include "local.hpp"
 #include "simd.hpp"
@@ -35,6 +36,11 @@
 #define MFREE_SIMD_SUM(v)
 #endif
 #define MFREE_STR(x) #x
+#if defined(__GNUC__) || defined(__clang__)
+#define MFREE_LAMBDA_INLINE __attribute__((always_inline))
+#else
+#define MFREE_LAMBDA_INLINE
+#endif
 #define MFREE_UNROLL _Pragma("GCC unroll 64")
 
 // Four neighbours at a time in GCC/Clang vector extensions: AVX2 registers in the AVX2
@@ -43,6 +49,13 @@
 #if defined(__GNUC__) || defined(__clang__)
 #define MFREE_VEC4 1
 typedef double V4 __attribute__((vector_size(32)));
+// Lane shuffles of two V4 (indices 0-3: the first, 4-7: the second).
+#if defined(__clang__)
+#define MFREE_SHUF(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+typedef long long I4 __attribute__((vector_size(32)));
+#define MFREE_SHUF(a, b, i, j, k, l) __builtin_shuffle(a, b, I4{i, j, k, l})
+#endif
 #else
 #define MFREE_VEC4 0
 #endif
@@ -54,11 +67,14 @@ namespace {
 // The row kernels, compiled for the baseline target and, on x86-64 with GCC or Clang,
 // once more for AVX2 + FMA; FastPath picks one copy per call from the CPU (simd.hpp),
 // so every thread of a call runs the same code.
+#define MFREE_ROWS_AVX2 0
 namespace base {
 #include "shape_fast_rows.inc"
 }  // namespace base
+#undef MFREE_ROWS_AVX2
 
 #if MFREE_SIMD_X86
+#define MFREE_ROWS_AVX2 1
 MFREE_AVX2_BEGIN
 namespace avx2 {
 #include "shape_fast_rows.inc"
@@ -66,22 +82,29 @@ namespace avx2 {
 // The caller (baseline code) goes on with SSE instructions: return with the upper
 // halves of the vector registers zeroed.
 template <int D, class Kern>
-int site_fn_ret(const FastPath &fp, const FastTables &t, int32_t s, FastScratch &w, int &support,
-                double &cond) {
-  const int r = site_fn<D, Kern>(fp, t, s, w, support, cond);
+void block_fn_ret(const FastPath &fp, const FastTables &t, int64_t b, int64_t e, FastScratch &w,
+                  const FastSites &out) {
+  block_fn<D, Kern>(fp, t, b, e, w, out);
   _mm256_zeroupper();
-  return r;
 }
 }  // namespace avx2
 MFREE_AVX2_END
+#undef MFREE_ROWS_AVX2
 #endif
 
 }  // namespace
 
 void FastScratch::reserve(int maxrow) {
-  if (maxrow <= cap) return;
-  cap = maxrow;
+  // whole groups of four neighbours (the fused rows write the padded group)
+  const int need = (maxrow + 4) / 4 * 4;
+  if (need <= cap) return;
+  cap = need;
   buf.assign(static_cast<size_t>(cap) * 10, 0.0);
+  // staging: a few hundred entries (values and up to 3 gradients: ~16 KB, in L1/L2), at
+  // least two rows
+  stage = std::max(512, 2 * cap);
+  sval.assign(static_cast<size_t>(stage), 0.0);
+  sgrad.assign(static_cast<size_t>(stage) * 3, 0.0);
 }
 
 FastPath::FastPath(int dim, int method, int order, const Kernel &kernel, int flags)
@@ -114,18 +137,18 @@ FastPath::FastPath(int dim, int method, int order, const Kernel &kernel, int fla
   if (simd::use_avx2()) {
     using namespace avx2;
     switch (dim) {
-      case 1: fn_ = cubic ? &site_fn_ret<1, CubicSpline> : &site_fn_ret<1, AnyShape>; break;
-      case 2: fn_ = cubic ? &site_fn_ret<2, CubicSpline> : &site_fn_ret<2, AnyShape>; break;
-      default: fn_ = cubic ? &site_fn_ret<3, CubicSpline> : &site_fn_ret<3, AnyShape>; break;
+      case 1: fn_ = cubic ? &block_fn_ret<1, CubicSpline> : &block_fn_ret<1, AnyShape>; break;
+      case 2: fn_ = cubic ? &block_fn_ret<2, CubicSpline> : &block_fn_ret<2, AnyShape>; break;
+      default: fn_ = cubic ? &block_fn_ret<3, CubicSpline> : &block_fn_ret<3, AnyShape>; break;
     }
     return;
   }
 #endif
   using namespace base;
   switch (dim) {
-    case 1: fn_ = cubic ? &site_fn<1, CubicSpline> : &site_fn<1, AnyShape>; break;
-    case 2: fn_ = cubic ? &site_fn<2, CubicSpline> : &site_fn<2, AnyShape>; break;
-    default: fn_ = cubic ? &site_fn<3, CubicSpline> : &site_fn<3, AnyShape>; break;
+    case 1: fn_ = cubic ? &block_fn<1, CubicSpline> : &block_fn<1, AnyShape>; break;
+    case 2: fn_ = cubic ? &block_fn<2, CubicSpline> : &block_fn<2, AnyShape>; break;
+    default: fn_ = cubic ? &block_fn<3, CubicSpline> : &block_fn<3, AnyShape>; break;
   }
 }
 

@@ -39,10 +39,14 @@ struct FastTables {
   double *grad = nullptr;  // nullptr when the gradient table is not built
 };
 
-// Per-thread scratch, sized for the longest row before the sites are computed.
+// Per-thread scratch, sized for the longest row before the sites are computed: SoA
+// neighbour data (cap >= the longest row rounded up to whole groups of four), and a
+// staging area for the output rows of consecutive sites (stage entries of value and
+// dim gradients), written out in chunks (streaming stores for large tables).
 struct FastScratch {
-  HVec<double> buf;
+  HVec<double> buf, sval, sgrad;
   int cap = 0;
+  int stage = 0;
   void reserve(int maxrow);
   double *d(int c) { return buf.data() + static_cast<size_t>(c) * cap; }
   double *w() { return d(3); }
@@ -52,6 +56,18 @@ struct FastScratch {
   double *b(int c) { return d(7 + c); }  // method-specific (Shepard gradients)
 };
 
+// Per-site results of a block of sites. A site whose particle failed in the set gets
+// that status (support 0, cond 1, order -1); a site the fast path cannot finish gets
+// kFastPending (its rows are garbage) for the general path to recompute.
+constexpr int32_t kFastPending = -0x7fffffff;
+struct FastSites {
+  int32_t *status = nullptr, *support = nullptr, *order = nullptr;
+  double *cond = nullptr;
+  const int32_t *pst = nullptr;  // particle status per site (nullptr at host points)
+  int order_used = 0;            // reported for the sites done here
+  bool stream = false;           // write the tables with streaming (non-temporal) stores
+};
+
 class FastPath {
  public:
   // Selects the specialised code for this configuration; ok() is false when the general
@@ -59,12 +75,13 @@ class FastPath {
   FastPath(int dim, int method, int order, const Kernel &kernel, int flags);
   bool ok() const { return fn_ != nullptr; }
 
-  // Rows of site s (written only on success). Returns 0, or a positive status when the
-  // site must be recomputed by the general path. support: neighbours with non-zero
-  // weight; cond: condition estimate of the local system as the general path reports
-  // it (1 when none).
-  int site(const FastTables &t, int32_t s, FastScratch &w, int &support, double &cond) const {
-    return fn_(*this, t, s, w, support, cond);
+  // Rows of the sites [b, e) and their entries of out (see FastSites); the scratch is
+  // reserved for the longest row. support: neighbours with non-zero weight; cond:
+  // condition estimate of the local system as the general path reports it (1 when none).
+  // The rows of every site are written (garbage for pending ones) and visible to other
+  // threads once the call returns.
+  void run(const FastTables &t, int64_t b, int64_t e, FastScratch &w, const FastSites &out) const {
+    fn_(*this, t, b, e, w, out);
   }
 
   int method() const { return method_; }
@@ -72,7 +89,8 @@ class FastPath {
   const Kernel &kernel() const { return *kernel_; }
 
  private:
-  using Fn = int (*)(const FastPath &, const FastTables &, int32_t, FastScratch &, int &, double &);
+  using Fn = void (*)(const FastPath &, const FastTables &, int64_t, int64_t, FastScratch &,
+                     const FastSites &);
   Fn fn_ = nullptr;
   int method_;
   int order_;
