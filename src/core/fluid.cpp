@@ -29,8 +29,9 @@ namespace mfree {
 
 namespace {
 // Threads for a loop of a few operations per particle (checks, volumes, updates): a team
-// (and its barrier, costly on a loaded machine) pays off only from ~30,000 particles.
-inline int light_threads(int64_t n) { return num_threads(n / 16); }
+// and its barrier (a few microseconds on idle cores, far more on a loaded machine) pay
+// off from ~8,000 particles.
+inline int light_threads(int64_t n) { return num_threads(n / 4); }
 }  // namespace
 
 FluidSystem::FluidSystem(int dim, int32_t n) : dim_(dim), n_(n), ps_(dim, n) {
@@ -295,13 +296,12 @@ Report FluidSystem::candidates(const double *xn) {
   cand_.cols.assign(nb.cols.begin(), nb.cols.end());
   const int64_t cnnz = cand_.nnz();
   ctrans_valid_ = false;
-  cpos_.assign(cnnz, -1);
-  kept_.resize(cnnz);
-  // the tables never outgrow the candidates: no allocation until the next rebuild
-  cols_.reserve(cnnz);
-  N_.reserve(cnnz);
-  G_.reserve(cnnz * dim);
-  rp_.resize(static_cast<size_t>(nall) + 1);
+  // the tables' rows lie in their candidate rows: no allocation until the next rebuild
+  cols_.resize(cnnz);
+  N_.resize(cnnz);
+  G_.resize(cnnz * dim);
+  rb_.resize(nall);
+  re_.resize(nall);
   cond_.resize(nall);
   maxrow_ = 0;
   for (int32_t i = 0; i < nall; ++i)
@@ -339,7 +339,8 @@ void FluidSystem::transposed_candidates() {
       while (p < cand_.rowptr[j + 1] && cand_.cols[p] < i) ++p;
       if (p < cand_.rowptr[j + 1] && cand_.cols[p] == i) ctrans_[e] = p;
     }
-  NT_.reserve(cand_.nnz() * (dim_ + 1));
+  cpos_.resize(cand_.nnz());
+  NT_.resize(cand_.nnz() * (dim_ + 1));
   ctrans_valid_ = true;
 }
 
@@ -410,46 +411,78 @@ void FluidSystem::shepard_row(int n, const double *w, const double *gf, double *
   }
 }
 
+#if defined(__GNUC__) || defined(__clang__)
+#define FLUID_NOINLINE __attribute__((noinline))
+#else
+#define FLUID_NOINLINE
+#endif
+
+namespace {
+
+// The candidates of row k closer than 2h (r2 < R2, in the search's units: a symmetric
+// test, |x_j - x_k| is computed alike from both ends) in structure-of-arrays scratch:
+// scaled offsets s = (x_j - x_k) / h and columns js; returns their count. Candidates out
+// of range are written and then overwritten (no branch: a quarter of them fall out).
+// Not inlined into the AVX2 copy of the row kernel, where FMA contraction of r2 would
+// move pairs at exactly 2h in or out of the rows depending on the CPU.
+template <int D>
+FLUID_NOINLINE int kept_candidates(const double *xn, int64_t k, const int32_t *cc, int64_t nc, double R2, double ih,
+                                   double *const *s, int64_t *js) {
+  const double *xk = xn + k * D;
+  int q = 0;
+  for (int64_t e = 0; e < nc; ++e) {
+    const int32_t j = cc[e];
+    const double *xj = xn + static_cast<size_t>(j) * D;
+    double r2 = 0.0;
+    for (int c = 0; c < D; ++c) {
+      const double d = xj[c] - xk[c];
+      r2 += d * d;
+      s[c][q] = d * ih;
+    }
+    js[q] = j;
+    q += r2 < R2;
+  }
+  return q;
+}
+
+}  // namespace
+
 template <int D>
 MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch,
-                                                     int64_t *iscratch, bool transpose, bool wide) {
+                                                     int64_t *iscratch, bool transpose, const AccelArgs *fused,
+                                                     bool wide) {
   (void)wide;
   constexpr int L = D + 1;
-  const double ih = 1.0 / h_, tol = shepard_cond_;
+  const double ih = 1.0 / h_, tol = shepard_cond_, R2 = 4.0 * h_ * h_;
   const int64_t *crp = cand_.rowptr.data();
   const int32_t *ccols = cand_.cols.data();
   const int32_t *cpos = cpos_.data();
   const int64_t *ctr = transpose ? ctrans_.data() : nullptr;
-  const int64_t *rp = rp_.data();
+  int64_t *rbeg = rb_.data(), *rend = re_.data();
   bool one_way = false;
-  for (int32_t k = k0; k < k1; ++k) {
+  for (int32_t k = k0; k < k1; ++k) {  // k0 starts a chunk
     const double *xk = xn + static_cast<size_t>(k) * D;
-    const int64_t o = rp[k];
-    const int n = static_cast<int>(rp[k + 1] - o);
+    const int64_t o = transpose ? rbeg[k] : k % kChunk == 0 ? crp[k] : rend[k - 1];
     double *Nk = N_.data() + o, *Gk = G_.data() + o * D;
     // the row's neighbours in structure-of-arrays scratch: scaled offsets s = (x_j - x) / h,
     // weights w = f(|s|) and gf = -f'(|s|) / |s|, so that grad_x w_j = gf s / h; the
-    // columns and transposed candidates. Candidates out of range are written and then
-    // overwritten (no branch).
+    // columns and transposed candidates.
     double *s[D], *w = scratch + D * static_cast<size_t>(maxrow_), *gf = w + maxrow_;
     for (int c = 0; c < D; ++c) s[c] = scratch + c * static_cast<size_t>(maxrow_);
     int64_t *js = iscratch, *ts = iscratch + maxrow_;
-    if (transpose) {
-      int q = 0;
+    int n = 0;
+    if (transpose) {  // the rows' ends and positions come from prepare's filter
       for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
         const int32_t j = ccols[e];
-        js[q] = j;
-        ts[q] = ctr[e];
-        for (int c = 0; c < D; ++c) s[c][q] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
-        q += cpos[e] >= 0;
+        js[n] = j;
+        ts[n] = ctr[e];
+        for (int c = 0; c < D; ++c) s[c][n] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
+        n += cpos[e] >= 0;
       }
     } else {
-      const int32_t *kk = kept_.data() + crp[k];  // the row's columns, from the filter
-      for (int m = 0; m < n; ++m) {
-        const int32_t j = kk[m];
-        js[m] = j;
-        for (int c = 0; c < D; ++c) s[c][m] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
-      }
+      n = kept_candidates<D>(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, ih, s, js);
+      rbeg[k] = o;
+      rend[k] = o + n;
     }
     const double *s0 = s[0], *s1 = s[1], *s2 = s[D - 1];
     for (int m = 0; m < n; ++m) w[m] = s0[m] * s0[m] + s1[m] * s1[m] + (D == 3 ? s2[m] * s2[m] : 0.0);
@@ -571,6 +604,7 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
     // columns, and the transposed copy: N_k(x_j) is entry (j, k) of the transpose
     int32_t *ck = cols_.data() + o;
     for (int m = 0; m < n; ++m) ck[m] = static_cast<int32_t>(js[m]);
+    if (fused) accel_point<D>(k, *fused);
     if (!transpose) continue;
     for (int m = 0; m < n; ++m) {
       const int32_t j = static_cast<int32_t>(js[m]);
@@ -579,7 +613,7 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
         one_way = true;
         continue;
       }
-      double *nt = NT_.data() + (rp[j] + cpos[t]) * (D + 1);  // one cache line per entry
+      double *nt = NT_.data() + (rbeg[j] + cpos[t]) * (D + 1);  // one cache line per entry
       nt[0] = Nk[m];
       for (int c = 0; c < D; ++c) nt[1 + c] = Gk[m * D + c];
     }
@@ -589,92 +623,109 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
 
 template <int D>
 bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
-                             bool transpose) {
-  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, false);
+                             bool transpose, const AccelArgs *fused) {
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, fused, false);
 }
 
 #if MFREE_SIMD_X86
 template <int D>
 MFREE_TARGET_AVX2 bool FluidSystem::table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch,
-                                                    int64_t *iscratch, bool transpose) {
-  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, true);
+                                                    int64_t *iscratch, bool transpose, const AccelArgs *fused) {
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, fused, true);
 }
 #endif
 
-Report FluidSystem::prepare(const double *y) {
+Report FluidSystem::prepare(const double *y, double *accel_out, Report *accel_rep) {
   check_ready();
   Report rep = check_state(y, -1);
   if (!rep.ok()) return rep;
   const int dim = dim_;
   const int32_t nall = nq();
-  const double *rho = y + 2 * static_cast<size_t>(dim) * n_;
+  const size_t nd = static_cast<size_t>(dim) * n_;
+  const double *rho = y + 2 * nd;
   parallel_blocks(n_, light_threads(n_), [&](int, int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) vol_[i] = mass_[i] / rho[i];
   });
   const double *xn = node_positions(y);  // + dummies (fluid_wall.cpp)
   Report r = candidates(xn);
   if (!r.ok()) return r;
-  // rows: the candidates closer than 2h (a symmetric test: |x_j - x_k| is computed
-  // alike from both ends), counted, then filled
-  const double R2 = 4.0 * h_ * h_;
   const int nt = num_threads(nall);
   const int64_t *crp = cand_.rowptr.data();
   const int32_t *ccols = cand_.cols.data();
+  const int64_t nchunk = (nall + kChunk - 1) / kChunk;  // the tables are written by chunks
   const bool transpose = vci_;  // only consistent integration reads NT_ (fluid_wall.cpp)
-  // the kept columns of row k go to kept_[crp[k] ...] (cpos_ only for the transpose)
-  auto filter = [&](auto dimc) {
-    constexpr int D = decltype(dimc)::value;
-    int32_t *kept = kept_.data(), *cpos = cpos_.data();
-    parallel_blocks(nall, nt, [&](int, int64_t b, int64_t e) {
-      for (int64_t k = b; k < e; ++k) {
-        const double *xk = xn + k * D;
-        int32_t cnt = 0;
-        for (int64_t q = crp[k]; q < crp[k + 1]; ++q) {
-          const int32_t j = ccols[q];
-          const double *xj = xn + static_cast<size_t>(j) * D;
-          double r2 = 0.0;
-          for (int c = 0; c < D; ++c) r2 += (xj[c] - xk[c]) * (xj[c] - xk[c]);
-          const int32_t keep = r2 < R2;  // no branch: a quarter of the candidates fall out
-          kept[crp[k] + cnt] = j;         // written always, kept only if counted
-          if (transpose) cpos[q] = keep ? cnt : -1;
-          cnt += keep;
-        }
-        rp_[k + 1] = cnt;
-      }
-    });
-  };
-  if (dim == 2) filter(std::integral_constant<int, 2>());
-  else filter(std::integral_constant<int, 3>());
-  rp_[0] = 0;
-  for (int32_t k = 0; k < nall; ++k) rp_[k + 1] += rp_[k];
-  const size_t nnz = static_cast<size_t>(rp_[nall]);
-  cols_.resize(nnz);
-  N_.resize(nnz);
-  G_.resize(nnz * dim);
   if (transpose) {
+    // the transposed writes need every row's kept positions first: a filter pass (the
+    // row kernel filters on the fly otherwise), the same symmetric test as kept_candidates
     if (!ctrans_valid_) transposed_candidates();
-    NT_.resize(nnz * (dim + 1));
+    const double R2 = 4.0 * h_ * h_;
+    auto filter = [&](auto dimc) {
+      constexpr int D = decltype(dimc)::value;
+      int32_t *cpos = cpos_.data();
+      int64_t *rbeg = rb_.data(), *rend = re_.data();
+      parallel_blocks(nchunk, nt, [&](int, int64_t cb, int64_t ce) {
+        for (int64_t k = cb * kChunk; k < std::min<int64_t>(nall, ce * kChunk); ++k) {
+          const double *xk = xn + k * D;
+          int32_t cnt = 0;
+          for (int64_t q = crp[k]; q < crp[k + 1]; ++q) {
+            const double *xj = xn + static_cast<size_t>(ccols[q]) * D;
+            double r2 = 0.0;
+            for (int c = 0; c < D; ++c) {
+              const double d = xj[c] - xk[c];
+              r2 += d * d;
+            }
+            const int32_t keep = r2 < R2;
+            cpos[q] = keep ? cnt : -1;
+            cnt += keep;
+          }
+          rbeg[k] = k % kChunk == 0 ? crp[k] : rend[k - 1];
+          rend[k] = rbeg[k] + cnt;
+        }
+      });
+    };
+    if (dim == 2) filter(std::integral_constant<int, 2>());
+    else filter(std::integral_constant<int, 3>());
   }
   const size_t per_thread = static_cast<size_t>(dim + 2) * maxrow_, iper_thread = 2 * static_cast<size_t>(maxrow_);
   if (rows_scratch_.size() < per_thread * nt) rows_scratch_.resize(per_thread * nt);
   if (rows_iscratch_.size() < iper_thread * nt) rows_iscratch_.resize(iper_thread * nt);
+  // the forces are summed as each row is finished (accel_point) unless an option needs
+  // all the tables first: the dummies' densities and shares, the VCI corrections
+  const bool fuse = accel_out && !dummy_.n && !vci_;
+  AccelArgs aa{};
+  if (fuse) aa = accel_args(y + nd, rho);
   bool one_way[64] = {};  // parallel_blocks runs at most 64 threads
   const bool avx2 = simd::use_avx2();  // once per step: every thread runs the same copy
   (void)avx2;
-  parallel_blocks(nall, nt, [&](int t, int64_t b, int64_t e) {
+  auto rows = [&](int t, int32_t k0, int32_t k1) {
     double *scratch = rows_scratch_.data() + per_thread * t;
     int64_t *iscratch = rows_iscratch_.data() + iper_thread * t;
-    const int32_t k0 = static_cast<int32_t>(b), k1 = static_cast<int32_t>(e);
+    const AccelArgs *fa = fuse ? &aa : nullptr;
 #if MFREE_SIMD_X86
-    if (avx2) {
-      one_way[t] = dim == 2 ? table_rows_avx2<2>(k0, k1, xn, scratch, iscratch, transpose)
-                            : table_rows_avx2<3>(k0, k1, xn, scratch, iscratch, transpose);
-      return;
-    }
+    if (avx2)
+      return dim == 2 ? table_rows_avx2<2>(k0, k1, xn, scratch, iscratch, transpose, fa)
+                      : table_rows_avx2<3>(k0, k1, xn, scratch, iscratch, transpose, fa);
 #endif
-    one_way[t] = dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch, transpose)
-                          : table_rows<3>(k0, k1, xn, scratch, iscratch, transpose);
-  });
+    return dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch, transpose, fa)
+                    : table_rows<3>(k0, k1, xn, scratch, iscratch, transpose, fa);
+  };
+  if (fuse) {
+    // in accel's order: the chunks of a colour in parallel, the colours in turn
+    const int nts = scatter_threads_ ? nt : 1;
+    for (size_t col = 0; col + 1 < color_ptr_.size(); ++col) {
+      const int32_t *chunks = chunk_order_.data() + color_ptr_[col];
+      parallel_blocks(color_ptr_[col + 1] - color_ptr_[col], nts, [&](int t, int64_t b, int64_t e) {
+        for (int64_t c = b; c < e; ++c) {
+          const int32_t k0 = chunks[c] * kChunk, k1 = std::min(nall, k0 + kChunk);
+          one_way[t] = rows(t, k0, k1) || one_way[t];
+        }
+      });
+    }
+  } else {
+    parallel_blocks(nchunk, nt, [&](int t, int64_t b, int64_t e) {
+      one_way[t] = rows(t, static_cast<int32_t>(b * kChunk), static_cast<int32_t>(std::min<int64_t>(nall, e * kChunk)));
+    });
+  }
   if (std::any_of(one_way, one_way + 64, [](bool f) { return f; })) {
     // cannot happen with lists from one search radius; a failure rather than a wrong sum
     rep.fail(MFREE_FAIL_NEIGHBORS, "the neighbour lists of the fluid are not symmetric");
@@ -683,13 +734,19 @@ Report FluidSystem::prepare(const double *y) {
   }
   fluid_share();
   vci_setup();  // optional, fluid_wall.cpp
+  if (accel_out) {
+    Report ar;
+    if (fuse) ar = dim == 2 ? accel_end<2>(aa, accel_out) : accel_end<3>(aa, accel_out);
+    else ar = accel(y + nd, rho, accel_out);
+    if (accel_rep) *accel_rep = ar;
+  }
   return rep;
 }
 
 void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, double *drho) const {
   v = node_velocities(v);
   const int dim = dim_;
-  const int64_t *rp = rp_.data();
+  const int64_t *rb = rb_.data(), *re = re_.data();
   const int32_t *cols = cols_.data();
   const double *N = N_.data(), *G = G_.data();
   parallel_blocks(n_, num_threads(n_), [&](int, int64_t b, int64_t e) {
@@ -698,7 +755,7 @@ void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, d
       if (dim == 2) {
         // five independent sums in scalars (one chain through div was the bottleneck)
         double v0 = 0, v1 = 0, d0 = 0, d1 = 0;
-        for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+        for (int64_t q = rb[k]; q < re[k]; ++q) {
           const double *vj = v + static_cast<size_t>(cols[q]) * 2;
           const double a0 = vj[0], a1 = vj[1], nq = N[q];
           v0 += nq * a0;
@@ -711,7 +768,7 @@ void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, d
         div = d0 + d1;
       } else {
         double d[3] = {0, 0, 0};
-        for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
+        for (int64_t q = rb[k]; q < re[k]; ++q) {
           const double *vj = v + static_cast<size_t>(cols[q]) * dim;
           for (int c = 0; c < dim; ++c) {
             vh[c] += N[q] * vj[c];
@@ -728,136 +785,131 @@ void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, d
   if (drho) density_diffusion(rho, drho);  // optional, fluid_wall.cpp
 }
 
-Report FluidSystem::accel(const double *v, const double *rho, double *a) {
-  return dim_ == 2 ? accel_dim<2>(v, rho, a) : accel_dim<3>(v, rho, a);
+FluidSystem::AccelArgs FluidSystem::accel_args(const double *v, const double *rho) {
+  const int dim = dim_;
+  const int32_t nall = nq();
+  AccelArgs aa;
+  aa.v = node_velocities(v);
+  aa.rho = node_densities(rho);
+  aa.rho0 = dummy_.n ? dummy_.rho0.data() : rho0_.data();
+  aa.mass = dummy_.n ? dummy_.mass.data() : mass_.data();
+  aa.keep_pack = vci_;  // vci_correct reads the points' stresses
+  if (aa.keep_pack) pack_.resize(static_cast<size_t>(nall) * (dim * dim + 2 + dim));
+  const int64_t na = static_cast<int64_t>(nall) * (2 * dim + 2);
+  acc_.resize(na);
+  double *acc = acc_.data();
+  parallel_blocks(na, light_threads(nall), [&](int, int64_t b, int64_t e) { std::fill(acc + b, acc + e, 0.0); });
+  return aa;
 }
 
-// 003 eqs 56, 61, 67-68 with nodal quadrature: the force on node i is
-//   f_i = sum_k [-sigma_k grad N_i(x_k) V_k + N_i(x_k) M_k g],  m_i = sum_k N_i(x_k) M_k,
-// over the quadrature points k whose row holds i. One pass over the rows computes per
-// point k the stress (times V_k), the interpolated velocity and the wall force and
-// scatters the row's terms to the nodes i of the row (acc_); the chunks of rows of one
-// colour touch disjoint nodes and run in parallel, the colours one after another, so that
-// every node sums its terms in the same order whatever the number of threads.
+// Point k of accel: the stress (times V_k), interpolated velocity and wall force at x_k,
+// and the row's terms scattered to its nodes. Not inlined, so that the row kernel's AVX2
+// copy (which calls it when fused) and accel run the same code: same results.
 template <int D>
-Report FluidSystem::accel_dim(const double *v, const double *rho, double *a) {
-  Report rep;
+FLUID_NOINLINE void FluidSystem::accel_point(int64_t k, const AccelArgs &arg) {
   constexpr int P = D * D + 2 + D;  // pack_ per point: sigma V (D x D), M, lumping mass, wall force
   constexpr int A = 2 * D + 2;      // acc_ per node: force, mass sum_k N M, lumped mass, wall force
-  const int32_t nall = nq();
-  v = node_velocities(v);
-  rho = node_densities(rho);
-  const double *rho0 = dummy_.n ? dummy_.rho0.data() : rho0_.data();
-  const double *mass = dummy_.n ? dummy_.mass.data() : mass_.data();
-  const bool keep_pack = vci_;  // vci_correct reads the points' stresses
-  if (keep_pack) pack_.resize(static_cast<size_t>(nall) * P);
-  vhat_.resize(static_cast<size_t>(nall) * D);
-  acc_.assign(static_cast<size_t>(nall) * A, 0.0);
-  const int64_t *rp = rp_.data();
+  const double *v = arg.v, *rho = arg.rho, *rho0 = arg.rho0, *mass = arg.mass;
+  const int64_t q0 = rb_[k], q1 = re_[k];
   const int32_t *cols = cols_.data();
   const double *N = N_.data(), *G = G_.data();
   double *acc = acc_.data();
-  auto point = [&](int64_t k) {
-    // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
-    double vh[D] = {}, L[D][D] = {};
-    if constexpr (D == 2) {
-      // six independent sums in scalars (the vectoriser's pairing made one dependent chain)
-      double v0 = 0, v1 = 0, l00 = 0, l01 = 0, l10 = 0, l11 = 0;
-      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
-        const double *vj = v + static_cast<size_t>(cols[q]) * 2;
-        const double a0 = vj[0], a1 = vj[1], nq = N[q], g0 = G[2 * q], g1 = G[2 * q + 1];
-        v0 += nq * a0;
-        v1 += nq * a1;
-        l00 += a0 * g0;
-        l01 += a0 * g1;
-        l10 += a1 * g0;
-        l11 += a1 * g1;
-      }
-      vh[0] = v0;
-      vh[1] = v1;
-      L[0][0] = l00;
-      L[0][1] = l01;
-      L[1][0] = l10;
-      L[1][1] = l11;
-    } else {
-      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
-        const double *vj = v + static_cast<size_t>(cols[q]) * D;
-        const double *gq = G + q * D;
-        for (int c = 0; c < D; ++c) {
-          vh[c] += N[q] * vj[c];
-          for (int bb = 0; bb < D; ++bb) L[c][bb] += vj[c] * gq[bb];
-        }
+  // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
+  double vh[D] = {}, L[D][D] = {};
+  if constexpr (D == 2) {
+    // six independent sums in scalars (the vectoriser's pairing made one dependent chain)
+    double v0 = 0, v1 = 0, l00 = 0, l01 = 0, l10 = 0, l11 = 0;
+    for (int64_t q = q0; q < q1; ++q) {
+      const double *vj = v + static_cast<size_t>(cols[q]) * 2;
+      const double a0 = vj[0], a1 = vj[1], nq = N[q], g0 = G[2 * q], g1 = G[2 * q + 1];
+      v0 += nq * a0;
+      v1 += nq * a1;
+      l00 += a0 * g0;
+      l01 += a0 * g1;
+      l10 += a1 * g0;
+      l11 += a1 * g1;
+    }
+    vh[0] = v0;
+    vh[1] = v1;
+    L[0][0] = l00;
+    L[0][1] = l01;
+    L[1][0] = l10;
+    L[1][1] = l11;
+  } else {
+    for (int64_t q = q0; q < q1; ++q) {
+      const double *vj = v + static_cast<size_t>(cols[q]) * D;
+      const double *gq = G + q * D;
+      for (int c = 0; c < D; ++c) {
+        vh[c] += N[q] * vj[c];
+        for (int bb = 0; bb < D; ++bb) L[c][bb] += vj[c] * gq[bb];
       }
     }
-    double tr3 = 0.0;
-    for (int c = 0; c < D; ++c) tr3 += L[c][c];
-    tr3 /= 3.0;
-    const double p = kappa_ * (tait(rho[k], rho0[k]) - 1.0), Vk = vol_[k];
-    double S[D][D];
-    for (int aa = 0; aa < D; ++aa)
-      for (int bb = 0; bb < D; ++bb) {
-        const double d = 0.5 * (L[aa][bb] + L[bb][aa]) - (aa == bb ? tr3 : 0.0);  // d' (003 eq 61)
-        S[aa][bb] = ((aa == bb ? -p : 0.0) + 2.0 * mu_ * d) * Vk;
-      }
-    const double Mk = mass[k];
-    const double Lk = k < n_ ? mass[k] / share(static_cast<int32_t>(k)) : 0.0;  // dummies carry no fluid mass
-    double F[D] = {};
-    bool wall = false;
-    if (walls_ && k < n_) {
-      // wall force (003 eqs 122-124) on approaching particles, spread through N_i(x_k)
-      for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
-        const int32_t w = wall_nbr_.cols[q];
-        const double *nw = &wall_n_[static_cast<size_t>(w) * D];
-        double r2 = 0.0, approach = 0.0;
-        for (int c = 0; c < D; ++c) {
-          const double d = xbound_[k * D + c] - walls_->x(w, c);
-          r2 += d * d;
-          approach += vh[c] * nw[c];
-        }
-        const double r = std::sqrt(r2);
-        if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // f1 = 0: moving away
-        const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
-        for (int c = 0; c < D; ++c) F[c] += f2 * nw[c];
-        wall = true;
-      }
-    }
-    for (int c = 0; c < D; ++c) vhat_[k * D + c] = vh[c];
-    if (keep_pack) {
-      double *pk = &pack_[static_cast<size_t>(k) * P];
-      for (int aa = 0; aa < D; ++aa)
-        for (int bb = 0; bb < D; ++bb) pk[aa * D + bb] = S[aa][bb];
-      pk[D * D] = Mk;
-      pk[D * D + 1] = Lk;
-      for (int c = 0; c < D; ++c) pk[D * D + 2 + c] = F[c];
-    }
-    // the row's terms to its nodes i: -sigma_k V_k grad N_i(x_k), N_i(x_k) M_k (003 eq 56)
-    for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
-      double *ai = acc + static_cast<size_t>(cols[q]) * A;
-      const double *gi = G + q * D, Ni = N[q];
-      for (int aa = 0; aa < D; ++aa) {
-        double sg = 0.0;
-        for (int bb = 0; bb < D; ++bb) sg += S[aa][bb] * gi[bb];
-        ai[aa] -= sg;
-      }
-      ai[D] += Ni * Mk;
-      ai[D + 1] += Ni * Lk;
-    }
-    if (wall)
-      for (int64_t q = rp[k]; q < rp[k + 1]; ++q) {
-        double *ai = acc + static_cast<size_t>(cols[q]) * A;
-        for (int c = 0; c < D; ++c) ai[D + 2 + c] += N[q] * F[c];
-      }
-  };
-  const int nt = scatter_threads_ ? num_threads(nall) : 1;
-  for (size_t col = 0; col + 1 < color_ptr_.size(); ++col) {
-    const int32_t *chunks = chunk_order_.data() + color_ptr_[col];
-    parallel_blocks(color_ptr_[col + 1] - color_ptr_[col], nt, [&](int, int64_t b, int64_t e) {
-      for (int64_t c = b; c < e; ++c) {
-        const int64_t k0 = static_cast<int64_t>(chunks[c]) * kChunk, k1 = std::min<int64_t>(nall, k0 + kChunk);
-        for (int64_t k = k0; k < k1; ++k) point(k);
-      }
-    });
   }
+  double tr3 = 0.0;
+  for (int c = 0; c < D; ++c) tr3 += L[c][c];
+  tr3 /= 3.0;
+  const double p = kappa_ * (tait(rho[k], rho0[k]) - 1.0), Vk = vol_[k];
+  double S[D][D];
+  for (int aa = 0; aa < D; ++aa)
+    for (int bb = 0; bb < D; ++bb) {
+      const double d = 0.5 * (L[aa][bb] + L[bb][aa]) - (aa == bb ? tr3 : 0.0);  // d' (003 eq 61)
+      S[aa][bb] = ((aa == bb ? -p : 0.0) + 2.0 * mu_ * d) * Vk;
+    }
+  const double Mk = mass[k];
+  const double Lk = k < n_ ? mass[k] / share(static_cast<int32_t>(k)) : 0.0;  // dummies carry no fluid mass
+  double F[D] = {};
+  bool wall = false;
+  if (walls_ && k < n_) {
+    // wall force (003 eqs 122-124) on approaching particles, spread through N_i(x_k)
+    for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
+      const int32_t w = wall_nbr_.cols[q];
+      const double *nw = &wall_n_[static_cast<size_t>(w) * D];
+      double r2 = 0.0, approach = 0.0;
+      for (int c = 0; c < D; ++c) {
+        const double d = xbound_[k * D + c] - walls_->x(w, c);
+        r2 += d * d;
+        approach += vh[c] * nw[c];
+      }
+      const double r = std::sqrt(r2);
+      if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // f1 = 0: moving away
+      const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
+      for (int c = 0; c < D; ++c) F[c] += f2 * nw[c];
+      wall = true;
+    }
+  }
+  if (arg.keep_pack) {
+    double *pk = &pack_[static_cast<size_t>(k) * P];
+    for (int aa = 0; aa < D; ++aa)
+      for (int bb = 0; bb < D; ++bb) pk[aa * D + bb] = S[aa][bb];
+    pk[D * D] = Mk;
+    pk[D * D + 1] = Lk;
+    for (int c = 0; c < D; ++c) pk[D * D + 2 + c] = F[c];
+  }
+  // the row's terms to its nodes i: -sigma_k V_k grad N_i(x_k), N_i(x_k) M_k (003 eq 56)
+  for (int64_t q = q0; q < q1; ++q) {
+    double *ai = acc + static_cast<size_t>(cols[q]) * A;
+    const double *gi = G + q * D, Ni = N[q];
+    for (int aa = 0; aa < D; ++aa) {
+      double sg = 0.0;
+      for (int bb = 0; bb < D; ++bb) sg += S[aa][bb] * gi[bb];
+      ai[aa] -= sg;
+    }
+    ai[D] += Ni * Mk;
+    ai[D + 1] += Ni * Lk;
+  }
+  if (wall)
+    for (int64_t q = q0; q < q1; ++q) {
+      double *ai = acc + static_cast<size_t>(cols[q]) * A;
+      for (int c = 0; c < D; ++c) ai[D + 2 + c] += N[q] * F[c];
+    }
+}
+
+template <int D>
+Report FluidSystem::accel_end(const AccelArgs &aa, double *a) {
+  Report rep;
+  constexpr int P = D * D + 2 + D;
+  constexpr int A = 2 * D + 2;
+  const double *acc = acc_.data();
   const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
   int32_t bad = n_;  // the first node without a positive mass
   int32_t first_bad[64];  // parallel_blocks runs at most 64 threads
@@ -876,7 +928,7 @@ Report FluidSystem::accel_dim(const double *v, const double *rho, double *a) {
     }
   });
   vci_correct(pack_.data(), P, a);  // optional, fluid_wall.cpp
-  velocity_smoothing(v, galerkin ? acc + D + 1 : mass_.data(), galerkin ? A : 1, a);  // optional, fluid_wall.cpp
+  velocity_smoothing(aa.v, galerkin ? acc + D + 1 : mass_.data(), galerkin ? A : 1, a);  // optional, fluid_wall.cpp
   for (int32_t fbad : first_bad) bad = std::min(bad, fbad);
   if (bad < n_) {
     const double m = galerkin ? acc[static_cast<size_t>(bad) * A + D + 1] : mass_[bad];
@@ -886,15 +938,41 @@ Report FluidSystem::accel_dim(const double *v, const double *rho, double *a) {
   return rep;
 }
 
+// 003 eqs 56, 61, 67-68 with nodal quadrature: the force on node i is
+//   f_i = sum_k [-sigma_k grad N_i(x_k) V_k + N_i(x_k) M_k g],  m_i = sum_k N_i(x_k) M_k,
+// over the quadrature points k whose row holds i. One pass over the rows computes per
+// point k the stress (times V_k), the interpolated velocity and the wall force and
+// scatters the row's terms to the nodes i of the row (acc_); the chunks of rows of one
+// colour touch disjoint nodes and run in parallel, the colours one after another, so that
+// every node sums its terms in the same order whatever the number of threads.
+Report FluidSystem::accel(const double *v, const double *rho, double *a) {
+  const AccelArgs aa = accel_args(v, rho);
+  const int32_t nall = nq();
+  const int nt = scatter_threads_ ? num_threads(nall) : 1;
+  for (size_t col = 0; col + 1 < color_ptr_.size(); ++col) {
+    const int32_t *chunks = chunk_order_.data() + color_ptr_[col];
+    parallel_blocks(color_ptr_[col + 1] - color_ptr_[col], nt, [&](int, int64_t b, int64_t e) {
+      for (int64_t c = b; c < e; ++c) {
+        const int64_t k0 = static_cast<int64_t>(chunks[c]) * kChunk, k1 = std::min<int64_t>(nall, k0 + kChunk);
+        for (int64_t k = k0; k < k1; ++k) {
+          if (dim_ == 2) accel_point<2>(k, aa);
+          else accel_point<3>(k, aa);
+        }
+      }
+    });
+  }
+  return dim_ == 2 ? accel_end<2>(aa, a) : accel_end<3>(aa, a);
+}
+
 Report FluidSystem::rhs(double t, const double *y, double *ydot) {
   (void)t;
-  Report rep = prepare(y);
-  if (!rep.ok()) return rep;
   const size_t nd = static_cast<size_t>(dim_) * n_;
+  Report arep;
+  Report rep = prepare(y, ydot + nd, &arep);  // and accel
+  if (!rep.ok()) return rep;
   const double *v = y + nd, *rho = y + 2 * nd;
-  rep = accel(v, rho, ydot + nd);
   kinematics(v, rho, ydot, ydot + 2 * nd);
-  return rep;
+  return arep;
 }
 
 Report FluidSystem::velocity(const double *y, double *vhat) {
@@ -915,14 +993,13 @@ Report FluidSystem::interpolation(const double *y, SparseMatrix &S) {
   if (!rep.ok()) return rep;
   // rows are not guaranteed sorted by column: sort each row with its values
   // the fluid rows and columns only (dummies are not unknowns)
-  const auto &arp = rp_;
   const auto &acols = cols_;
   std::vector<int64_t> rp(static_cast<size_t>(n_) + 1, 0);
   std::vector<int32_t> cols;
   std::vector<double> vals;
   for (int32_t k = 0; k < n_; ++k) {
     std::vector<std::pair<int32_t, double>> row;
-    for (int64_t e = arp[k]; e < arp[k + 1]; ++e)
+    for (int64_t e = rb(k); e < re(k); ++e)
       if (acols[e] < n_) row.push_back({acols[e], N_[e]});
     std::sort(row.begin(), row.end());
     for (auto &q : row) {
@@ -941,7 +1018,6 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   if (!rep.ok()) return rep;
   const int dim = dim_;
   const size_t nd = static_cast<size_t>(dim) * n_;
-  const auto &rp = rp_;
   const auto &cols = cols_;
   const auto &N = N_;
   // node-level velocity block: consistent m_ij = sum_k N_i(x_k) N_j(x_k) M_k (003 eq 42),
@@ -949,9 +1025,9 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   std::vector<std::vector<std::pair<int32_t, double>>> rows(n_);
   // with dummies: fluid rows and columns only, lumped masses as in accel (fluid_wall.hpp)
   for (int32_t k = 0; k < n_; ++k)
-    for (int64_t a = rp[k]; a < rp[k + 1]; ++a) {
+    for (int64_t a = rb(k); a < re(k); ++a) {
       if (cols[a] >= n_) continue;
-      for (int64_t b = rp[k]; b < rp[k + 1]; ++b) {
+      for (int64_t b = rb(k); b < re(k); ++b) {
         const double m = N[a] * N[b] * mass_[k];
         if (consistent) {
           if (cols[b] < n_) rows[cols[a]].push_back({cols[b], m});
@@ -1027,9 +1103,14 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
   const size_t nd = static_cast<size_t>(dim) * n_, ny = static_cast<size_t>(neq());
   work_state_.resize(ny);
   stage_.resize(ny);
-  std::vector<double> rate(ny), vh(nd), dr(n_);
+  rate_.resize(ny);
+  vh_.resize(nd);
+  dr_.resize(n_);
+  double *rate = rate_.data(), *vh = vh_.data(), *dr = dr_.data();
   while (t < t_end) {
-    rep = prepare(y);
+    // leap-frog: the tables at y and the accelerations (003 Sect. 6.1) in one pass
+    Report arep;
+    rep = prepare(y, scheme == MFREE_INTEGRATOR_LEAPFROG ? rate + nd : nullptr, &arep);
     if (!rep.ok()) {
       rep.message = "step " + std::to_string(nsteps) + ": " + rep.message;
       return rep;
@@ -1047,34 +1128,34 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
     double *yn = work_state_.data();
     const double *x = y, *v = y + nd, *rho = y + 2 * nd;
     if (scheme == MFREE_INTEGRATOR_LEAPFROG) {
-      // 003 Sect. 6.1: a from (x^k, rho^k, v^{k-1/2}); v^{k+1/2} = v + dt a; density rates
-      // and interpolated velocities with v^{k+1/2} on the tables at x^k
-      Report r = accel(v, rho, rate.data());
-      if (!r.ok()) return r;
+      // 003 Sect. 6.1: a from (x^k, rho^k, v^{k-1/2}) (prepare); v^{k+1/2} = v + dt a;
+      // density rates and interpolated velocities with v^{k+1/2} on the tables at x^k
+      if (!arep.ok()) return arep;
+      const double *acc = rate + nd;
       const int nt = light_threads(n_);
       parallel_blocks(static_cast<int64_t>(nd), nt, [&](int, int64_t b, int64_t e) {
-        for (int64_t q = b; q < e; ++q) yn[nd + q] = v[q] + dt * rate[q];
+        for (int64_t q = b; q < e; ++q) yn[nd + q] = v[q] + dt * acc[q];
       });
-      kinematics(yn + nd, rho, vh.data(), dr.data());
+      kinematics(yn + nd, rho, vh, dr);
       parallel_blocks(n_, nt, [&](int, int64_t b, int64_t e) {
         for (int64_t q = b * dim; q < e * dim; ++q) yn[q] = x[q] + dt * vh[q];
         for (int64_t i = b; i < e; ++i) yn[2 * nd + i] = rho[i] + dt * dr[i];
       });
     } else {
       // 003 eqs 111-119
-      Report r = rhs(t, y, rate.data());
+      Report r = rhs(t, y, rate);
       if (!r.ok()) return r;
       double *yp = stage_.data();
       for (size_t q = 0; q < ny; ++q) yp[q] = y[q] + 0.5 * dt * rate[q];
-      r = prepare(yp);
+      Report ar;
+      r = prepare(yp, rate, &ar);  // and accel (into the first nd rates, as read below)
       if (!r.ok()) {
         r.message = "step " + std::to_string(nsteps) + " (predictor): " + r.message;
         return r;
       }
-      r = accel(yp + nd, yp + 2 * nd, rate.data());
-      if (!r.ok()) return r;
+      if (!ar.ok()) return ar;
       for (size_t q = 0; q < nd; ++q) yn[nd + q] = v[q] + 0.5 * dt * rate[q];  // v^C
-      kinematics(yn + nd, yp + 2 * nd, vh.data(), dr.data());
+      kinematics(yn + nd, yp + 2 * nd, vh, dr);
       for (int32_t i = 0; i < n_; ++i) yn[2 * nd + i] = rho[i] + 0.5 * dt * dr[i];  // rho^C
       for (size_t q = 0; q < nd; ++q) yn[q] = x[q] + 0.5 * dt * vh[q];              // x^C
       for (size_t q = 0; q < ny; ++q) yn[q] = 2.0 * yn[q] - y[q];                   // eqs 117-119

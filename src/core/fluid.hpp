@@ -51,22 +51,27 @@ class FluidSystem : public System {
 
  private:
   void check_ready() const;
-  // Validate the state and build the shape-function tables at the nodes (below).
-  Report prepare(const double *y);
+  // Validate the state and build the shape-function tables at the nodes (below). With
+  // a, also accel(v, rho, a) of y's velocities and densities, its report in *arep (fused
+  // into the table rows where no option needs the finished tables first: same results).
+  Report prepare(const double *y, double *a = nullptr, Report *arep = nullptr);
   // Candidate neighbour lists (Verlet lists with a skin, see tables_) for the node
   // positions xn, rebuilt when a node moved more than half the skin since the last build.
   Report candidates(const double *xn);
   // Tables rows [k0, k1): linear MLS at the nodes, Shepard rows where ill-conditioned;
   // with transpose, also NT_ (true if a pair is in one node's row only, which the search
-  // rules out).
+  // rules out); with fused, accel_point(k) after each row k.
   // table_rows_avx2 is the same code compiled for AVX2 + FMA (simd.hpp), chosen per step.
+  struct AccelArgs;
   template <int D>
-  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
+                  const AccelArgs *fused);
   template <int D>
-  bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
+                       const AccelArgs *fused);
   template <int D>
   bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
-                       bool wide);  // wide: the AVX2 copy (256-bit sqrt)
+                       const AccelArgs *fused, bool wide);  // wide: the AVX2 copy (256-bit sqrt)
   // Chunks of kChunk rows coloured so that no two chunks of a colour touch a common
   // node (on the candidate pattern), for the scatter of accel (rebuilt with the lists).
   void color_chunks();
@@ -74,10 +79,19 @@ class FluidSystem : public System {
   template <int D>
   void shepard_row(int n, const double *w, const double *gf, double *const *s, double ih, bool volumes,
                    const int64_t *js, double *Nk, double *Gk) const;
-  // Acceleration parameters a (dim per particle) from the prepared tables and v, rho.
+  // Acceleration parameters a (dim per particle) from the prepared tables and v, rho:
+  // accel_args (node arrays, zeroed sums), accel_point for every row in colour order
+  // (chunk_order_), accel_end (the nodes' accelerations).
+  struct AccelArgs {
+    const double *v, *rho, *rho0, *mass;
+    bool keep_pack;
+  };
   Report accel(const double *v, const double *rho, double *a);
+  AccelArgs accel_args(const double *v, const double *rho);
   template <int D>
-  Report accel_dim(const double *v, const double *rho, double *a);
+  void accel_point(int64_t k, const AccelArgs &aa);
+  template <int D>
+  Report accel_end(const AccelArgs &aa, double *a);
   // Interpolated velocities and density rates for velocity parameters v.
   void kinematics(const double *v, const double *rho, double *vhat, double *drho) const;
   double stable_dt(const double *y) const;  // h / max(c_i + |v_i|)
@@ -115,8 +129,12 @@ class FluidSystem : public System {
   double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
 
   // Shape functions at the nodes, rebuilt at every prepare (003: linear MLS with the
-  // cubic spline, nodal quadrature): CSR rows sorted by column, rp_/cols_; values N_
-  // and gradients G_ (dim per entry) of node cols_[e] at node k. Only with consistent
+  // cubic spline, nodal quadrature): rows sorted by column, entries [rb(k), re(k)) of
+  // cols_, values N_ and gradients G_ (dim per entry) of node cols_[e] at node k. The
+  // rows of a chunk of kChunk rows lie one after another from where the chunk's candidate
+  // rows start (the tables never outgrow the candidates), so that one thread writes a
+  // chunk as it computes it, without a count pass; a few entries at a chunk's end are
+  // unused. Only with consistent
   // integration (vci_, whose sums fluid_wall.cpp takes as gathers) also the transpose NT_
   // on the same pattern (it is symmetric: one h for all), value and gradient interleaved
   // (dim + 1 per entry): entry e of row i holds N_i(x_j), j = cols_[e]. The force
@@ -128,14 +146,15 @@ class FluidSystem : public System {
   // tables never depend on the skin, only the cost does. The wall lists use the same rule.
   ParticleSet ps_;
   std::vector<double> vol_;
-  std::vector<int64_t> rp_;
+  int64_t rb(int64_t k) const { return rb_[k]; }
+  int64_t re(int64_t k) const { return re_[k]; }
+  std::vector<int64_t> rb_, re_;  // row begins and ends
   std::vector<int32_t> cols_;
   std::vector<double> N_, G_, NT_, cond_;
   Csr cand_;
   std::vector<int64_t> ctrans_;  // transposed candidate entry, -1 if none (only with NT_)
   bool ctrans_valid_ = false;
   std::vector<int32_t> cpos_;    // position of a candidate in its row of the tables, -1 if out (only with NT_)
-  std::vector<int32_t> kept_;    // per candidate row: the columns of the table row, then junk
   std::vector<double> xref_;
   double skin_ = 0.25;  // in units of h
   bool lists_valid_ = false;
@@ -146,8 +165,8 @@ class FluidSystem : public System {
   std::vector<double> rows_scratch_;  // (dim + 2) maxrow_ per thread
   std::vector<int64_t> rows_iscratch_;  // 2 maxrow_ per thread
   Csr wall_nbr_;
-  // per node (reused): packed quadrature-point data of accel, interpolated velocities
-  std::vector<double> pack_, vhat_, work_state_, stage_;
+  // per node (reused): packed quadrature-point data of accel; integrate's states and rates
+  std::vector<double> pack_, work_state_, stage_, rate_, vh_, dr_;
   // accel scatters row k's contributions to the nodes of the row; rows go in chunks of
   // kChunk, chunk_order_[color_ptr_[c] .. color_ptr_[c + 1]) are the chunks of colour c,
   // which no two of touch a common node. Colours run one after another, so every node

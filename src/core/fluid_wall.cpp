@@ -139,7 +139,7 @@ const double *FluidSystem::node_densities(const double *rho) const {
     for (int32_t w = n_; w < nall; ++w) {
       if (dummy_.level[w]) continue;
       double sw = 0.0, sp = 0.0, sr0 = 0.0;
-      for (int64_t e = rp_[w]; e < rp_[w + 1]; ++e) {  // the pairs closer than 2h
+      for (int64_t e = rb(w); e < re(w); ++e) {  // the pairs closer than 2h
         const int32_t f = cols_[e];
         const int lf = dummy_.level[f];
         if (lf == 0 || lf == pass) continue;  // only values of earlier passes
@@ -181,12 +181,11 @@ const double *FluidSystem::node_densities(const double *rho) const {
 
 void FluidSystem::fluid_share() {
   if (!dummy_.n) return;
-  const auto &rp = rp_;
   const auto &cols = cols_;
   dummy_.share.assign(nq(), 0.0);
   for (int32_t k = 0; k < n_; ++k) {
     double s = 0.0;
-    for (int64_t e = rp[k]; e < rp[k + 1]; ++e)
+    for (int64_t e = rb(k); e < re(k); ++e)
       if (cols[e] < n_) s += N_[e];
     // a fluid particle surrounded by dummies only (cannot happen for walls 2h thick and
     // a particle inside the fluid) keeps its mass on its own row's fluid part
@@ -206,18 +205,17 @@ void FluidSystem::density_diffusion(const double *rho, double *drho) const {
   const int dim = dim_;
   const int32_t nall = nq();
   const double *r = node_densities(rho);
-  const auto &rp = rp_;
   const auto &cols = cols_;
   dummy_.grad_rho.assign(static_cast<size_t>(nall) * dim, 0.0);
   for (int32_t k = 0; k < nall; ++k)
-    for (int64_t e = rp[k]; e < rp[k + 1]; ++e)
+    for (int64_t e = rb(k); e < re(k); ++e)
       for (int c = 0; c < dim; ++c) dummy_.grad_rho[static_cast<size_t>(k) * dim + c] += G_[e * dim + c] * r[cols[e]];
   const double *gr = dummy_.grad_rho.data();
   const CubicSpline kern(dim, h_);
   for (int32_t i = 0; i < n_; ++i) {
     const double c0 = std::sqrt(gamma_ * kappa_ / rho0_[i]);
     double s = 0.0;
-    for (int64_t e = rp[i]; e < rp[i + 1]; ++e) {
+    for (int64_t e = rb(i); e < re(i); ++e) {
       const int32_t j = cols[e];
       if (j == i) continue;
       double r2 = 0.0, gx = 0.0;
@@ -260,7 +258,7 @@ void FluidSystem::vci_setup() {
   dummy_.blend.assign(n_, 0.0);
   for (int32_t i = 0; i < n_; ++i) {
     double K = 0.0;
-    for (int64_t q = rp_[i]; q < rp_[i + 1]; ++q) {
+    for (int64_t q = rb(i); q < re(i); ++q) {
       const int32_t k = cols_[q];
       double r2 = 0.0;
       for (int c = 0; c < dim; ++c) r2 += (ps_.x(i, c) - ps_.x(k, c)) * (ps_.x(i, c) - ps_.x(k, c));
@@ -274,7 +272,7 @@ void FluidSystem::vci_setup() {
   kern.eval(1.5 * h_, W15, dW);
   for (int32_t i = 0; i < n_; ++i) {
     double blend = 1.0, S = 0.0, b[3] = {0, 0, 0};
-    for (int64_t q = rp_[i]; q < rp_[i + 1]; ++q) {
+    for (int64_t q = rb(i); q < re(i); ++q) {
       const int32_t k = cols_[q];
       if (k < n_ && dummy_.blend[k] < 1.0) {  // dummies count as complete
         double r2 = 0.0, W;
@@ -300,7 +298,7 @@ void FluidSystem::vci_correct(const double *pack, int per_point, double *a) cons
   for (int32_t i = 0; i < n_; ++i) {
     const double *xi = &dummy_.xi[static_cast<size_t>(i) * dim];
     double f[3] = {0, 0, 0}, lm = 0.0;
-    for (int64_t q = rp_[i]; q < rp_[i + 1]; ++q) {
+    for (int64_t q = rb(i); q < re(i); ++q) {
       const double *pk = pack + static_cast<size_t>(cols_[q]) * per_point;
       const double Ni = NT_[static_cast<size_t>(q) * (dim + 1)];
       for (int aa = 0; aa < dim; ++aa) {
@@ -350,7 +348,7 @@ void FluidSystem::velocity_smoothing(const double *v, const double *lumped, int 
     for (int64_t i = b; i < e; ++i) {
       double f[3] = {0, 0, 0};
       const double ci = std::sqrt(gk / rho0[i]);
-      for (int64_t q = rp_[i]; q < rp_[i + 1]; ++q) {
+      for (int64_t q = rb(i); q < re(i); ++q) {
         const int32_t j = cols_[q];
         if (j == i) continue;
         double r2 = 0.0;
