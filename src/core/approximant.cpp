@@ -13,11 +13,6 @@ namespace mfree {
 
 namespace {
 
-// Tables (values + gradients) above this size are written with streaming stores: they
-// do not fit the last-level cache of the machines we measure on (issue 8: 32 MiB shared
-// L3, 2 cores), so caching them would only cost a read of every line before its write.
-constexpr double kStreamTableBytes = 16.0 * 1024 * 1024;
-
 bool needs_volumes(int m) {
   return m == MFREE_METHOD_SPH || m == MFREE_METHOD_SPH_SYMMETRIC || m == MFREE_METHOD_RKPM ||
          m == MFREE_METHOD_SSPH || m == MFREE_METHOD_MSPH || m == MFREE_METHOD_JOHNSON_BEISSEL ||
@@ -298,9 +293,11 @@ void Approximant::build_pattern() {
   } else {
     nsites_ = ps_->num_owned();
   }
-  rowptr_.assign(static_cast<size_t>(nsites_) + 1, 0);
-  self_.assign(nsites_, -1);
-  status_.assign(nsites_, 0);
+  // every entry is written below (and status_ by compute), in parallel blocks
+  rowptr_.resize(static_cast<size_t>(nsites_) + 1);
+  rowptr_[0] = 0;
+  self_.resize(nsites_);
+  status_.resize(nsites_);
   const auto &pst = ps_->site_status();
   // The row of site s: its neighbours within the kernel's support (closed, kEdgeTol) in
   // the order of the neighbour list, the particle itself always (appended when a host
@@ -432,16 +429,28 @@ bool Approximant::share_rows(const Csr &src) {
   parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
     if (b >= e) return;
     std::copy(srp + b + 1, srp + e + 1, rp + b + 1);
-    std::copy(scl + srp[b], scl + srp[e], cl + srp[b]);
     int miss = 0;
     int64_t big = 0;
     for (int64_t s = b; s < e; ++s) {
-      const int32_t *r0 = scl + srp[s], *r1 = scl + srp[s + 1];
-      const int32_t *at = std::lower_bound(r0, r1, static_cast<int32_t>(s));
-      const bool found = at != r1 && *at == s;
-      self[s] = found ? static_cast<int32_t>(at - r0) : -1;
+      // the row copied, and the site's place in it (sorted) found as the count of smaller
+      // entries in the same pass (no branch to mispredict, unlike a binary search)
+      const int32_t *r0 = scl + srp[s];
+      int32_t *out = cl + srp[s];
+      const int n = static_cast<int>(srp[s + 1] - srp[s]);
+      const int32_t me = static_cast<int32_t>(s);
+      int at = 0;
+#ifdef _OPENMP
+#pragma omp simd reduction(+ : at)
+#endif
+      for (int q = 0; q < n; ++q) {
+        const int32_t v = r0[q];
+        out[q] = v;
+        at += v < me;
+      }
+      const bool found = at < n && r0[at] == me;
+      self[s] = found ? at : -1;
       miss += !found;
-      big = std::max<int64_t>(big, r1 - r0);
+      big = std::max<int64_t>(big, n);
     }
     if (miss) missing += miss;
     int cur = longest.load();
@@ -525,9 +534,6 @@ Report Approximant::compute(const char *what) {
   fs.order = order_used_.data();
   fs.pst = points_ ? nullptr : pst.data();
   fs.order_used = has_order(method_) ? order_ : fixed_order(method_);
-  // Tables larger than the last-level cache go out with streaming stores (no read of
-  // every destination line before it is written); smaller ones stay cached for apply.
-  fs.stream = static_cast<double>(val_.size() + grad_.size()) * sizeof(double) > kStreamTableBytes;
   bool periodic = false;
   for (int c = 0; c < dim; ++c) periodic = periodic || ps_->periodic(c);
   const bool gather = ps_->search_convention() == MFREE_SEARCH_GATHER;

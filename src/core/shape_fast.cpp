@@ -13,6 +13,7 @@
 #include "shape_fast.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <type_traits>
@@ -50,10 +51,10 @@
 #define MFREE_VEC4 1
 typedef double V4 __attribute__((vector_size(32)));
 // Lane shuffles of two V4 (indices 0-3: the first, 4-7: the second).
+typedef long long I4 __attribute__((vector_size(32)));
 #if defined(__clang__)
 #define MFREE_SHUF(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
 #else
-typedef long long I4 __attribute__((vector_size(32)));
 #define MFREE_SHUF(a, b, i, j, k, l) __builtin_shuffle(a, b, I4{i, j, k, l})
 #endif
 #else
@@ -100,11 +101,8 @@ void FastScratch::reserve(int maxrow) {
   if (need <= cap) return;
   cap = need;
   buf.assign(static_cast<size_t>(cap) * 10, 0.0);
-  // staging: a few hundred entries (values and up to 3 gradients: ~16 KB, in L1/L2), at
-  // least two rows
-  stage = std::max(512, 2 * cap);
-  sval.assign(static_cast<size_t>(stage), 0.0);
-  sgrad.assign(static_cast<size_t>(stage) * 3, 0.0);
+  sval.assign(static_cast<size_t>(cap), 0.0);
+  sgrad.assign(static_cast<size_t>(cap) * 3, 0.0);
 }
 
 FastPath::FastPath(int dim, int method, int order, const Kernel &kernel, int flags)

@@ -41,12 +41,10 @@ struct FastTables {
 
 // Per-thread scratch, sized for the longest row before the sites are computed: SoA
 // neighbour data (cap >= the longest row rounded up to whole groups of four), and a
-// staging area for the output rows of consecutive sites (stage entries of value and
-// dim gradients), written out in chunks (streaming stores for large tables).
+// staging area for one row of values and up to three gradients.
 struct FastScratch {
   HVec<double> buf, sval, sgrad;
   int cap = 0;
-  int stage = 0;
   void reserve(int maxrow);
   double *d(int c) { return buf.data() + static_cast<size_t>(c) * cap; }
   double *w() { return d(3); }
@@ -65,7 +63,6 @@ struct FastSites {
   double *cond = nullptr;
   const int32_t *pst = nullptr;  // particle status per site (nullptr at host points)
   int order_used = 0;            // reported for the sites done here
-  bool stream = false;           // write the tables with streaming (non-temporal) stores
 };
 
 class FastPath {
