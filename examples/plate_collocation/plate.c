@@ -1,26 +1,34 @@
 /* Plate with a circular hole by SSPH/MSPH collocation (paper 001 Sect. 6.3); see plate.h.
  *
  * Particle arrangement (the paper's Figs. 10, 11 and 13 are not available, spec 001
- * erratum 11): rings refined towards the hole, with locally square "cells".
+ * erratum 11): rings refined towards the hole.
  *  - Rays: for t in [0, 1], the straight line from the hole point
  *    H(t) = a (cos(pi t/2), sin(pi t/2)) to the point P(t) of the outer edges (x = b,
  *    then y = b) at the fraction t of their length; P(1/2) is the corner (b, b).
  *  - Rings: ring k is the curve H + s_k (P - H), t in [0, 1]. The fractions s_k grow
- *    geometrically, the first radial spacing on the axes being the spacing
- *    a dtheta = a pi / (2 (nt - 1)) of the nt particles on the quarter hole; with
- *    nr = plate_rings(a, b, nt) the rings grow like r_{k+1} = r_k (1 + dtheta) on the
- *    axes (conformal, square cells near the hole).
+ *    geometrically, the first radial spacing on the axes being radial_step times the
+ *    spacing a dtheta = a pi / (2 (nt - 1)) of the nt particles on the quarter hole,
+ *    with nr = plate_rings(a, b, nt) rings (with radial_step 1 they grow like
+ *    r_{k+1} = r_k (1 + dtheta) on the axes: square cells there). The default
+ *    radial_step 0.6 makes a radially refined layer at the hole, steeper grading
+ *    outwards: the rings' first gap is 1.46 times larger at 45 degrees than on the
+ *    axes, and with square cells on the axes the hole particles at 45 degrees
+ *    (h_i = 1.5 Delta_i set by the hole spacing) reach only one ring inwards, so the
+ *    normal curvature of the quadratic fits that their traction rows use comes from the
+ *    hole's own curvature; with 0.6 they reach two rings (t650 has the measurements:
+ *    SSPH below MSPH at every resolution only then).
  *  - Particles on ring k > 0: spaced along the ring like the rings are spaced across it
  *    (equal increments of the ring's arc length divided by the local ring spacing), with
  *    a particle on both ends and on t = 1/2, so the arrangement is symmetric about the
  *    diagonal and the corner (b, b) carries a particle. The number of particles per ring
  *    thus grows outwards ("coarser away from the hole" in the paper's words, yet with
- *    cells of aspect about 1 everywhere). A plain nt x nr tensor arrangement was tried
+ *    cells of aspect about 1 away from the hole). A plain nt x nr tensor arrangement was tried
  *    first: its cells get long and thin towards the outer edges, and with
  *    h_i = 1.5 Delta_i (Delta_i the nearest distance) some supports then hold only two
  *    lines of particles, on which a quadratic basis is singular (setup reports it).
- *  - With b = 10 a: nt = 11 gives 17 rings and 209 particles (the paper: 188 with 11 on
- *    the quarter hole), nt = 21 gives 31 rings and 677 particles (the paper: 686 with 21).
+ *  - With b = 10 a: nt = 11 gives 17 rings and 203 particles (the paper: 188 with 11 on
+ *    the quarter hole), nt = 21 gives 31 rings and 679 particles (the paper: 686 with 21);
+ *    with radial_step 1, 209 and 677.
  *
  * PLATE_LAYOUT_RAYS, the ruled arrangement that the paper's counts suggest (188 =
  * 11 x 17 + 1, 686 ~ 21 x 33; "coarser away from the hole"): nt straight rays from the
@@ -85,6 +93,7 @@ void plate_config_default(plate_config_t *cfg, int nt, int nr) {
   cfg->sigma0 = 1.0;
   cfg->kernel_param = 1.6;
   cfg->hfac = 1.5;
+  cfg->radial_step = 0.6;
   cfg->layout = PLATE_LAYOUT_RINGS;
   cfg->hole_corner = PLATE_CORNER_DIRICHLET;
   cfg->search = MFREE_SEARCH_GATHER;
@@ -244,6 +253,7 @@ int plate_particles(const plate_config_t *cfg, int *nout, double **xout, double 
   const int nt = cfg->nt, nr = cfg->nr, m0 = (nt - 1) / 2;
   const double a = cfg->a, b = cfg->b;
   if (nt < 3 || nt % 2 == 0 || nr < 3 || !(b > a && a > 0) || !(cfg->hfac > 0) ||
+      !(cfg->radial_step > 0 && cfg->radial_step <= 2) ||
       cfg->hole_corner < PLATE_CORNER_DIRICHLET || cfg->hole_corner > PLATE_CORNER_HOLE ||
       cfg->search < MFREE_SEARCH_GATHER || cfg->search > MFREE_SEARCH_SYMMETRIC_MEAN)
     return 1;
@@ -258,8 +268,8 @@ int plate_particles(const plate_config_t *cfg, int *nout, double **xout, double 
     free(s), free(gap), free(m), free(tk), free(cum);
     return 1;
   }
-  /* ring fractions: geometric, the first radial spacing on the axes = a dtheta */
-  const double d1 = a * kPi / (2.0 * (nt - 1));
+  /* ring fractions: geometric, the first radial spacing on the axes radial_step a dtheta */
+  const double d1 = cfg->radial_step * a * kPi / (2.0 * (nt - 1));
   const double g = grading(d1, nr - 1, b - a);
   s[0] = 0.0;
   for (int k = 1; k < nr; ++k) s[k] = s[k - 1] + d1 * pow(g, k - 1) / (b - a);
@@ -424,8 +434,8 @@ mfree_status_t plate_solve(mfree_context_t *ctx, const plate_config_t *cfg,
   if (plate_particles(cfg, &n, &x, &vol, &h, &tag))
     return mfree_context_set_error(ctx, MFREE_ERR_ARG,
                                    "plate: needs odd nt >= 3, nr >= 3, b > a > 0, hfac > 0, "
-                                   "a PLATE_LAYOUT_*, a PLATE_CORNER_* and an "
-                                   "MFREE_SEARCH_* value");
+                                   "0 < radial_step <= 2, a PLATE_LAYOUT_*, a PLATE_CORNER_* "
+                                   "and an MFREE_SEARCH_* value");
   const int neq = 2 * n;
   res->n = n;
   res->neq = neq;

@@ -46,6 +46,10 @@ typedef struct {
   double sigma0;          /* remote tension, 1 */
   double kernel_param;    /* revised super Gauss decay a = 1.6 */
   double hfac;            /* h_i = hfac * Delta_i, 1.5 */
+  double radial_step;     /* rings: the first radial step at the hole as a fraction of
+                             the spacing a dtheta of the particles on the hole, (0, 2]
+                             (0.6: a radially refined layer at the hole; 1: square
+                             cells on the axes; plate.c says why 0.6) */
   int layout;             /* PLATE_LAYOUT_* */
   int hole_corner;        /* PLATE_CORNER_* */
   int search;             /* pair support: MFREE_SEARCH_GATHER, W(x_i - x_j, h_i) with
@@ -95,9 +99,10 @@ typedef struct {
   int top;           /* the particle at (0, a) */
 } plate_result_t;
 
-/* Rings for nt particles on the quarter hole such that the rings grow like
- * r_{k+1} = r_k (1 + dtheta) on the axes, dtheta = pi / (2 (nt - 1)): locally square
- * cells near the hole. b = 10 a: nt = 11 -> 17 (209 particles), 21 -> 31 (677). */
+/* Rings for nt particles on the quarter hole such that with radial_step 1 the rings
+ * grow like r_{k+1} = r_k (1 + dtheta) on the axes, dtheta = pi / (2 (nt - 1)): square
+ * cells there. b = 10 a: nt = 11 -> 17 (203 particles with radial_step 0.6, 209 with 1),
+ * 21 -> 31 (679, 677). */
 int plate_rings(double a, double b, int nt);
 
 /* Particles on each ray of the ray layouts for nt rays: 1 + 8 (nt - 1)/5, the paper's
@@ -105,8 +110,9 @@ int plate_rings(double a, double b, int nt);
 int plate_ray_particles(int nt);
 
 /* Defaults of paper 001 Sect. 6.3 (a = 1, b = 10, SSPH, E = 1, nu = 0.25, sigma0 = 1,
- * revised super Gauss a = 1.6, h_i = 1.5 Delta_i, PLATE_LAYOUT_RINGS,
- * PLATE_CORNER_DIRICHLET, MFREE_SEARCH_GATHER) with nt particles on the hole and nr rings (nr <= 0:
+ * revised super Gauss a = 1.6, h_i = 1.5 Delta_i, PLATE_LAYOUT_RINGS with radial_step
+ * 0.6, PLATE_CORNER_DIRICHLET, MFREE_SEARCH_GATHER) with nt particles on the hole and nr
+ * rings (nr <= 0:
  * plate_rings(1, 10, nt); set it again after changing a or b). For the ray layouts set
  * layout and nr = plate_ray_particles(nt) afterwards. */
 void plate_config_default(plate_config_t *cfg, int nt, int nr);

@@ -11,20 +11,32 @@
  * interior particles (MFREE_FORM_COLLOCATION_PLANE_STRAIN); UMFPACK.
  *
  * The plate size. The paper does not give it (erratum 11). b = 10 a is used: with the
- * paper's 11 (21) particles on the quarter hole and rings growing like
- * r_{k+1} = r_k (1 + dtheta) (square cells near the hole) a plate of half-width 10 a
- * takes 209 (677) particles, close to the paper's 188 (686); the exact tractions make
- * any b admissible, so b only sets the resolution and the length of the x_2 axis over
- * which the error is integrated (from a to b). --width changes it.
+ * paper's 11 (21) particles on the quarter hole and 17 (31) rings, graded geometrically
+ * from a first radial step of 0.6 a dtheta at the hole (dtheta = pi / (2 (nt - 1)), the
+ * angular spacing on the hole), a plate of half-width 10 a takes 203 (679) particles,
+ * close to the paper's 188 (686); the exact tractions make any b admissible, so b only
+ * sets the resolution and the length of the x_2 axis over which the error is integrated
+ * (from a to b). --width changes it.
+ *
+ * The layer at the hole (--radial-step, default 0.6). The paper's Figs. 11 and 13 are
+ * missing; its text says only that the particles get coarser with the distance from the
+ * hole. The first radial step decides the paper's ordering SSPH <= MSPH: with 0.5-0.65
+ * of the hole spacing SSPH is below MSPH at every resolution (9 to 31 on the hole), plate
+ * size, corner rule, Dirichlet reading and pair support tried; with square cells at the
+ * hole (1, the earlier default) MSPH wins at the paper's resolutions. The rings' first
+ * gap is 1.46 times larger at 45 degrees than on the axes, so with square cells on the
+ * axes the hole particles at 45 degrees (h_i = 1.5 Delta_i set by the hole spacing)
+ * reach only one ring inwards and their one-sided quadratic fits, which the traction
+ * rows use, take the normal curvature from the hole's own curvature; with 0.6 they reach
+ * two rings. tests/collocation/t650 records the measurements.
  *
  * The arrangement (--layout): rings (default) or the ruled rays that the paper's counts
- * suggest (188 = 11 x 17 + 1, 686 ~ 21 x 33), which on b = 10 a also have square cells
- * along the axes and which cannot carry the quadratic basis with h_i = 1.5 Delta_i on
- * the smaller standard plate b = 5 a (plate.c explains why). The note printed under the
- * table records every arrangement measured; on none of them does SSPH beat MSPH at both
- * of the paper's resolutions, nor with the other readings of the paper's open choices
+ * suggest (188 = 11 x 17 + 1, 686 ~ 21 x 33), which on b = 10 a have square cells at the
+ * hole and which cannot carry the quadratic basis with h_i = 1.5 Delta_i on the smaller
+ * standard plate b = 5 a (plate.c explains why); on them SSPH stays above MSPH at the
+ * paper's resolutions, as on the square-cell rings, whatever the other open choices
  * (Dirichlet rows on the nodal unknowns, symmetric h_ij = (h_i + h_j)/2 via --search,
- * the corner rows; tests/collocation/t650 records the measurements).
+ * the corner rows).
  *
  * The hole radius (--radius) sets the scale only: at a fixed shape the error norm scales
  * exactly as a^(3/2) and the stress concentration not at all, so the paper's absolute
@@ -67,31 +79,25 @@ static const char *const kSearch[4] = {"", "gather", "max", "mean"}; /* by MFREE
 static const char kNote[] =
     "The paper's plate size, hole radius and particle arrangement are unknown (spec 001\n"
     "erratum 11): compare orderings and rates, not the absolute errors. e(u2) scales as\n"
-    "a^(3/2) with the hole radius a at a fixed shape (--radius 0.3 gives 0.031 / 0.012 and\n"
-    "0.0034 / 0.0025 on the default rings, the paper's magnitudes).\n"
-    "e(u2) SSPH / MSPH measured (default corner rows):\n"
-    "  rings, b = 10 (default): 209: 0.189 / 0.075   677: 0.0210 / 0.0150   1492: 0.0076 / 0.0103\n"
-    "  rings, b = 5:            142: 0.455 / 0.139   472: 0.0537 / 0.0111   1063: 0.0270 / 0.0092\n"
+    "a^(3/2) with the hole radius a at a fixed shape (--radius 0.3 gives 0.0153 / 0.0175\n"
+    "and 0.0020 / 0.0037 on the default rings, the paper's magnitudes).\n"
+    "The ordering SSPH <= MSPH comes with the radially refined layer at the hole\n"
+    "(--radial-step 0.5-0.65): then at every resolution from 9 to 31 on the hole, on\n"
+    "b = 5 ... 15, with every corner rule, Dirichlet reading and --search. Square cells at\n"
+    "the hole (--radial-step 1) reverse it at the paper's resolutions; e(u2) SSPH / MSPH:\n"
+    "  rings, radial step 1:    209: 0.189 / 0.075   677: 0.0210 / 0.0150   1492: 0.0076 / 0.0103\n"
     "  rays (the paper's 11 x 17, 21 x 33 ruled), b = 10:\n"
     "                           187: 0.149 / 0.131   693: 0.0487 / 0.0353   1519: 0.0236 / 0.0166\n"
     "  polar rays, b = 10:      187: 0.644 / 0.117   693: 0.0465 / 0.0384   1519: 0.0236 / 0.0205\n"
     "  rays or polar on the standard b = 5 (paper 000): singular supports with h = 1.5 Delta\n"
     "  (cells 4x longer across the rays than along them at the outer edges).\n"
-    "So SSPH <= MSPH (the paper's ordering) holds only on the rings from ~1500 particles\n"
-    "(and, with h = 1.7 Delta instead of the paper's 1.5, on the rays at 187 and 693).\n"
-    "Corner rows on the rings, 209 / 677: symmetry 0.079 / 0.081, 0.0208 / 0.0178;\n"
-    "hole 0.088 / 0.088, 0.0201 / 0.0206; on the rays SSPH stays above MSPH with all three.\n"
-    "SSPH's shape functions are not the cause: applied to the exact field their Navier\n"
-    "residual is below MSPH's (interior max 0.227 vs 0.266 at 209) and their boundary\n"
-    "gradients as good; the solve amplifies SSPH's error more. Dirichlet rows on the nodal\n"
-    "unknowns instead of the estimates change the errors by < 15 %; the norm with the nodal\n"
-    "values instead of the estimates by < 1 %. SSPH/MSPH at ~200 / ~700 particles, rings /\n"
-    "rays: nodal u rows 3.13 / 1.36, 0.87 / 1.37; --search mean 4.04 / 2.76, 0.95 / 1.07;\n"
-    "none of 36 combinations of u rows, pair support and corner rows on rings, rays and a\n"
-    "log-polar grid gives SSPH <= MSPH at both (tests/collocation/t650 has the table).\n";
+    "There (radial step 1, rays, log-polar) none of 36 combinations of Dirichlet rows on\n"
+    "nodal values or estimates, gather or symmetric h_ij and the three corner rules gives\n"
+    "SSPH <= MSPH at both resolutions; the norm with the nodal values instead of the\n"
+    "estimates differs by < 1 % (tests/collocation/t650 has the table).\n";
 
 typedef struct {
-  double b, a; /* half-width in hole radii; hole radius */
+  double b, a, step; /* half-width in hole radii; hole radius; first radial step */
   int layout, corner, search;
   int nres;
   int nt[NRES_MAX];
@@ -124,6 +130,10 @@ static int parse_args(int argc, char **argv, options_t *o, int *json) {
       char *end = NULL;
       o->a = strtod(argv[++i], &end);
       if (*end || !(o->a > 1e-6 && o->a < 1e6)) return 0;
+    } else if (strcmp(argv[i], "--radial-step") == 0 && i + 1 < argc) {
+      char *end = NULL;
+      o->step = strtod(argv[++i], &end);
+      if (*end || !(o->step > 0 && o->step <= 2)) return 0;
     } else if (strcmp(argv[i], "--search") == 0 && i + 1 < argc) {
       const char *v = argv[++i];
       if (strcmp(v, "gather") == 0) o->search = MFREE_SEARCH_GATHER;
@@ -214,7 +224,7 @@ int main(int argc, char **argv) {
   static const char usage[] =
       "usage: mfree_plate_collocation [--json] [--width B] [--radius A] [--hole N1,N2,...]\n"
       "       [--layout rings|rays|polar] [--corner dirichlet|symmetry|hole]\n"
-      "       [--search gather|mean|max] [--out DIR]\n"
+      "       [--radial-step F] [--search gather|mean|max] [--out DIR]\n"
       "Paper 001 Sect. 6.3: plate with a hole (Kirsch), SSPH and MSPH collocation, next to\n"
       "the paper's numbers. --width: plate half-width in hole radii (default 10);\n"
       "--radius: the hole radius (default 1; the error norm scales as radius^(3/2),\n"
@@ -223,10 +233,12 @@ int main(int argc, char **argv) {
       "--layout: the particle arrangement (default rings; rays and polar put\n"
       "1 + 8 (N - 1)/5 particles on each of N rays, the paper's 11 x 17 and 21 x 33);\n"
       "--corner: the rows at (a, 0) and (0, a) (default dirichlet, see plate.h);\n"
+      "--radial-step: rings' first radial step at the hole over the hole spacing, (0, 2]\n"
+      "(default 0.6; 1 gives square cells on the axes);\n"
       "--search: the pair support, gather W(x_i - x_j, h_i) (default, the paper's W_i)\n"
       "or symmetric h_ij = (h_i + h_j)/2 (mean) or max(h_i, h_j) (max);\n"
       "--out: write the profiles along the x2 axis to DIR/plate_collocation.dat.\n";
-  options_t opt = {10.0, 1.0, PLATE_LAYOUT_RINGS, PLATE_CORNER_DIRICHLET, MFREE_SEARCH_GATHER,
+  options_t opt = {10.0, 1.0, 0.6, PLATE_LAYOUT_RINGS, PLATE_CORNER_DIRICHLET, MFREE_SEARCH_GATHER,
                    3, {11, 21, 31}, NULL};
   int json = 0;
   const int pa = parse_args(argc, argv, &opt, &json);
@@ -254,6 +266,7 @@ int main(int argc, char **argv) {
     cfg[k].layout = opt.layout;
     cfg[k].hole_corner = opt.corner;
     cfg[k].search = opt.search;
+    cfg[k].radial_step = opt.step;
     cfg[k].nr = opt.layout == PLATE_LAYOUT_RINGS ? plate_rings(cfg[k].a, cfg[k].b, opt.nt[k])
                                                  : plate_ray_particles(opt.nt[k]);
     for (int m = 0; m < NM && !status; ++m) {
@@ -275,11 +288,11 @@ int main(int argc, char **argv) {
     printf("{\"problem\":{\"a\":%.6g,\"b\":%.6g,\"E\":%.6g,\"nu\":%.6g,\"sigma0\":%.6g,"
            "\"kernel\":\"revised super Gauss\",\"kernel_a\":%.6g,\"hfac\":%.6g,\"order\":2,"
            "\"plane\":\"strain\",\"solver\":\"UMFPACK\",\"layout\":\"%s\",\"corner\":\"%s\","
-           "\"search\":\"%s\"},"
+           "\"search\":\"%s\",\"radial_step\":%.6g},"
            "\"runs\":[",
            cfg[0].a, cfg[0].b, cfg[0].young, cfg[0].poisson, cfg[0].sigma0,
            cfg[0].kernel_param, cfg[0].hfac, kLayout[opt.layout], kCorner[opt.corner],
-           kSearch[opt.search]);
+           kSearch[opt.search], cfg[0].radial_step);
     for (int k = 0; k < opt.nres; ++k) {
       printf("%s{\"hole\":%d,\"rings\":%d,\"particles\":%d,\"equations\":%d", k ? "," : "",
              cfg[k].nt, cfg[k].nr, res[k][0].n, res[k][0].neq);
@@ -301,11 +314,12 @@ int main(int argc, char **argv) {
            "Quarter plate [0,%g]^2 minus the hole r < %g; E = %g, nu = %g, plane strain,\n"
            "sigma0 = %g; revised super Gauss a = %g, quadratic basis, h_i = %g Delta_i;\n"
            "UMFPACK. e(u2) = sqrt(int_a^b (u2^h - u2)^2 dx2) on x1 = 0; SCF = s11(0,a)/s0\n"
-           "from the solution (interp: from the exact displacements). Particles: %s,\n"
-           "corner rows: %s, pair support: %s.\n\n",
+           "from the solution (interp: from the exact displacements). Particles: %s\n"
+           "(rings: first radial step %g of the hole spacing), corner rows: %s, pair\n"
+           "support: %s.\n\n",
            cfg[0].b, cfg[0].a, cfg[0].young, cfg[0].poisson, cfg[0].sigma0,
-           cfg[0].kernel_param, cfg[0].hfac, kLayout[opt.layout], kCorner[opt.corner],
-           kSearch[opt.search]);
+           cfg[0].kernel_param, cfg[0].hfac, kLayout[opt.layout], cfg[0].radial_step,
+           kCorner[opt.corner], kSearch[opt.search]);
     printf("%9s %5s %5s %6s  %-6s %10s %10s %8s %7s %7s %8s %8s\n", "particles", "hole",
            opt.layout == PLATE_LAYOUT_RINGS ? "rings" : "onray", "eqs", "method", "e(u2)", "paper", "rel", "SCF", "interp", "setup s",
            "solve s");
