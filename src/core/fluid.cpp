@@ -394,7 +394,7 @@ void FluidSystem::color_chunks() {
 // number tried). Hence the default threshold 100 (mfree_system_set_shepard_condition).
 template <int D>
 void FluidSystem::shepard_row(int n, const double *w, const double *gf, double *const *s, double ih,
-                              bool volumes, const int64_t *js, double *Nk, double *Gk) const {
+                              bool volumes, const int32_t *js, double *Nk, double *Gk) const {
   double S = 0.0, dS[D] = {};
   for (int m = 0; m < n; ++m) {
     const double V = volumes ? vol_[js[m]] : 1.0;
@@ -427,7 +427,7 @@ namespace {
 // move pairs at exactly 2h in or out of the rows depending on the CPU.
 template <int D>
 FLUID_NOINLINE int kept_candidates(const double *xn, int64_t k, const int32_t *cc, int64_t nc, double R2, double ih,
-                                   double *const *s, int64_t *js) {
+                                   double *const *s, int32_t *js) {
   const double *xk = xn + k * D;
   int q = 0;
   for (int64_t e = 0; e < nc; ++e) {
@@ -445,12 +445,88 @@ FLUID_NOINLINE int kept_candidates(const double *xn, int64_t k, const int32_t *c
   return q;
 }
 
+#if MFREE_SIMD_X86
+// kept_candidates four candidates at a time (AVX2 gathers, left-packed stores through a
+// permutation table): the same differences, products and sums, so the same rows and
+// offsets; the products are kept from FMA contraction by an empty asm.
+struct PackTable {
+  int32_t d[16][8];  // mask -> 32-bit lane indices moving the kept doubles to the front
+  int32_t i[16][8];  // mask -> lane indices moving the kept 32-bit columns to the front
+};
+constexpr PackTable make_pack_table() {
+  PackTable t{};
+  for (int m = 0; m < 16; ++m) {
+    int q = 0;
+    for (int l = 0; l < 4; ++l)
+      if (m >> l & 1) {
+        t.d[m][2 * q] = 2 * l;
+        t.d[m][2 * q + 1] = 2 * l + 1;
+        t.i[m][q] = l;
+        ++q;
+      }
+  }
+  return t;
+}
+constexpr PackTable kPack = make_pack_table();
+
+template <int D>
+MFREE_TARGET_AVX2 FLUID_NOINLINE int kept_candidates_avx2(const double *xn, int64_t k, const int32_t *cc, int64_t nc,
+                                                          double R2, double ih, double *const *s, int32_t *js) {
+  const double *xk = xn + k * D;
+  __m256d xkv[D];
+  for (int c = 0; c < D; ++c) xkv[c] = _mm256_set1_pd(xk[c]);
+  const __m256d r2v = _mm256_set1_pd(R2), ihv = _mm256_set1_pd(ih);
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  int q = 0;
+  int64_t e = 0;
+  for (; e + 4 <= nc; e += 4) {
+    const __m128i j4 = _mm_loadu_si128(reinterpret_cast<const __m128i *>(cc + e));
+    const __m128i idx = D == 2 ? _mm_slli_epi32(j4, 1) : _mm_add_epi32(_mm_slli_epi32(j4, 1), j4);  // j * D
+    __m256d d[D], p[D];
+    for (int c = 0; c < D; ++c) {
+      // the masked form: the plain one trips GCC 12's -Wmaybe-uninitialized
+      const __m256d xj = _mm256_mask_i32gather_pd(_mm256_setzero_pd(), xn + c, idx, all, 8);
+      d[c] = _mm256_sub_pd(xj, xkv[c]);
+      p[c] = _mm256_mul_pd(d[c], d[c]);
+      __asm__("" : "+x"(p[c]));  // r2 = (d0 d0 + d1 d1) + d2 d2, rounded as the scalar loop
+    }
+    __m256d r2 = p[0];
+    for (int c = 1; c < D; ++c) r2 = _mm256_add_pd(r2, p[c]);
+    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(r2, r2v, _CMP_LT_OQ));
+    const __m256i pd = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.d[mask]));
+    for (int c = 0; c < D; ++c) {
+      const __m256d sc = _mm256_mul_pd(d[c], ihv);
+      _mm256_storeu_pd(s[c] + q, _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(sc), pd)));
+    }
+    const __m256i pi = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.i[mask]));
+    const __m256i jp = _mm256_permutevar8x32_epi32(_mm256_zextsi128_si256(j4), pi);
+    _mm_storeu_si128(reinterpret_cast<__m128i *>(js + q), _mm256_castsi256_si128(jp));
+    q += __builtin_popcount(static_cast<unsigned>(mask));
+  }
+  for (; e < nc; ++e) {
+    const int32_t j = cc[e];
+    const double *xj = xn + static_cast<size_t>(j) * D;
+    double r2 = 0.0;
+    for (int c = 0; c < D; ++c) {
+      const double dc = xj[c] - xk[c];
+      double pc = dc * dc;
+      __asm__("" : "+x"(pc));
+      r2 += pc;
+      s[c][q] = dc * ih;
+    }
+    js[q] = j;
+    q += r2 < R2;
+  }
+  _mm256_zeroupper();
+  return q;
+}
+#endif
+
 }  // namespace
 
 template <int D>
 MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch,
-                                                     int64_t *iscratch, bool transpose, const AccelArgs *fused,
-                                                     bool wide) {
+                                                     int64_t *iscratch, bool transpose, bool wide) {
   (void)wide;
   constexpr int L = D + 1;
   const double ih = 1.0 / h_, tol = shepard_cond_, R2 = 4.0 * h_ * h_;
@@ -466,10 +542,12 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
     double *Nk = N_.data() + o, *Gk = G_.data() + o * D;
     // the row's neighbours in structure-of-arrays scratch: scaled offsets s = (x_j - x) / h,
     // weights w = f(|s|) and gf = -f'(|s|) / |s|, so that grad_x w_j = gf s / h; the
-    // columns and transposed candidates.
+    // transposed candidates; the columns go straight to the row's place in cols_ (the
+    // candidates out of range land on entries of later rows of the chunk, or unused ones).
     double *s[D], *w = scratch + D * static_cast<size_t>(maxrow_), *gf = w + maxrow_;
     for (int c = 0; c < D; ++c) s[c] = scratch + c * static_cast<size_t>(maxrow_);
-    int64_t *js = iscratch, *ts = iscratch + maxrow_;
+    int32_t *js = cols_.data() + o;
+    int64_t *ts = iscratch;
     int n = 0;
     if (transpose) {  // the rows' ends and positions come from prepare's filter
       for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
@@ -480,11 +558,17 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
         n += cpos[e] >= 0;
       }
     } else {
+#if MFREE_SIMD_X86
+      if (wide) n = kept_candidates_avx2<D>(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, ih, s, js);
+      else n = kept_candidates<D>(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, ih, s, js);
+#else
       n = kept_candidates<D>(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, ih, s, js);
+#endif
       rbeg[k] = o;
       rend[k] = o + n;
     }
     const double *s0 = s[0], *s1 = s[1], *s2 = s[D - 1];
+    FLUID_SIMD()
     for (int m = 0; m < n; ++m) w[m] = s0[m] * s0[m] + s1[m] * s1[m] + (D == 3 ? s2[m] * s2[m] : 0.0);
 #if MFREE_SIMD_X86
     if (wide) sqrt_n_avx2(w, n);  // |x_j - x| / h < 2
@@ -601,13 +685,10 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
     } else {
       shepard_row<D>(n, w, gf, s, ih, mls, js, Nk, Gk);
     }
-    // columns, and the transposed copy: N_k(x_j) is entry (j, k) of the transpose
-    int32_t *ck = cols_.data() + o;
-    for (int m = 0; m < n; ++m) ck[m] = static_cast<int32_t>(js[m]);
-    if (fused) accel_point<D>(k, *fused);
+    // the transposed copy: N_k(x_j) is entry (j, k) of the transpose
     if (!transpose) continue;
     for (int m = 0; m < n; ++m) {
-      const int32_t j = static_cast<int32_t>(js[m]);
+      const int32_t j = js[m];
       const int64_t t = ts[m];
       if (t < 0 || cpos[t] < 0) {
         one_way = true;
@@ -623,19 +704,19 @@ MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, co
 
 template <int D>
 bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
-                             bool transpose, const AccelArgs *fused) {
-  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, fused, false);
+                             bool transpose) {
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, false);
 }
 
 #if MFREE_SIMD_X86
 template <int D>
 MFREE_TARGET_AVX2 bool FluidSystem::table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch,
-                                                    int64_t *iscratch, bool transpose, const AccelArgs *fused) {
-  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, fused, true);
+                                                    int64_t *iscratch, bool transpose) {
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, true);
 }
 #endif
 
-Report FluidSystem::prepare(const double *y, double *accel_out, Report *accel_rep) {
+Report FluidSystem::prepare(const double *y) {
   check_ready();
   Report rep = check_state(y, -1);
   if (!rep.ok()) return rep;
@@ -686,46 +767,26 @@ Report FluidSystem::prepare(const double *y, double *accel_out, Report *accel_re
     if (dim == 2) filter(std::integral_constant<int, 2>());
     else filter(std::integral_constant<int, 3>());
   }
-  const size_t per_thread = static_cast<size_t>(dim + 2) * maxrow_, iper_thread = 2 * static_cast<size_t>(maxrow_);
+  const size_t per_thread = static_cast<size_t>(dim + 2) * maxrow_, iper_thread = static_cast<size_t>(maxrow_);
   if (rows_scratch_.size() < per_thread * nt) rows_scratch_.resize(per_thread * nt);
   if (rows_iscratch_.size() < iper_thread * nt) rows_iscratch_.resize(iper_thread * nt);
-  // the forces are summed as each row is finished (accel_point) unless an option needs
-  // all the tables first: the dummies' densities and shares, the VCI corrections
-  const bool fuse = accel_out && !dummy_.n && !vci_;
-  AccelArgs aa{};
-  if (fuse) aa = accel_args(y + nd, rho);
   bool one_way[64] = {};  // parallel_blocks runs at most 64 threads
   const bool avx2 = simd::use_avx2();  // once per step: every thread runs the same copy
   (void)avx2;
   auto rows = [&](int t, int32_t k0, int32_t k1) {
     double *scratch = rows_scratch_.data() + per_thread * t;
     int64_t *iscratch = rows_iscratch_.data() + iper_thread * t;
-    const AccelArgs *fa = fuse ? &aa : nullptr;
 #if MFREE_SIMD_X86
     if (avx2)
-      return dim == 2 ? table_rows_avx2<2>(k0, k1, xn, scratch, iscratch, transpose, fa)
-                      : table_rows_avx2<3>(k0, k1, xn, scratch, iscratch, transpose, fa);
+      return dim == 2 ? table_rows_avx2<2>(k0, k1, xn, scratch, iscratch, transpose)
+                      : table_rows_avx2<3>(k0, k1, xn, scratch, iscratch, transpose);
 #endif
-    return dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch, transpose, fa)
-                    : table_rows<3>(k0, k1, xn, scratch, iscratch, transpose, fa);
+    return dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch, transpose)
+                    : table_rows<3>(k0, k1, xn, scratch, iscratch, transpose);
   };
-  if (fuse) {
-    // in accel's order: the chunks of a colour in parallel, the colours in turn
-    const int nts = scatter_threads_ ? nt : 1;
-    for (size_t col = 0; col + 1 < color_ptr_.size(); ++col) {
-      const int32_t *chunks = chunk_order_.data() + color_ptr_[col];
-      parallel_blocks(color_ptr_[col + 1] - color_ptr_[col], nts, [&](int t, int64_t b, int64_t e) {
-        for (int64_t c = b; c < e; ++c) {
-          const int32_t k0 = chunks[c] * kChunk, k1 = std::min(nall, k0 + kChunk);
-          one_way[t] = rows(t, k0, k1) || one_way[t];
-        }
-      });
-    }
-  } else {
-    parallel_blocks(nchunk, nt, [&](int t, int64_t b, int64_t e) {
-      one_way[t] = rows(t, static_cast<int32_t>(b * kChunk), static_cast<int32_t>(std::min<int64_t>(nall, e * kChunk)));
-    });
-  }
+  parallel_blocks(nchunk, nt, [&](int t, int64_t b, int64_t e) {
+    one_way[t] = rows(t, static_cast<int32_t>(b * kChunk), static_cast<int32_t>(std::min<int64_t>(nall, e * kChunk)));
+  });
   if (std::any_of(one_way, one_way + 64, [](bool f) { return f; })) {
     // cannot happen with lists from one search radius; a failure rather than a wrong sum
     rep.fail(MFREE_FAIL_NEIGHBORS, "the neighbour lists of the fluid are not symmetric");
@@ -734,12 +795,6 @@ Report FluidSystem::prepare(const double *y, double *accel_out, Report *accel_re
   }
   fluid_share();
   vci_setup();  // optional, fluid_wall.cpp
-  if (accel_out) {
-    Report ar;
-    if (fuse) ar = dim == 2 ? accel_end<2>(aa, accel_out) : accel_end<3>(aa, accel_out);
-    else ar = accel(y + nd, rho, accel_out);
-    if (accel_rep) *accel_rep = ar;
-  }
   return rep;
 }
 
@@ -803,10 +858,9 @@ FluidSystem::AccelArgs FluidSystem::accel_args(const double *v, const double *rh
 }
 
 // Point k of accel: the stress (times V_k), interpolated velocity and wall force at x_k,
-// and the row's terms scattered to its nodes. Not inlined, so that the row kernel's AVX2
-// copy (which calls it when fused) and accel run the same code: same results.
+// and the row's terms scattered to its nodes.
 template <int D>
-FLUID_NOINLINE void FluidSystem::accel_point(int64_t k, const AccelArgs &arg) {
+void FluidSystem::accel_point(int64_t k, const AccelArgs &arg) {
   constexpr int P = D * D + 2 + D;  // pack_ per point: sigma V (D x D), M, lumping mass, wall force
   constexpr int A = 2 * D + 2;      // acc_ per node: force, mass sum_k N M, lumped mass, wall force
   const double *v = arg.v, *rho = arg.rho, *rho0 = arg.rho0, *mass = arg.mass;
@@ -886,6 +940,18 @@ FLUID_NOINLINE void FluidSystem::accel_point(int64_t k, const AccelArgs &arg) {
     for (int c = 0; c < D; ++c) pk[D * D + 2 + c] = F[c];
   }
   // the row's terms to its nodes i: -sigma_k V_k grad N_i(x_k), N_i(x_k) M_k (003 eq 56)
+#ifdef __SSE2__
+  if constexpr (D == 2) {  // the same operations in the same order, two lanes at a time
+    const __m128d s0 = _mm_setr_pd(S[0][0], S[1][0]), s1 = _mm_setr_pd(S[0][1], S[1][1]);
+    const __m128d ml = _mm_setr_pd(Mk, Lk);
+    for (int64_t q = q0; q < q1; ++q) {
+      double *ai = acc + static_cast<size_t>(cols[q]) * A;
+      const __m128d sg = _mm_add_pd(_mm_mul_pd(s0, _mm_set1_pd(G[2 * q])), _mm_mul_pd(s1, _mm_set1_pd(G[2 * q + 1])));
+      _mm_storeu_pd(ai, _mm_sub_pd(_mm_loadu_pd(ai), sg));
+      _mm_storeu_pd(ai + 2, _mm_add_pd(_mm_loadu_pd(ai + 2), _mm_mul_pd(_mm_set1_pd(N[q]), ml)));
+    }
+  } else
+#endif
   for (int64_t q = q0; q < q1; ++q) {
     double *ai = acc + static_cast<size_t>(cols[q]) * A;
     const double *gi = G + q * D, Ni = N[q];
@@ -966,13 +1032,13 @@ Report FluidSystem::accel(const double *v, const double *rho, double *a) {
 
 Report FluidSystem::rhs(double t, const double *y, double *ydot) {
   (void)t;
-  const size_t nd = static_cast<size_t>(dim_) * n_;
-  Report arep;
-  Report rep = prepare(y, ydot + nd, &arep);  // and accel
+  Report rep = prepare(y);
   if (!rep.ok()) return rep;
+  const size_t nd = static_cast<size_t>(dim_) * n_;
   const double *v = y + nd, *rho = y + 2 * nd;
+  rep = accel(v, rho, ydot + nd);
   kinematics(v, rho, ydot, ydot + 2 * nd);
-  return arep;
+  return rep;
 }
 
 Report FluidSystem::velocity(const double *y, double *vhat) {
@@ -1108,9 +1174,7 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
   dr_.resize(n_);
   double *rate = rate_.data(), *vh = vh_.data(), *dr = dr_.data();
   while (t < t_end) {
-    // leap-frog: the tables at y and the accelerations (003 Sect. 6.1) in one pass
-    Report arep;
-    rep = prepare(y, scheme == MFREE_INTEGRATOR_LEAPFROG ? rate + nd : nullptr, &arep);
+    rep = prepare(y);
     if (!rep.ok()) {
       rep.message = "step " + std::to_string(nsteps) + ": " + rep.message;
       return rep;
@@ -1128,13 +1192,13 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
     double *yn = work_state_.data();
     const double *x = y, *v = y + nd, *rho = y + 2 * nd;
     if (scheme == MFREE_INTEGRATOR_LEAPFROG) {
-      // 003 Sect. 6.1: a from (x^k, rho^k, v^{k-1/2}) (prepare); v^{k+1/2} = v + dt a;
-      // density rates and interpolated velocities with v^{k+1/2} on the tables at x^k
-      if (!arep.ok()) return arep;
-      const double *acc = rate + nd;
+      // 003 Sect. 6.1: a from (x^k, rho^k, v^{k-1/2}); v^{k+1/2} = v + dt a; density rates
+      // and interpolated velocities with v^{k+1/2} on the tables at x^k
+      Report r = accel(v, rho, rate);
+      if (!r.ok()) return r;
       const int nt = light_threads(n_);
       parallel_blocks(static_cast<int64_t>(nd), nt, [&](int, int64_t b, int64_t e) {
-        for (int64_t q = b; q < e; ++q) yn[nd + q] = v[q] + dt * acc[q];
+        for (int64_t q = b; q < e; ++q) yn[nd + q] = v[q] + dt * rate[q];
       });
       kinematics(yn + nd, rho, vh, dr);
       parallel_blocks(n_, nt, [&](int, int64_t b, int64_t e) {
@@ -1147,13 +1211,13 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
       if (!r.ok()) return r;
       double *yp = stage_.data();
       for (size_t q = 0; q < ny; ++q) yp[q] = y[q] + 0.5 * dt * rate[q];
-      Report ar;
-      r = prepare(yp, rate, &ar);  // and accel (into the first nd rates, as read below)
+      r = prepare(yp);
       if (!r.ok()) {
         r.message = "step " + std::to_string(nsteps) + " (predictor): " + r.message;
         return r;
       }
-      if (!ar.ok()) return ar;
+      r = accel(yp + nd, yp + 2 * nd, rate);
+      if (!r.ok()) return r;
       for (size_t q = 0; q < nd; ++q) yn[nd + q] = v[q] + 0.5 * dt * rate[q];  // v^C
       kinematics(yn + nd, yp + 2 * nd, vh, dr);
       for (int32_t i = 0; i < n_; ++i) yn[2 * nd + i] = rho[i] + 0.5 * dt * dr[i];  // rho^C

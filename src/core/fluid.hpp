@@ -51,34 +51,29 @@ class FluidSystem : public System {
 
  private:
   void check_ready() const;
-  // Validate the state and build the shape-function tables at the nodes (below). With
-  // a, also accel(v, rho, a) of y's velocities and densities, its report in *arep (fused
-  // into the table rows where no option needs the finished tables first: same results).
-  Report prepare(const double *y, double *a = nullptr, Report *arep = nullptr);
+  // Validate the state and build the shape-function tables at the nodes (below).
+  Report prepare(const double *y);
   // Candidate neighbour lists (Verlet lists with a skin, see tables_) for the node
   // positions xn, rebuilt when a node moved more than half the skin since the last build.
   Report candidates(const double *xn);
   // Tables rows [k0, k1): linear MLS at the nodes, Shepard rows where ill-conditioned;
   // with transpose, also NT_ (true if a pair is in one node's row only, which the search
-  // rules out); with fused, accel_point(k) after each row k.
+  // rules out). k0 starts a chunk of kChunk rows (see rb_).
   // table_rows_avx2 is the same code compiled for AVX2 + FMA (simd.hpp), chosen per step.
-  struct AccelArgs;
   template <int D>
-  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
-                  const AccelArgs *fused);
+  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
   template <int D>
-  bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
-                       const AccelArgs *fused);
+  bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
   template <int D>
   bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
-                       const AccelArgs *fused, bool wide);  // wide: the AVX2 copy (256-bit sqrt)
+                       bool wide);  // wide: the AVX2 copy (gathers, 256-bit sqrt)
   // Chunks of kChunk rows coloured so that no two chunks of a colour touch a common
   // node (on the candidate pattern), for the scatter of accel (rebuilt with the lists).
   void color_chunks();
   void transposed_candidates();  // ctrans_, only for NT_ (consistent integration)
   template <int D>
   void shepard_row(int n, const double *w, const double *gf, double *const *s, double ih, bool volumes,
-                   const int64_t *js, double *Nk, double *Gk) const;
+                   const int32_t *js, double *Nk, double *Gk) const;
   // Acceleration parameters a (dim per particle) from the prepared tables and v, rho:
   // accel_args (node arrays, zeroed sums), accel_point for every row in colour order
   // (chunk_order_), accel_end (the nodes' accelerations).
@@ -163,7 +158,7 @@ class FluidSystem : public System {
   int64_t rebuilds_ = 0;
   int64_t maxrow_ = 0;               // longest candidate row
   std::vector<double> rows_scratch_;  // (dim + 2) maxrow_ per thread
-  std::vector<int64_t> rows_iscratch_;  // 2 maxrow_ per thread
+  std::vector<int64_t> rows_iscratch_;  // maxrow_ per thread (transposed candidates)
   Csr wall_nbr_;
   // per node (reused): packed quadrature-point data of accel; integrate's states and rates
   std::vector<double> pack_, work_state_, stage_, rate_, vh_, dr_;
