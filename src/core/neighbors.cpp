@@ -90,6 +90,9 @@ class CellGrid {
   double rmax() const { return rmax_; }
   double radius(int32_t j) const { return rad_[j]; }
   bool uniform() const { return uniform_; }
+  // Expected row length (particles per support ball at the mean density of the grid's
+  // box): sizes the first search's row buffers.
+  double expected_hits() const { return hits_; }
   int64_t num_cells() const { return ncells_; }
 
   // Wrap a coordinate into the periodic box along periodic axes.
@@ -156,6 +159,7 @@ class CellGrid {
   bool any_periodic_ = false;
   bool uniform_ = true;  // one search radius for every valid particle
   double rmax_ = 0.0;
+  double hits_ = 0.0;
   int32_t nvalid_ = 0;
   Buf<double> rad_;              // by host index
   Buf<double> sx_[3], srad_;     // by cell order, one padding entry at the end
@@ -180,6 +184,7 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
     margin_[c] = 0.0;
   }
   rmax_ = 0.0;
+  hits_ = 0.0;
   nvalid_ = 0;
   uniform_ = true;
   ncells_ = 1;
@@ -278,6 +283,16 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   }
   ncells_ = 1;
   for (int c = 0; c < dim_; ++c) ncells_ *= nc_[c];
+  {
+    // expected row length if the particles filled the grid's box evenly
+    const double r = rsum / static_cast<double>(nvalid_);
+    double box = 1.0;
+    for (int c = 0; c < dim_; ++c) box *= static_cast<double>(nc_[c]) * cell_[c];
+    const double pi = 3.141592653589793;
+    const double ball = dim_ == 1 ? 2.0 * r : (dim_ == 2 ? pi * r * r : 4.0 / 3.0 * pi * r * r * r);
+    const double est = static_cast<double>(nvalid_) * ball / box;
+    hits_ = std::isfinite(est) ? std::min(est, static_cast<double>(nvalid_)) : 0.0;
+  }
   // A particle's cell index floor((x - lo) / cell) may be off by one for x within a few
   // ulps of a cell face; 1e-10 of the grid's scale covers that with room to spare.
   for (int c = 0; c < dim_; ++c)
@@ -573,10 +588,6 @@ inline void row_min_max(const int32_t *b, const int32_t *e, int32_t init_min, in
   mm[1] = z;
 }
 
-struct Slot {
-  int64_t next, end;
-};
-
 }  // namespace
 
 // Buffers of a search, kept by a particle set between searches (sizes settle after the
@@ -588,7 +599,6 @@ struct NeighborScratch {
   Buf<int64_t> first, rowptr;
   Buf<int32_t> lo_hi;
   Buf<const int32_t *> src;
-  Buf<Slot> slot;
 };
 
 NeighborScratch *new_neighbor_scratch() { return new NeighborScratch; }
@@ -634,8 +644,15 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
   for_chunks(nt, [&](int t) {
     int64_t b, e;
     thread_block(nq, t, nt, b, e);
+    // Room for the expected rows with a margin (growing it copies what was found so far
+    // and touches twice the pages: a first search in 3D grew it once). Untouched
+    // capacity costs no memory traffic.
     RowBuf &cols = sc.buf[t];
-    if (cols.size() < static_cast<size_t>((e - b) * 32 + 64)) cols.resize(static_cast<size_t>((e - b) * 32 + 64));
+    const size_t room = static_cast<size_t>(e - b) * static_cast<size_t>(1.25 * grid.expected_hits() + 8.0) + 64;
+    if (cols.size() < room) {
+      cols.clear();  // (the old contents need no copy)
+      cols.resize(room);
+    }
     size_t cnt = 0;
     // The minimum and maximum of a row are taken one query later: the row was just
     // written entry by entry, and reading it back in 16-byte loads at once would stall
@@ -679,11 +696,11 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
   });
   for (int32_t s = 0; s < nsites; ++s) rp[s + 1] += rp[s];
   const int64_t nnz = rp[nsites];
-  if (symmetric) sc.slot.resize(static_cast<size_t>(nsites));
   out.rowptr.reserve(static_cast<size_t>(nsites) + 1);
   out.cols.reserve(static_cast<size_t>(nnz));
   // nothing below allocates
-  out.rowptr.assign(rp, rp + nsites + 1);
+  if (!symmetric) out.rowptr.assign(rp, rp + nsites + 1);
+  else out.rowptr.resize(static_cast<size_t>(nsites) + 1);
   out.cols.resize(static_cast<size_t>(nnz));
   auto place = [&]() {
     for_chunks(nt, [&](int t) {
@@ -701,18 +718,22 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
     place();
     return;
   }
-  // Transpose. slot[j] = {next free position of row j, end of row j}; a source that
-  // would overfill a row or leave one short (an asymmetric pair, which the conditions
-  // above exclude: a safety net, not a proof) sets `bad`, and the rows are then placed
-  // and sorted instead.
-  Slot *sl = sc.slot.data();
+  // Transpose. cur[j] = out.rowptr[j + 1] is the next free position of row j, from rp[j]
+  // on; a complete row leaves it at its end rp[j + 1], which is what out.rowptr must
+  // hold (the CSR transposition's shifted row pointers: no separate cursor array, no
+  // copy). A source that would overfill a row or leave one short (an asymmetric pair,
+  // which the conditions above exclude: a safety net, not a proof) leaves some cursor
+  // off its end; the rows are then placed and sorted instead. Writes stay inside the
+  // thread's own rows [rp[jb], rp[je]) whatever happens.
+  int64_t *cur = out.rowptr.data() + 1;
+  out.rowptr[0] = 0;
   const int ntt = num_threads(nsites) < nt ? num_threads(nsites) : nt;
   char bad[64] = {0};
   for_chunks(ntt, [&](int t) {
     int64_t jb, je;
     thread_block(nsites, t, ntt, jb, je);
     if (jb >= je) return;
-    for (int64_t j = jb; j < je; ++j) sl[j] = Slot{rp[j], rp[j + 1]};
+    for (int64_t j = jb; j < je; ++j) cur[j] = rp[j];
     // sources that reach rows [jb, je): by symmetry, the members of those rows
     int64_t imin = 0, imax = nsites - 1;
     if (ntt > 1) {
@@ -727,23 +748,24 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
     int32_t *cols = out.cols.data();
     const uint64_t span = static_cast<uint64_t>(je - jb);
     const bool all = jb == 0 && je == nsites;
-    bool over = false;
+    const int64_t lim = rp[je];
     for (int64_t i = imin; i <= imax; ++i) {
       const int32_t *r = src[i];
       const int64_t len = rp[i + 1] - rp[i];
       for (int64_t k = 0; k < len; ++k) {
         const int64_t j = r[k];
         if (!all && static_cast<uint64_t>(j - jb) >= span) continue;
-        Slot &q = sl[j];
-        if (q.next < q.end) cols[q.next++] = static_cast<int32_t>(i);
-        else over = true;
+        const int64_t c = cur[j]++;
+        if (c < lim) cols[c] = static_cast<int32_t>(i);
       }
     }
-    for (int64_t j = jb; j < je; ++j) over = over || sl[j].next != sl[j].end;
+    bool over = false;
+    for (int64_t j = jb; j < je; ++j) over = over || cur[j] != rp[j + 1];
     bad[t] = over;
   });
   for (int t = 0; t < ntt; ++t)
     if (bad[t]) {
+      out.rowptr.assign(rp, rp + nsites + 1);  // same size: no allocation
       place();
       return;
     }
