@@ -20,10 +20,10 @@
  * 0.47-0.59 at ~700); radial_step 0.5 and 0.55 behave alike. With square cells at the
  * hole (radial_step 1, the default until this recheck) MSPH wins at the paper's
  * resolutions, and from 0.7 up the ordering is lost somewhere (0.7: 0.80 / 0.67 but 1.23
- * at 1486; 0.75: 7.8 / 0.93; 0.8: 1.03 / 1.08; 0.9: 1.11 / 0.84): the
- * rings' first gap is 1.46 times larger at 45 degrees than on the axes, so with square
- * cells on the axes the hole particles at 45 degrees (h_i = 1.5 Delta_i set by the hole
- * spacing) reach only one ring inwards and take the normal curvature of their quadratic
+ * at 1486; 0.75: 7.8 / 0.93; 0.8: 1.03 / 1.08; 0.9: 1.11 / 0.84): the rings' first gap
+ * is 1.46 times larger at 45 degrees than on the axes, so with square cells on the axes
+ * the hole particles at 45 degrees (h_i = 1.5 Delta_i set by the hole spacing) reach
+ * only one ring inwards and take the normal curvature of their quadratic
  * fit from the hole's own curvature (radial-derivative stencil sum |N| h 11.4 against
  * 5.4 with 0.6, which reaches two rings); their traction rows then leave residuals up to
  * 0.52 on the exact field, to which SSPH's solve responds more than MSPH's. The paper's
@@ -32,8 +32,8 @@
  *
  * Square-cell rings and the other arrangements measured (issue 4), e(u2) SSPH / MSPH,
  * default corner rows:
- *   rings b = 10 (radial_step 1) 209: 0.189 / 0.075  677: 0.0210 / 0.0150  1492: 0.0076 / 0.0103
- *   rings b = 5              142: 0.455 / 0.139   472: 0.0537 / 0.0111  1063: 0.0270 / 0.0092
+ *   rings b = 10, radial_step 1  209: 0.189 / 0.075  677: 0.0210 / 0.0150  1492: 0.0076 / 0.0103
+ *   same, b = 5              142: 0.455 / 0.139   472: 0.0537 / 0.0111  1063: 0.0270 / 0.0092
  *   rays b = 10 (11x17 ...)  187: 0.149 / 0.131   693: 0.0487 / 0.0353  1519: 0.0236 / 0.0166
  *   polar rays b = 10        187: 0.644 / 0.117   693: 0.0465 / 0.0384  1519: 0.0236 / 0.0205
  *   rays b = 10 with the axis ray's spacings as fractions on every ray (not the default
@@ -72,14 +72,14 @@
  *   h_ij = max(h_i, h_j):                                              11.1 / 5.02, 0.11 / 0.89
  *     (the latter with MSPH 1.69 at 187: a broken solve, not a better SSPH)
  *   all 36 combinations of {estimate, nodal} x {gather, mean} x {3 corner rules} on
- *   square-cell rings, rays and a log-polar grid r_k = a (1 + dtheta)^k clipped at the square
- *   (b = 9.75 a: 191 / 684 particles, the paper's 188 / 686 within 2 %): none has SSPH <=
- *   MSPH at both resolutions (closest: rings, "hole" corners, 1.01 / 0.97);
- *   plate sizes b = 8 ... 15 a: square-cell rings 1.98-3.26 at ~200 and 0.99-1.68 at ~700, rays
- *   0.94-1.15 at 187 and 1.24-1.42 at 693; SSPH's SCF at ~200 is 3.9-4.7 on all of them
+ *   square-cell rings, rays and a log-polar grid r_k = a (1 + dtheta)^k clipped at the
+ *   square (b = 9.75 a: 191 / 684 particles, the paper's 188 / 686 within 2 %): none has
+ *   SSPH <= MSPH at both resolutions (closest: rings, "hole" corners, 1.01 / 0.97);
+ *   plate sizes b = 8 ... 15 a: square-cell rings 1.98-3.26 at ~200 and 0.99-1.68 at
+ *   ~700, rays 0.94-1.15 at 187 and 1.24-1.42 at 693; SSPH's SCF at ~200 is 3.9-4.7 on all of them
  *   (MSPH 2.8-3.2);
  *   rings with the first radial step a dtheta on every ray (square cells along the whole
- *   hole; the default rings have them only on the axes, and at 45 degrees the hole
+ *   hole; the square-cell rings have them only on the axes, and at 45 degrees the hole
  *   particles' supports reach one ring inwards, the normal curvature of their fit then
  *   coming from the hole's own curvature): 193 / 655 / 1438: 1.87 / 1.28 / 1.13;
  *   V_j = 1 instead of the cell areas: rings 0.71 / 3.88, rays 1.70 / 1.42, log-polar
@@ -89,11 +89,10 @@
  * W and its first and second xi-derivatives (001 eq 2.9) and the 1D tables anchor both
  * methods (t410), Delta_i is the nearest distance (which always lies in the support).
  * Where SSPH loses: swapping one row group of the SSPH system for MSPH's, square-cell
- * rings 209: the
- * 18 hole traction rows (corners apart) take SSPH from 0.190 to 0.062 (MSPH 0.074; the
- * other groups change it < 25 %), although both methods' hole rows leave the same residual on the
- * exact field (up to 0.52 at 45 degrees, sum 1.37 vs 1.15); rays 187 / 693: the
- * interior Navier rows (0.150 -> 0.122, 0.049 -> 0.043). The absolute numbers are not
+ * rings 209: the 18 hole traction rows (corners apart) take SSPH from 0.190 to 0.062
+ * (MSPH 0.074; the other groups change it < 25 %), although both methods' hole rows
+ * leave the same residual on the exact field (up to 0.52 at 45 degrees, sum 1.37 vs
+ * 1.15); rays 187 / 693: the interior Navier rows (0.150 -> 0.122, 0.049 -> 0.043). The absolute numbers are not
  * comparable with the paper's: e(u_2) is dimensional, scaling exactly as a^{3/2} with
  * the hole radius a at a fixed shape (test below), and the paper gives no radius; with
  * a = 0.3 the square-cell rings give 0.031 / 0.012 and 0.0034 / 0.0025, the default
