@@ -27,6 +27,10 @@ typedef struct {
                       edges (non-uniform, dense at the hole), 2 = the same map with rings
                       graded to square cells and per-node supports; 0 = the cut regular
                       grid */
+  int beam_dyadic; /* beam levels: 0 = nodes per depth ny = 3, 4, 5, 7, 9, 13, 17, 25, 33
+                      (17x3, 25x4, 33x5, 49x7, 65x9, ...: dx falls by about sqrt 2 per
+                      level; the first five are the paper's likely regime, see
+                      es_beam_ny); 1 = ny = 3, 5, 9, 17, 33, ... (dx halves per level) */
   int traction_gauss; /* 1: tractions by 4 Gauss points per boundary segment for every
                          scheme; 0 (default): nodal boundary quadrature Psi_J(x_I) dGamma_I
                          (000 eq 95) for the nodal-quadrature schemes, Gauss points for EFG
@@ -75,6 +79,10 @@ typedef struct {
   double lo[2], hi[2];
   int32_t ncells[2];
 } es_level_t;
+
+/* Nodes across the depth of beam level k (0 = coarsest; nx = 8 (ny - 1) + 1), 0 when k
+ * is out of range. */
+int32_t es_beam_ny(const es_problem_t *p, int k);
 
 /* Build level k (0 = coarsest) of problem p; ngauss points per direction in each
  * background cell for xq/wq. Returns 0, or 1 on allocation failure. */

@@ -326,6 +326,15 @@ const char *es_nodes_text(int kind) {
   }
 }
 
+int32_t es_beam_ny(const es_problem_t *p, int k) {
+  /* sqrt 2 steps: 2^j + 1 and 1.5 2^j + 1 alternate, so that dx / D = 1/2, 1/3, 1/4,
+   * 1/6, 1/8, ... and L / dx stays an integer */
+  static const int32_t kSqrt2[] = {3, 4, 5, 7, 9, 13, 17, 25, 33, 49, 65};
+  if (k < 0) return 0;
+  if (p->beam_dyadic) return k <= 8 ? (1 << (k + 1)) + 1 : 0;
+  return k < (int)(sizeof kSqrt2 / sizeof kSqrt2[0]) ? kSqrt2[k] : 0;
+}
+
 int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
   memset(lv, 0, sizeof *lv);
   grow_t X = {NULL, 0, 0, 2}, DS = {NULL, 0, 0, 4}, DN = {NULL, 0, 0, 2}, DM = {NULL, 0, 0, 1};
@@ -337,7 +346,8 @@ int es_level_build(const es_problem_t *p, int k, int ngauss, es_level_t *lv) {
   double lo[2], hi[2];
   int fail = 0;
   if (p->kind == ES_BEAM) {
-    const int32_t ny = (1 << (k + 1)) + 1;
+    const int32_t ny = es_beam_ny(p, k);
+    if (ny < 2) return 1;
     const double dx = p->D / (ny - 1);
     const int32_t nx = (int32_t)lround(p->L / dx) + 1;
     lv->dx = dx;

@@ -8,17 +8,68 @@
 # blending layer of 000 Sect. 5.6 (mfree_assembler_set_fe_layer, one call and component
 # mask per essential line), nodal quadrature (EFG: 5 x 5 Gauss per cell) and, since issue
 # 4's third session, the tractions by nodal boundary quadrature Psi_J(x_I) dGamma_I as 000
-# eq 95 writes them (EFG: 4 Gauss points per segment), on 2 busy cores in about 10 s each:
+# eq 95 writes them (EFG: 4 Gauss points per segment):
 #
-#   rates energy / L2   beam 17x3..129x17     paper      hole 118..814 nodes  paper
-#   SPH                 0.22 / 0.43 (grows)   NC / NC   -0.15 / -0.32 (grows) NC / NC
-#   JB                  0.20 / 0.30           NC / NC    0.05 / -0.01 (grows) NC / NC
-#   RL                  1.47 / 1.65           0.98/0.41  0.66 / 0.67          0.51/0.62
-#   CD1                 0.84 / 1.60           1.29/1.84  0.60 / 2.03          0.54/1.10
-#   CD2                 0.77 / 1.61           1.29/1.84  0.49 / 2.05          0.49/1.30
-#   MLS                 1.31 / 1.86           1.50/1.82  0.44 / 2.41          0.65/1.22
-#   EFG                 1.68 / 2.00           1.50/2.00  1.45 / 2.96          1.50/2.50
-#   beam 17x3..65x9: CD1 1.11 / 2.27, CD2 1.05 / 2.11, MLS 1.55 / 1.77 (asserted below).
+#   rates energy / L2   beam 17x3..65x9     beam 17x3..129x17    paper      hole 118..814  paper
+#                       (5 levels, sqrt2)   (4 levels, dyadic)
+#   SPH                 0.23 / 0.09 (grows) 0.22 / 0.43 (grows)  NC / NC   -0.15 / -0.32   NC / NC
+#   JB                  0.20 / 0.37 (grows) 0.20 / 0.30          NC / NC    0.05 / -0.01   NC / NC
+#   RL                  1.56 / 1.53         1.47 / 1.65          0.98/0.41  0.66 / 0.67    0.51/0.62
+#   CD1                 1.11 / 2.30         0.84 / 1.60          1.29/1.84  0.60 / 2.03    0.54/1.10
+#   CD2                 1.05 / 2.12         0.77 / 1.61          1.29/1.84  0.49 / 2.05    0.49/1.30
+#   MLS                 1.57 / 1.77         1.31 / 1.86          1.50/1.82  0.44 / 2.41    0.65/1.22
+#   EFG                 1.76 / 2.36         1.68 / 2.00          1.50/2.00  1.45 / 2.96    1.50/2.50
+#
+# Which levels (issue 4, fifth session). The paper gives no node counts. Over the long
+# range the energy errors of CD1 and CD2 level off near 8-10 % (257x33: 7.5 %, 9.3 %),
+# so the beam test asserts the issue's criteria on five levels at dx / sqrt 2 steps, 17x3,
+# 25x4, 33x5, 49x7, 65x9 (L/D = 8, s / dx = sqrt 2 fixed; the example's default, the
+# paper's likely regime: >= 4 refinements) and records the long range with the bounds
+# it meets (CD1, CD2 energy >= 0.7; L2 >= 1.5 holds there too). Local slopes of CD1's
+# energy error over the five levels: 1.56, 1.31, 0.91, 0.56: the stall starts at ~49x7.
+#
+# Where the stall comes from (measured with a scratch driver on the example's code: the
+# residual r = K u_I - f of the exact nodal values u_I = u(x_I), split by region, each
+# part solved for its error field e = K^-1 r_part; and runs with parts of the boundary
+# replaced by the exact values on three node columns or rows, so that no free node's
+# test function reaches that boundary):
+# (1) the layer. Nodal quadrature of the blended functions (000 eq 105) never sees the
+#     term r' Psi_J of the test functions inside the strip 0 < x < dx (r' = 0 at both
+#     strip edges): the rows of the columns x = dx and 2 dx carry an O(1) residual; CD1's
+#     column x = 2 dx has a moment sum_I r_x,I y_I = 0.742, 0.746, 0.742, 0.738 at 33x5,
+#     65x9, 129x17, 257x33 (P L = 8), constant. Its error field accounts for nearly all of
+#     the energy error at 129x17 and 257x33 (CD1 0.082 of 0.084, 0.075 of 0.075), but its L2 error is
+#     small (0.3 %) and its energy in 0.5 < x < 7.5 (0.061) is 30x its nodal energy there
+#     (strains at the nodes: 0.002; MLS 0.024 vs 0.0009): an oscillation between the
+#     nodes that nodal quadrature does not see (its spurious low-energy modes, the
+#     instability 000 Sect. 6.2.3 reports for Fig. 10), excited at the clamp and carried
+#     along the beam. It is the "global" error found in the middle of the beam before; it
+#     is not a bending error. With the exact values on the first three node columns
+#     instead of the layer, CD1's energy error falls 0.49, 0.165, 0.059, 0.026, 0.0165
+#     over 17x3..257x33 (rate ~1.3). Making the interface column's nodal volume 1.25 dx dy
+#     (against sum dV = V) nearly cancels the moment (0.08): the defect is the strip's
+#     missing integral, not the volumes of the x = 0 nodes (their quadrature points only
+#     enter the rows of the x = dx column).
+# (2) the loaded end, for Shepard test functions. For the test functions of the last
+#     columns the nodal quadrature misses the divergence identity sum_I dPsi_J/dx(x_I)
+#     dV_I = sum_I Psi_J(x_I) n_x dGamma_I by a fixed fraction: with sigma_xy = O(1)
+#     there the rows of the last columns carry a net spurious shear of +1.37 % of P at
+#     every level (an independent computation of the Shepard sums on the grid: 1.372e-2,
+#     1.372e-2 at ny = 17, 33; the same with volume-weighted Shepard functions, and
+#     independent of the end column's volume: the Shepard ramp sum_J Psi_J, not the
+#     boundary node, carries it). So the tip deflection is 1.3-1.5 % short at every level
+#     from 65x9 on and the L2 errors of CD1 and CD2 level off near 1.1 %. MLS test
+#     functions do not have it (tip error -15.7, -4.2, -1.0, -0.25 %: O(dx^2)).
+# (3) the free edges contribute nothing measurable (sigma_yy = 0 and sigma_xy = 0 there):
+#     with the exact values on three columns at both ends, CD1's energy and L2 errors
+#     equal those of the interpolant u_I = u(x_I) (257x33: 5.8e-3 vs 6.2e-3, 4.6e-4 vs
+#     4.6e-4). A linear patch field on the beam grid with its tractions on all free
+#     edges shows that they are not consistent either (energy errors of 1-4 % for CD1 and
+#     MLS that fall slowly or not at all): nodal quadrature fails the patch test next to any
+#     traction edge that carries a normal or shear stress.
+# Both defects are inherent to the paper's ingredients (nodal quadrature with eq 105's
+# layer, Shepard test functions); no implementation defect was found (item (a)-(c) below
+# and these). Consistent integration (PROBLEM=beam-vci) removes both.
 #
 # With 4 Gauss points per segment for the tractions of every scheme (--traction gauss, the
 # default before; not eq 95) the beam gave CD1 0.65 / 0.98, CD2 0.60 / 1.05, MLS 1.13 /
@@ -46,9 +97,10 @@
 # x = 0 nodes' Shepard functions included (eq 105b); only the x = 0 quadrature points get
 # element rows. Tractions: see above (eq 95's nodal rule is now the default). The energy
 # error at 257x33 lies mostly in the middle of the beam (0.5 < x < 7.5: 69 %, 74 %, 70 %
-# of the squared error for CD1, CD2, MLS; the layer strip 0 < x < dx: 10 %, 5 %, 6 %): a
-# global bending error, not a local one at the clamp. (d) Rates over windows of levels
-# (Gauss tractions; energy / L2): CD1 17x3..33x5 1.19/0.10, ..65x9 0.86/1.04; CD2 1.14/
+# of the squared error for CD1, CD2, MLS; the layer strip 0 < x < dx: 10 %, 5 %, 6 %);
+# the fifth session found it to be an oscillation between the nodes excited by the
+# layer's residual, not bending (see "Where the stall comes from" above). (d) Rates over
+# windows of levels (Gauss tractions; energy / L2): CD1 17x3..33x5 1.19/0.10, ..65x9 0.86/1.04; CD2 1.14/
 # 2.68, 0.81/2.30; MLS 1.50/1.63, 1.40/1.78. No defect was found; the scheme is the paper's.
 #
 # JB is the paper's (normal strains beta-corrected, shear strain symmetrised SPH), which
@@ -76,7 +128,8 @@
 # spurious moment at the clamp. The Bubnov MLS scheme still converges in L2 (1.87);
 # the Shepard test functions, which are not linearly complete, do not balance moments
 # (000 Sect. 5.7: no angular-momentum conservation), and with them the error becomes a
-# global bending error that grows with refinement: on a fifth level (257x33) the CD1 and
+# global error that grows with refinement (the fifth session: an oscillation between the
+# nodes, see above, plus the end's 1.4 % shear for the L2 error): on a fifth level (257x33) the CD1 and
 # CD2 L2 errors rise from 5.3e-3 and 6.8e-3 to 9.8e-3 and 1.0e-2, while MLS's falls to
 # 1.4e-3. The paper's levels are not stated; its rates may come from coarser grids or
 # from nodal norms (its Sect. 6.2.3 speaks of "the error in energy as measured by an l2
@@ -86,7 +139,8 @@
 # (mfree_elastostatics --bc fe-gauss), the energy rates over 17x3..257x33 rise to 0.94 /
 # 0.93 (MLS 0.96), but the L2 errors still level off near 1.3e-2: the nodal sums next to
 # the layer keep a smaller end error of the same kind, and a bending error of about 1 %
-# remains (tip deflection too small).
+# remains (tip deflection too small; the fifth session traced it to the loaded end, (2)
+# of "Where the stall comes from" above).
 #
 # Checked again (issue 4, second session): (a) with fe-gauss the interface column's
 # volumes do lose the half cell inside the layer (fe_gauss_points subtracts a quarter of
@@ -180,7 +234,7 @@ endif()
 if(PROBLEM STREQUAL "beam-vci")
   # CD1 and CD2 with mfree_assembler_set_consistent_integration, from the 33x5 level
   # (MLS with it: 2.14 / 2.57, not run here to keep the test short)
-  set(args --problem beam --no-plot --vci --scheme CD1,CD2 --first 1)
+  set(args --problem beam --no-plot --vci --scheme CD1,CD2 --beam-grid dyadic --first 1)
 endif()
 execute_process(COMMAND ${EXE} --json ${args} --levels ${LEVELS} --out ${OUT}
                 RESULT_VARIABLE rc OUTPUT_VARIABLE json ERROR_VARIABLE stderr)
@@ -352,6 +406,16 @@ if(PROBLEM STREQUAL "beam" OR PROBLEM STREQUAL "hole")
 endif()
 
 if(PROBLEM STREQUAL "beam")
+  # Two level ranges (the paper gives no node counts; see "Which levels" at the top):
+  # (1) the paper's likely regime, five levels at dx / sqrt 2 steps, 17x3, 25x4, 33x5,
+  #     49x7, 65x9 (the example's default): the issue's criteria are asserted here;
+  # (2) the long range 17x3, 33x5, 65x9, 129x17 (--beam-grid dyadic): the stall of CD1 and
+  #     CD2 under the paper's scheme is recorded, with the bounds it meets.
+  string(JSON kind GET "${json}" beam levels_kind)
+  string(JSON nlev LENGTH "${json}" beam dx)
+  if(NOT kind STREQUAL "sqrt2" OR NOT nlev EQUAL ${LEVELS})
+    fail("beam: expected ${LEVELS} sqrt2 levels, got ${nlev} ${kind} levels")
+  endif()
   # 000 Table III, beam: SPH and JB "NC" (energy and L2). JB is the paper's (its shear
   # strain keeps the symmetrised SPH derivatives, 000 eqs 48-52).
   foreach(key energy L2)
@@ -360,48 +424,62 @@ if(PROBLEM STREQUAL "beam")
   endforeach()
   # 000 Sect. 6.2.3: "JB did improve the SPH accuracy in the energy norm slightly".
   below_at_every_level(beam JB SPH energy "000 Sect. 6.2.3")
-  # 000 Table III, MLS 1.50 / 1.82.
-  at_least(beam MLS energy_rate 1.0 "000 Table III beam MLS 1.50")
-  at_least(beam MLS L2_rate 1.5 "000 Table III beam MLS 1.82")
-  # 000 Table III, CD1 and CD2 1.29 / 1.84; asked for: energy >= 1.0, L2 >= 1.5. With the
-  # paper's scheme (nodal tractions, eq 95) over 17x3 .. 129x17: CD1 0.84 / 1.60, CD2
-  # 0.77 / 1.61: the L2 criterion holds, the energy one does not (the energy error levels
-  # off near 8-10 %, see the top of this file); over the three coarse levels (below) both
-  # hold. Earlier measurements with other conditions (Gauss-point tractions; energy / L2,
-  # CD1 and CD2): direct rows 0.25/1.32, 0.20/1.26; Nitsche 1.10/0.51, 1.09/0.68 (the
-  # Shepard test functions leave a rigid rotation of the clamped end of about 3e-3);
-  # penalty 1.40/1.53, 1.07/1.04; Lagrange 1.11/0.46, 0.17/0.76.
-  at_least(beam CD1 energy_rate 0.7 "000 Table III beam CD1 1.29, measured 0.84")
-  at_least(beam CD1 L2_rate 1.5 "000 Table III beam CD1 1.84, measured 1.60")
-  at_least(beam CD2 energy_rate 0.7 "000 Table III beam CD2 1.29, measured 0.77")
-  at_least(beam CD2 L2_rate 1.5 "000 Table III beam CD2 1.84, measured 1.61")
+  # 000 Table III, CD1 and CD2 1.29 / 1.84, MLS 1.50 / 1.82; asked for: energy >= 1.0,
+  # L2 >= 1.5. Measured over 17x3..65x9 (sqrt2): CD1 1.11 / 2.30, CD2 1.05 / 2.12, MLS
+  # 1.57 / 1.77.
+  foreach(s CD1 CD2 MLS)
+    at_least(beam ${s} energy_rate 1.0 "000 Table III beam ${s}, 17x3..65x9")
+    at_least(beam ${s} L2_rate 1.5 "000 Table III beam ${s}, 17x3..65x9")
+  endforeach()
   # 000 Sect. 6.2.3: CD1 and CD2 "very close".
   close_at_every_level(beam CD1 CD2 energy 15 "000 Sect. 6.2.3")
-  # 000 Table III, EFG 1.50 / 2.00, and "EFG best overall" (with the FE layer blended
-  # inside the background cells; the L2 error flattens between 33x5 and 65x9, hence 1.8).
+  # 000 Table III, EFG 1.50 / 2.00 (measured 1.76 / 2.36), and "EFG best overall".
   at_least(beam EFG energy_rate 1.0 "000 Table III beam EFG 1.50")
   at_least(beam EFG L2_rate 1.8 "000 Table III beam EFG 2.00")
   smallest_at_finest(beam EFG energy "000 Sect. 6.2.3: EFG best overall")
   get(rl_e beam RL energy_rate)
   get(rl_l beam RL L2_rate)
   message(STATUS "beam RL (not asserted): energy rate ${rl_e}, L2 rate ${rl_l}; 000 Table III 0.98 / 0.41")
-  # The paper's levels are not stated. Over the three coarse levels 17x3 .. 65x9 the
-  # paper's scheme gives CD1 1.11 / 2.27, CD2 1.05 / 2.11, MLS 1.55 / 1.77 (paper 1.29 /
-  # 1.84, 1.29 / 1.84, 1.50 / 1.82): the issue's energy >= 1.0, L2 >= 1.5 hold there.
-  execute_process(COMMAND ${EXE} --json --no-plot --problem beam --scheme CD1,CD2,MLS --levels 3
-                          --out ${OUT}
+
+  # (2) The long range 17x3 .. 129x17, every scheme, the paper's scheme.
+  execute_process(COMMAND ${EXE} --json --no-plot --problem beam --beam-grid dyadic --levels 4 --out ${OUT}
                   RESULT_VARIABLE rc OUTPUT_VARIABLE json ERROR_VARIABLE stderr)
   if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "${EXE} (three levels) exited with ${rc}:\n${stderr}")
+    message(FATAL_ERROR "${EXE} (dyadic levels) exited with ${rc}:\n${stderr}")
   endif()
   string(STRIP "${json}" json)
-  file(WRITE ${OUT}/table3-beam-coarse.json "${json}\n")
-  foreach(s CD1 CD2)
-    at_least(beam ${s} energy_rate 1.0 "000 Table III beam ${s} 1.29, 17x3..65x9")
-    at_least(beam ${s} L2_rate 1.5 "000 Table III beam ${s} 1.84, 17x3..65x9")
+  file(WRITE ${OUT}/table3-beam-long.json "${json}\n")
+  string(JSON kind GET "${json}" beam levels_kind)
+  if(NOT kind STREQUAL "dyadic")
+    fail("beam: the long range ran on ${kind} levels")
+  endif()
+  foreach(s SPH JB RL CD1 CD2 MLS EFG)
+    string(JSON ps ERROR_VARIABLE e GET "${json}" beam ${s} paper_scheme)
+    if(e OR NOT (ps STREQUAL "ON" OR ps STREQUAL "true"))
+      fail("beam (long range) ${s}: not run with the paper's scheme (paper_scheme = ${ps} ${e})")
+    endif()
   endforeach()
-  at_least(beam MLS energy_rate 1.3 "000 Table III beam MLS 1.50, 17x3..65x9")
-  at_least(beam MLS L2_rate 1.5 "000 Table III beam MLS 1.82, 17x3..65x9")
+  foreach(key energy L2)
+    no_convergence(beam SPH ${key})
+    no_convergence(beam JB ${key})
+  endforeach()
+  below_at_every_level(beam JB SPH energy "000 Sect. 6.2.3, 17x3..129x17")
+  at_least(beam MLS energy_rate 1.0 "000 Table III beam MLS 1.50, 17x3..129x17: 1.31")
+  at_least(beam MLS L2_rate 1.5 "000 Table III beam MLS 1.82, 17x3..129x17: 1.86")
+  at_least(beam EFG energy_rate 1.0 "000 Table III beam EFG 1.50, 17x3..129x17: 1.68")
+  at_least(beam EFG L2_rate 1.8 "000 Table III beam EFG 2.00, 17x3..129x17: 2.00")
+  smallest_at_finest(beam EFG energy "000 Sect. 6.2.3: EFG best overall, 17x3..129x17")
+  # The stall (see the top of this file): CD1 0.84 / 1.60, CD2 0.77 / 1.61 measured; the
+  # L2 criterion holds over this range too, the energy one does not (the layer's O(1)
+  # moment at the clamp holds the energy error near 8-10 %).
+  at_least(beam CD1 energy_rate 0.7 "000 Table III beam CD1 1.29; stalls over 17x3..129x17: 0.84")
+  at_least(beam CD1 L2_rate 1.5 "000 Table III beam CD1 1.84, 17x3..129x17: 1.60")
+  at_least(beam CD2 energy_rate 0.7 "000 Table III beam CD2 1.29; stalls over 17x3..129x17: 0.77")
+  at_least(beam CD2 L2_rate 1.5 "000 Table III beam CD2 1.84, 17x3..129x17: 1.61")
+  close_at_every_level(beam CD1 CD2 energy 15 "000 Sect. 6.2.3, 17x3..129x17")
+  get(rl_e beam RL energy_rate)
+  get(rl_l beam RL L2_rate)
+  message(STATUS "beam RL over 17x3..129x17 (not asserted): energy rate ${rl_e}, L2 rate ${rl_l}")
 elseif(PROBLEM STREQUAL "hole")
   # 000 Table III, hole: SPH and JB "NC" (energy and L2): their errors grow or stall
   # near 50 % (SPH 40 %, 43 %, 45 %, 47 %; JB 53 %, 52 %, 52 %, 51 %). 000 Sect. 6.2.3's
