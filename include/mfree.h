@@ -820,7 +820,9 @@ MFREE_API mfree_status_t mfree_assembler_set_material(mfree_assembler_t *as, dou
 /** Coefficient c of the Laplace forms, or density rho of the mass forms. Default 1. */
 MFREE_API mfree_status_t mfree_assembler_set_coefficient(mfree_assembler_t *as, double c);
 
-/** Nodal quadrature: points = the particles, weights = their volumes (the default). */
+/** Nodal quadrature: points = the particles, weights = their volumes (the default);
+ * mfree_assembler_setup is MFREE_ERR_STATE when the particle set has no volumes (nor
+ * masses and densities). */
 MFREE_API mfree_status_t mfree_assembler_set_quadrature_nodal(mfree_assembler_t *as);
 /**
  * Background cells: a structured grid of ncells[d] cells over [lo, hi], ngauss^dim

@@ -6,6 +6,7 @@
 
 #include "basis.hpp"
 #include "quadrature.hpp"
+#include "unknowns.h"
 
 namespace mfree {
 
@@ -1054,10 +1055,14 @@ void Assembler::build_pattern() {
         ++nmult_;
       }
   }
-  // unknowns are int32 indices in the ABI (mfree_matrix_t columns)
-  const int64_t nunknowns = static_cast<int64_t>(n) * nc + static_cast<int64_t>(mcols.size());
-  if (nunknowns > INT32_MAX)
-    throw Error(MFREE_ERR_ARG, "too many unknowns (" + std::to_string(nunknowns) + ") for int32 indices");
+  // unknowns are int32 indices in the ABI (mfree_matrix_t columns): unknowns.h, t690
+  int32_t nunknowns = 0;
+  const mfree_status_t size_status =
+      mfree_core_count_unknowns(n, nc, static_cast<int64_t>(mcols.size()), &nunknowns);
+  if (size_status != MFREE_SUCCESS)
+    throw Error(size_status, "too many unknowns (" +
+                                   std::to_string(static_cast<int64_t>(n) * nc + static_cast<int64_t>(mcols.size())) +
+                                   ") for int32 indices");
   const int32_t nbase = n * nc;
   ndofs_ = nbase + nmult_;
   // transpose of the multiplier columns: for each dof, the multipliers touching it
@@ -1105,6 +1110,10 @@ void Assembler::build_pattern() {
 
 Report Assembler::setup() {
   if (!ps_->is_setup()) throw Error(MFREE_ERR_STATE, "the particle set is not set up");
+  // nodal quadrature weighs every particle with its volume (000 eq 95)
+  if (!collocation() && quad_kind_ == 0 && !ps_->has_volumes())
+    throw Error(MFREE_ERR_STATE,
+                "nodal quadrature needs particle volumes (mfree_particles_set_volumes, or masses and densities)");
   const double modulus = elasticity() ? young_ : coef_;
   if (!penalty_set_) penalty_ = 1e6 * modulus;
   nitsche_ = penalty_set_ ? penalty_ : 100.0 * modulus / mean_h();
