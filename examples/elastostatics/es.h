@@ -119,10 +119,15 @@ typedef enum {
                          the blended functions and the other nodes by nodal quadrature (the
                          interface nodes' volumes less their share of the layer): not the
                          paper's; shows what the layer's nodal quadrature costs */
-  ES_BC_FE_NODAL = 7  /* the same layer as nodal quadrature sees it, built by the example
+  ES_BC_FE_NODAL = 7, /* the same layer as nodal quadrature sees it, built by the example
                          (000 eq 105, Fig. 2): element derivatives at the quadrature points
                          of the nodes on Gamma_u, prescribed values on their parameters;
                          nodal-quadrature schemes only; equals fe-layer to round-off */
+  ES_BC_COLUMNS = 9,  /* beam, a diagnosis (not the paper's): rows u_J = g(x_J) on every
+                         node of the first three node columns (x < 2.5 dx), so that no free
+                         node's test function reaches x = 0 (support 2 s = 2.83 dx) */
+  ES_BC_COLUMNS2 = 10 /* the same at both ends (also x > L - 2.5 dx): what remains is the
+                         interior and the free edges */
 } es_bc_t;
 
 const char *es_bc_name(es_bc_t bc);

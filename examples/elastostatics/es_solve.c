@@ -26,15 +26,15 @@ const es_scheme_t es_schemes[ES_NSCHEMES] = {
     {"EFG", MFREE_METHOD_MLS, 1, (mfree_method_t)0, 1, 0},
 };
 
-static const char *const kBcNames[] = {"auto",     "direct",   "rows",     "nitsche", "penalty",
-                                       "lagrange", "fe-layer", "fe-nodal", "fe-gauss"};
+static const char *const kBcNames[] = {"auto",     "direct",   "rows",     "nitsche", "penalty",  "lagrange",
+                                       "fe-layer", "fe-nodal", "fe-gauss", "columns", "columns2"};
 
 const char *es_bc_name(es_bc_t bc) {
-  return (int)bc >= 0 && (int)bc <= ES_BC_FE_GAUSS ? kBcNames[bc] : "?";
+  return (int)bc >= 0 && (int)bc <= ES_BC_COLUMNS2 ? kBcNames[bc] : "?";
 }
 
 int es_bc_parse(const char *s, es_bc_t *bc) {
-  for (int k = 0; k <= ES_BC_FE_GAUSS; ++k)
+  for (int k = 0; k <= ES_BC_COLUMNS2; ++k)
     if (strcmp(s, kBcNames[k]) == 0) {
       *bc = (es_bc_t)k;
       return 0;
@@ -376,14 +376,14 @@ static int fe_gauss_points(const es_level_t *lv, double **px, double **pw, int32
 /* Rows u_J = g_c(x_J) on the nodal parameters (ES_BC_DIRECT): the pattern of the
  * assembled matrix always holds the diagonal (every particle is its own neighbour). The
  * rows are scaled by E, the size of the stiffness rows. */
-static void direct_rows(const es_problem_t *p, const es_level_t *lv, const int64_t *rp, const int32_t *ci,
-                        double *v, double *f) {
+static void direct_rows(const es_problem_t *p, const es_level_t *lv, const int32_t *mask, const int64_t *rp,
+                        const int32_t *ci, double *v, double *f) {
   for (int32_t i = 0; i < lv->n; ++i) {
-    if (!lv->dmask[i]) continue;
+    if (!mask[i]) continue;
     double g[2];
     es_exact(p, lv->x + 2 * i, g, NULL, NULL);
     for (int c = 0; c < 2; ++c) {
-      if (!(lv->dmask[i] & (1 << c))) continue;
+      if (!(mask[i] & (1 << c))) continue;
       const int32_t d = 2 * i + c;
       for (int64_t k = rp[d]; k < rp[d + 1]; ++k) v[k] = ci[k] == d ? p->E : 0.0;
       f[d] = p->E * g[c];
@@ -605,7 +605,7 @@ mfree_status_t es_run_vci(mfree_context_t *ctx, const es_problem_t *p, const es_
   double *f = NULL, *u = NULL, *bx = NULL, *bw = NULL, *bn = NULL, *uq = NULL, *gq = NULL;
   double *un = NULL, *gx = NULL, *gw = NULL;
   int32_t ngp = 0;
-  int32_t *nodes = NULL, *conn = NULL, *gu = NULL, *on_gu = NULL;
+  int32_t *nodes = NULL, *conn = NULL, *gu = NULL, *on_gu = NULL, *band = NULL;
   traction_t *tu = NULL;
   const int32_t n = lv->n;
 
@@ -626,6 +626,11 @@ mfree_status_t es_run_vci(mfree_context_t *ctx, const es_problem_t *p, const es_
   if (s->particles_only && vci) {
     st = MFREE_ERR_UNSUPPORTED;
     if (err) snprintf(err, (size_t)errlen, "%s: consistent integration needs test-function values", s->name);
+    goto done;
+  }
+  if ((bc == ES_BC_COLUMNS || bc == ES_BC_COLUMNS2) && p->kind != ES_BEAM) {
+    st = MFREE_ERR_UNSUPPORTED;
+    if (err) snprintf(err, (size_t)errlen, "%s: --bc %s is a diagnosis for the beam only", s->name, es_bc_name(bc));
     goto done;
   }
   if (s->particles_only && bc == ES_BC_NITSCHE) {
@@ -809,7 +814,7 @@ mfree_status_t es_run_vci(mfree_context_t *ctx, const es_problem_t *p, const es_
   }
   CHECK(mfree_assembler_assemble_matrix(as, &K), "stiffness");
   CHECK(mfree_assembler_assemble_rhs(as, f), "load");
-  if (bc == ES_BC_DIRECT || bc == ES_BC_FE_NODAL) {
+  if (bc == ES_BC_DIRECT || bc == ES_BC_FE_NODAL || bc == ES_BC_COLUMNS || bc == ES_BC_COLUMNS2) {
     /* the example's changes to the assembled stiffness, on a copy of its values */
     const int64_t *rp;
     const int32_t *ci;
@@ -836,7 +841,19 @@ mfree_status_t es_run_vci(mfree_context_t *ctx, const es_problem_t *p, const es_
         goto done;
       }
     }
-    if (bc == ES_BC_DIRECT || bc == ES_BC_FE_NODAL) direct_rows(p, lv, rp, ci, kv, f);
+    if (bc == ES_BC_DIRECT || bc == ES_BC_FE_NODAL) direct_rows(p, lv, lv->dmask, rp, ci, kv, f);
+    if (bc == ES_BC_COLUMNS || bc == ES_BC_COLUMNS2) {
+      band = calloc((size_t)(n ? n : 1), sizeof(int32_t));
+      if (!band) {
+        st = MFREE_ERR_ALLOC;
+        goto done;
+      }
+      for (int32_t i = 0; i < n; ++i) {
+        const double x = lv->x[2 * i];
+        if (x < 2.5 * lv->dx || (bc == ES_BC_COLUMNS2 && x > p->L - 2.5 * lv->dx)) band[i] = 3;
+      }
+      direct_rows(p, lv, band, rp, ci, kv, f);
+    }
     mfree_matrix_t *K2 = NULL;
     CHECK(mfree_matrix_create_csr(ctx, nr, ncol, rp, ci, kv, &K2), "modified matrix");
     mfree_matrix_destroy(&K);
@@ -951,7 +968,7 @@ done:
   mfree_approximant_destroy(&trial);
   mfree_particles_destroy(&ps);
   free(f), free(u), free(bx), free(bw), free(bn), free(uq), free(gq), free(un), free(nodes), free(tu);
-  free(conn), free(gu), free(on_gu), free(gx), free(gw);
+  free(conn), free(gu), free(on_gu), free(gx), free(gw), free(band);
   r->seconds = now() - t0;
   return st;
 }
