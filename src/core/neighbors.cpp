@@ -682,9 +682,14 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
   // row lengths by site, then prefix sums; each block knows its own buffer's end
   sc.rowptr.resize(static_cast<size_t>(nsites) + 1);
   int64_t *rp = sc.rowptr.data();
-  std::fill(rp, rp + nsites + 1, 0);
   if (symmetric) sc.src.resize(static_cast<size_t>(nsites));
   const int32_t **src = sc.src.data();
+  // (every pass over the sites runs on the threads: serial ones bounded the speed-up)
+  for_chunks(nt, [&](int t) {
+    int64_t b, e;
+    thread_block(static_cast<int64_t>(nsites) + 1, t, nt, b, e);
+    std::fill(rp + b, rp + e, 0);  // sites without a row (invalid, ghosts) keep 0
+  });
   for_chunks(nt, [&](int t) {
     int64_t b, e;
     thread_block(nq, t, nt, b, e);
@@ -694,7 +699,20 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
       if (symmetric) src[order[q]] = sc.buf[t].data() + first[q];
     }
   });
-  for (int32_t s = 0; s < nsites; ++s) rp[s + 1] += rp[s];
+  // prefix sums: block totals, their offsets, then each block's running sum
+  int64_t part[64];
+  for_chunks(nt, [&](int t) {
+    int64_t b, e, sum = 0;
+    thread_block(nsites, t, nt, b, e);
+    for (int64_t s = b; s < e; ++s) sum += rp[s + 1];
+    part[t] = sum;
+  });
+  for (int t = 1; t < nt; ++t) part[t] += part[t - 1];
+  for_chunks(nt, [&](int t) {
+    int64_t b, e, acc = t > 0 ? part[t - 1] : 0;
+    thread_block(nsites, t, nt, b, e);
+    for (int64_t s = b; s < e; ++s) rp[s + 1] = acc += rp[s + 1];
+  });
   const int64_t nnz = rp[nsites];
   out.rowptr.reserve(static_cast<size_t>(nsites) + 1);
   out.cols.reserve(static_cast<size_t>(nnz));
@@ -782,10 +800,20 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, N
   const int32_t *mem = grid.members();
   const int32_t nv = grid.num_valid();
   sc.order.resize(static_cast<size_t>(nv));
-  int32_t no = 0;
-  for (int32_t p = 0; p < nv; ++p)
-    if (mem[p] < rows) sc.order[no++] = mem[p];
-  sc.order.resize(static_cast<size_t>(no));
+  if (rows == ps.size()) {  // no ghosts: every member owns a row
+    const int nch = std::min(num_threads(nv), 64);
+    int32_t *o = sc.order.data();
+    for_chunks(nch, [&](int t) {
+      int64_t b, e;
+      thread_block(nv, t, nch, b, e);
+      std::copy(mem + b, mem + e, o + b);
+    });
+  } else {
+    int32_t no = 0;
+    for (int32_t p = 0; p < nv; ++p)
+      if (mem[p] < rows) sc.order[no++] = mem[p];
+    sc.order.resize(static_cast<size_t>(no));
+  }
   const int dim = ps.dim();
   // symmetric relation (see run_queries): every valid particle has a row (no ghosts), and
   // a symmetric convention or one radius for all
