@@ -355,7 +355,8 @@ void FluidSystem::color_chunks() {
   const int64_t *crp = cand_.rowptr.data();
   const int32_t *ccols = cand_.cols.data();
   color_mask_.assign(nall, 0);
-  std::vector<int32_t> color(nch, 0);
+  std::vector<int32_t> &color = chunk_color_;  // members: a rebuild allocates only when the set grows
+  color.assign(nch, 0);
   int ncolor = 0;
   bool serial = false;
   for (int32_t c = 0; c < nch && !serial; ++c) {
@@ -380,7 +381,8 @@ void FluidSystem::color_chunks() {
   for (int32_t c = 0; c < nch; ++c) ++color_ptr_[color[c] + 1];
   for (int col = 0; col < ncolor; ++col) color_ptr_[col + 1] += color_ptr_[col];
   chunk_order_.resize(nch);
-  std::vector<int32_t> fill(color_ptr_.begin(), color_ptr_.end() - 1);
+  std::vector<int32_t> &fill = chunk_fill_;
+  fill.assign(color_ptr_.begin(), color_ptr_.end() - 1);
   for (int32_t c = 0; c < nch; ++c) chunk_order_[fill[color[c]]++] = c;
   scatter_threads_ = !serial;
 }

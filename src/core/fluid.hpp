@@ -169,6 +169,7 @@ class FluidSystem : public System {
   static constexpr int32_t kChunk = 512;
   std::vector<int32_t> chunk_order_, color_ptr_;
   std::vector<uint64_t> color_mask_;  // scratch of color_chunks
+  std::vector<int32_t> chunk_color_, chunk_fill_;  // scratch of color_chunks
   bool scatter_threads_ = true;       // false: one colour, the chunks in order, one thread
   std::vector<double> acc_;           // per node: force, mass, lumped mass, wall force
 };
