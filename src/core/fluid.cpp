@@ -270,11 +270,18 @@ Report FluidSystem::candidates(const double *xn) {
     // 2 max |x - x_ref| < skin: pairs now closer than 2h were closer than 2h + skin at
     // the build (a tenth of the skin kept back for rounding)
     const double lim = 0.45 * skin_ * h_, lim2 = lim * lim;
-    for (size_t q = 0; q < nx && !rebuild; q += dim) {
-      double d2 = 0.0;
-      for (int c = 0; c < dim; ++c) d2 += (xn[q + c] - xref_[q + c]) * (xn[q + c] - xref_[q + c]);
-      rebuild = !(d2 <= lim2);
-    }
+    bool moved[64] = {};  // per thread (parallel_blocks runs at most 64)
+    const double *xr = xref_.data();
+    parallel_blocks(nall, light_threads(nall), [&](int t, int64_t b, int64_t e) {
+      bool far = false;
+      for (int64_t i = b; i < e; ++i) {
+        double d2 = 0.0;
+        for (int c = 0; c < dim; ++c) d2 += (xn[i * dim + c] - xr[i * dim + c]) * (xn[i * dim + c] - xr[i * dim + c]);
+        far = far || !(d2 <= lim2);
+      }
+      moved[t] = far;
+    });
+    rebuild = std::any_of(moved, moved + 64, [](bool f) { return f; });
   }
   if (!rebuild) {
     if (xn != xbound_) {  // same lists, positions from another buffer (ps_ is read by fluid_wall)
@@ -1266,7 +1273,9 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
     }
     Report bad = check_state(yn, nsteps + 1);
     if (!bad.ok()) return bad;  // y keeps the last good state
-    std::copy(yn, yn + ny, y);
+    parallel_blocks(static_cast<int64_t>(ny), light_threads(n_), [&](int, int64_t b, int64_t e) {
+      std::copy(yn + b, yn + e, y + b);
+    });
     t = (t_end - t <= dt) ? t_end : t + dt;
     ++nsteps;
     if (progress && progress(user, nsteps, t, dt)) break;
