@@ -13,26 +13,7 @@
 #include <new>
 #include <vector>
 
-namespace {
-std::atomic<long> g_new{0};
-bool g_counting = false;
-}  // namespace
-
-void *operator new(std::size_t n) {
-  if (g_counting) ++g_new;
-  if (void *p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void *operator new[](std::size_t n) { return operator new(n); }
-void *operator new(std::size_t n, const std::nothrow_t &) noexcept {
-  if (g_counting) ++g_new;
-  return std::malloc(n ? n : 1);
-}
-void *operator new[](std::size_t n, const std::nothrow_t &t) noexcept { return operator new(n, t); }
-void operator delete(void *p) noexcept { std::free(p); }
-void operator delete[](void *p) noexcept { std::free(p); }
-void operator delete(void *p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void *p, std::size_t) noexcept { std::free(p); }
+#include "../util/counting_new.hpp"
 
 namespace {
 
