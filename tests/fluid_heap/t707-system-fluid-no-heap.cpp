@@ -18,24 +18,6 @@
 
 namespace {
 
-std::atomic<long> g_hook{0};
-void *hook_alloc(void *, int64_t bytes) {
-  ++g_hook;
-  return std::malloc(static_cast<size_t>(bytes));
-}
-void hook_free(void *, void *p, int64_t) { std::free(p); }
-
-int failures = 0;
-#define CHECK(cond, ...)                 \
-  do {                                   \
-    if (!(cond)) {                       \
-      std::fprintf(stderr, __VA_ARGS__); \
-      std::fprintf(stderr, "\n");        \
-      ++failures;                        \
-    }                                    \
-  } while (0)
-#define OK(call) CHECK((call) == MFREE_SUCCESS, "%s failed at line %d", #call, __LINE__)
-
 int stop_after_one(void *, int64_t step, double, double) { return step >= 1; }
 
 // A 16 x 32 column (the dam break's, as in bench_dambreak) with walls on three sides.

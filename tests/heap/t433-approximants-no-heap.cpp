@@ -17,27 +17,6 @@
 
 namespace {
 
-struct Hook {
-  long calls = 0;
-};
-void *hook_alloc(void *user, int64_t bytes) {
-  ++static_cast<Hook *>(user)->calls;
-  return std::malloc(static_cast<size_t>(bytes));
-}
-void hook_free(void *, void *p, int64_t) { std::free(p); }
-
-int failures = 0;
-#define CHECK(cond, ...)              \
-  do {                                \
-    if (!(cond)) {                    \
-      std::fprintf(stderr, __VA_ARGS__); \
-      std::fprintf(stderr, "\n");     \
-      ++failures;                     \
-    }                                 \
-  } while (0)
-
-#define OK(call) CHECK((call) == MFREE_SUCCESS, "%s failed at line %d", #call, __LINE__)
-
 void run(int dim, int threads, int method) {
   const int m = dim == 2 ? 24 : 9;
   int n = 1;
@@ -57,11 +36,10 @@ void run(int dim, int threads, int method) {
     }
   }
   for (size_t i = 0; i < u.size(); ++i) u[i] = 0.01 * static_cast<double>(i % 97);
-  Hook hook;
   mfree_context_t *ctx = nullptr;
   OK(mfree_context_create(&ctx));
   OK(mfree_context_set_num_threads(ctx, threads));
-  OK(mfree_context_set_allocator(ctx, hook_alloc, hook_free, &hook));
+  OK(mfree_context_set_allocator(ctx, hook_alloc, hook_free, nullptr));
   const double h = 1.3, vol = 1.0;
   mfree_particles_t *ps = nullptr;
   OK(mfree_particles_create(ctx, dim, n, &ps));
@@ -79,23 +57,23 @@ void run(int dim, int threads, int method) {
   long pnew = 0, pcalls = 0, anew = 0, acalls = 0, onew = 0, ocalls = 0;
   for (int step = 0; step < 3; ++step) {
     for (auto &v : x) v += 1e-3 * jitter();
-    long n0 = g_new, c0 = hook.calls;
+    long n0 = g_new, c0 = g_hook;
     g_counting = true;
     const mfree_status_t sp = mfree_particles_update(ps);
     g_counting = false;
     pnew += g_new - n0;
-    pcalls += hook.calls - c0;
+    pcalls += g_hook - c0;
     CHECK(sp == MFREE_SUCCESS, "particles_update: %d", static_cast<int>(sp));
     n0 = g_new;
-    c0 = hook.calls;
+    c0 = g_hook;
     g_counting = true;
     const mfree_status_t sa = mfree_approximant_update(a);
     g_counting = false;
     anew += g_new - n0;
-    acalls += hook.calls - c0;
+    acalls += g_hook - c0;
     CHECK(sa == MFREE_SUCCESS, "approximant_update: %d", static_cast<int>(sa));
     n0 = g_new;
-    c0 = hook.calls;
+    c0 = g_hook;
     g_counting = true;
     mfree_status_t so = mfree_approximant_apply(a, MFREE_OP_GRADIENT, 1, u.data(), MFREE_LAYOUT_AOS, 1,
                                                 out.data(), MFREE_LAYOUT_AOS, dim);
@@ -113,7 +91,7 @@ void run(int dim, int threads, int method) {
                                    MFREE_LAYOUT_AOS, 1);
     g_counting = false;
     onew += g_new - n0;
-    ocalls += hook.calls - c0;
+    ocalls += g_hook - c0;
     CHECK(so == MFREE_SUCCESS, "apply: %d", static_cast<int>(so));
   }
   CHECK(pnew == 0 && pcalls == 0,

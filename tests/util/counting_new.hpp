@@ -1,13 +1,17 @@
-// Replaces the global operator new/delete of a C++ test program and counts the
-// allocations made while g_counting is set (std::vector, std::string and every other
-// allocation of the C++ standard library inside libmfree, which the context's allocator
-// hook cannot see). Include it in exactly one translation unit of the test program (t433,
+// Heap counting for the C++ no-allocation tests (t433, t707): replaces the global
+// operator new/delete of the test program and counts the allocations made while
+// g_counting is set (std::vector, std::string and every other allocation of the C++
+// standard library inside libmfree, which the context's allocator hook cannot see);
+// hook_alloc/hook_free, for mfree_context_set_allocator, count the hook's allocations in
+// g_hook; CHECK/OK count failed checks in `failures` (the program's exit status). Include it in exactly one translation unit of the test program (t433,
 // t707); the test links with -Wno-mismatched-new-delete under GCC, which pairs the
 // replaced delete (free) with the malloc inside the replaced new after inlining.
 #ifndef MFREE_TESTS_COUNTING_NEW_HPP
 #define MFREE_TESTS_COUNTING_NEW_HPP
 
 #include <atomic>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <new>
 
@@ -31,5 +35,25 @@ void operator delete(void *p) noexcept { std::free(p); }
 void operator delete[](void *p) noexcept { std::free(p); }
 void operator delete(void *p, std::size_t) noexcept { std::free(p); }
 void operator delete[](void *p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+std::atomic<long> g_hook{0};  // allocations through the context's allocator hook
+void *hook_alloc(void *, int64_t bytes) {
+  ++g_hook;
+  return std::malloc(static_cast<size_t>(bytes));
+}
+void hook_free(void *, void *p, int64_t) { std::free(p); }
+
+int failures = 0;
+#define CHECK(cond, ...)                 \
+  do {                                   \
+    if (!(cond)) {                       \
+      std::fprintf(stderr, __VA_ARGS__); \
+      std::fprintf(stderr, "\n");        \
+      ++failures;                        \
+    }                                    \
+  } while (0)
+#define OK(call) CHECK((call) == MFREE_SUCCESS, "%s failed at line %d", #call, __LINE__)
+}  // namespace
 
 #endif
