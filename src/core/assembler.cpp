@@ -1064,7 +1064,7 @@ void Assembler::build_pattern() {
                                    std::to_string(static_cast<int64_t>(n) * nc + static_cast<int64_t>(mcols.size())) +
                                    ") for int32 indices");
   const int32_t nbase = n * nc;
-  ndofs_ = nbase + nmult_;
+  ndofs_ = nunknowns;  // = nbase + nmult_, counted once by the size rule above
   // transpose of the multiplier columns: for each dof, the multipliers touching it
   std::vector<std::vector<int32_t>> dof_mult(nbase);
   for (int32_t m = 0; m < nmult_; ++m)
