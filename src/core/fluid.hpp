@@ -64,6 +64,11 @@ class FluidSystem : public System {
   bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
   template <int D>
   bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  // The 2D rows for AVX2 + FMA without the transpose (the dam break's configuration), in
+  // one register-resident kernel: the candidates filtered four at a time, then weights,
+  // the 15 moment sums and the outputs four neighbours at a time, the 3x3 system solved in
+  // closed form (adjugate). The same rows as table_rows<2> to round-off.
+  void table_rows2_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch);
   template <int D>
   bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
                        bool wide);  // wide: the AVX2 copy (gathers, 256-bit sqrt)
@@ -157,7 +162,7 @@ class FluidSystem : public System {
   const double *xbound_ = nullptr;  // node positions ps_ borrows
   int64_t rebuilds_ = 0;
   int64_t maxrow_ = 0;               // longest candidate row
-  std::vector<double> rows_scratch_;  // (dim + 2) maxrow_ per thread
+  std::vector<double> rows_scratch_;  // (dim + 2) (maxrow_ + 8) per thread
   std::vector<int64_t> rows_iscratch_;  // maxrow_ per thread (transposed candidates)
   Csr wall_nbr_;
   // per node (reused): packed quadrature-point data of accel; integrate's states and rates
