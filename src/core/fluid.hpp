@@ -90,6 +90,20 @@ class FluidSystem : public System {
   AccelArgs accel_args(const double *v, const double *rho);
   template <int D>
   void accel_point(int64_t k, const AccelArgs &aa);
+  // Point k's stress sigma_k V_k (from the interpolated velocity vh and the velocity
+  // gradient L at x_k), masses M_k and L_k and wall force F (wall: F != 0), shared by
+  // accel_point and the AVX2 copy of its 2D rows; also fills pack_ when asked.
+  template <int D>
+  struct PointTerms {
+    double S[D][D], Mk, Lk, F[D];
+    bool wall;
+  };
+  template <int D>
+  void point_terms(int64_t k, const AccelArgs &aa, const double (&vh)[D], const double (&L)[D][D], PointTerms<D> &pt);
+  // accel_point<2> for rows [k0, k1) and the 2D kinematics of nodes [k0, k1), four table
+  // entries at a time for AVX2 + FMA (the same sums, rounded differently), chosen per step.
+  void accel_rows2_avx2(int64_t k0, int64_t k1, const AccelArgs &aa);
+  void kinematics2_avx2(int64_t k0, int64_t k1, const double *v, const double *rho, double *vhat, double *drho) const;
   template <int D>
   Report accel_end(const AccelArgs &aa, double *a);
   // Interpolated velocities and density rates for velocity parameters v.
