@@ -812,9 +812,14 @@ MFREE_TARGET_AVX2 void FluidSystem::table_rows2_avx2(int32_t k0, int32_t k1, con
     __m256d a0 = zero, a1 = zero, a2 = zero, a11 = zero, a12 = zero, a22 = zero;
     __m256d b1 = zero, b2 = zero, b11 = zero, b12 = zero, b22 = zero, b111 = zero, b112 = zero, b122 = zero, b222 = zero;
     const __m256i nv = _mm256_set1_epi64x(n);
+    _mm256_storeu_pd(sx + n, zero);  // the last group's lanes past n: offsets 0, weights 0 below
+    _mm256_storeu_pd(sy + n, zero);
+    // weights and the 6 sums of M first, then the 9 of M_,c from the stored gf: two short
+    // loops keep their sums in registers (one loop spilled 9 of 15) and let the out-of-order
+    // core overlap the square roots and divisions of successive groups
     for (int m = 0; m < n; m += 4) {
       const __m256d valid = _mm256_castsi256_pd(_mm256_cmpgt_epi64(nv, _mm256_add_epi64(lane, _mm256_set1_epi64x(m))));
-      const __m256d x1 = _mm256_and_pd(_mm256_loadu_pd(sx + m), valid), x2 = _mm256_and_pd(_mm256_loadu_pd(sy + m), valid);
+      const __m256d x1 = _mm256_loadu_pd(sx + m), x2 = _mm256_loadu_pd(sy + m);
       const __m256d r2 = _mm256_fmadd_pd(x1, x1, _mm256_mul_pd(x2, x2));
       const __m256d r = _mm256_sqrt_pd(r2);
       const __m256d inner = _mm256_cmp_pd(r, one, _CMP_LT_OQ);
@@ -834,16 +839,22 @@ MFREE_TARGET_AVX2 void FluidSystem::table_rows2_avx2(int32_t k0, int32_t k1, con
       a11 = _mm256_fmadd_pd(wx, x1, a11);
       a12 = _mm256_fmadd_pd(wx, x2, a12);
       a22 = _mm256_fmadd_pd(wy, x2, a22);
-      const __m256d g1 = _mm256_mul_pd(g, x1), g2 = _mm256_mul_pd(g, x2);
-      const __m256d g11 = _mm256_mul_pd(g1, x1), g12 = _mm256_mul_pd(g1, x2), g22 = _mm256_mul_pd(g2, x2);
+    }
+    for (int m = 0; m < n; m += 4) {
+      const __m256d x1 = _mm256_loadu_pd(sx + m), x2 = _mm256_loadu_pd(sy + m), g = _mm256_loadu_pd(gv + m);
+      const __m256d g1 = _mm256_mul_pd(g, x1);
       b1 = _mm256_add_pd(b1, g1);
-      b2 = _mm256_add_pd(b2, g2);
+      const __m256d g11 = _mm256_mul_pd(g1, x1);
       b11 = _mm256_add_pd(b11, g11);
-      b12 = _mm256_add_pd(b12, g12);
-      b22 = _mm256_add_pd(b22, g22);
       b111 = _mm256_fmadd_pd(g11, x1, b111);
       b112 = _mm256_fmadd_pd(g11, x2, b112);
+      const __m256d g12 = _mm256_mul_pd(g1, x2);
+      b12 = _mm256_add_pd(b12, g12);
       b122 = _mm256_fmadd_pd(g12, x2, b122);
+      const __m256d g2 = _mm256_mul_pd(g, x2);
+      b2 = _mm256_add_pd(b2, g2);
+      const __m256d g22 = _mm256_mul_pd(g2, x2);
+      b22 = _mm256_add_pd(b22, g22);
       b222 = _mm256_fmadd_pd(g22, x2, b222);
     }
     double sm[16];
