@@ -801,9 +801,9 @@ MFREE_TARGET_AVX2 void FluidSystem::table_rows2_avx2(int32_t k0, int32_t k1, con
     int64_t e = 0;
     for (; e + 4 <= nc; e += 4) filter4(cc + e, 15);
     if (e < nc) {
-      int32_t jt[4] = {k, k, k, k};
-      for (int l = 0; e + l < nc; ++l) jt[l] = cc[e + l];
-      filter4(jt, (1 << (nc - e)) - 1);
+      const int64_t rest = nc - e;  // 1, 2 or 3 (a loop here became a call of memcpy)
+      const int32_t jt[4] = {cc[e], rest > 1 ? cc[e + 1] : k, rest > 2 ? cc[e + 2] : k, k};
+      filter4(jt, (1 << rest) - 1);
     }
     const int n = q;
     rbeg[k] = o;
@@ -878,14 +878,14 @@ MFREE_TARGET_AVX2 void FluidSystem::table_rows2_avx2(int32_t k0, int32_t k1, con
       const double nc_ = std::max(std::max(std::fabs(C00) + std::fabs(C01) + std::fabs(C02),
                                            std::fabs(C01) + std::fabs(C11) + std::fabs(C12)),
                                   std::fabs(C02) + std::fabs(C12) + std::fabs(C22));
-      cond = na * (nc_ / det);
-      mls = std::isfinite(cond) && cond > 0.0 && 1.0 / cond >= kMinRcond;
+      cond = na * nc_ * (1.0 / det);
+      mls = std::isfinite(cond) && cond > 0.0 && cond <= 1.0 / kMinRcond;  // one division on the row's path
       if (!mls) cond = 1.0;
     }
     cond_[k] = cond;
     if (mls && !(cond > tol)) {
       // 003 eqs 27-31 as in table_rows_body: g = M^-1 p(0), g_,c = M^-1 (e_c / h - M_,c g)
-      const double id = 1.0 / det;
+      const double id = 1.0 / det;  // the same division as above (the compiler keeps one)
       const double X00 = C00 * id, X01 = C01 * id, X02 = C02 * id, X11 = C11 * id, X12 = C12 * id, X22 = C22 * id;
       const double g0 = X00, g1 = X01, g2 = X02;
       // M_,1 = [[B1 B11 B12] [B11 B111 B112] [B12 B112 B122]] / h, M_,2 = [[B2 B12 B22] [B12 B112 B122] [B22 B122 B222]] / h
