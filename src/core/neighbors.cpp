@@ -200,7 +200,10 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   for_chunks(nch, [&](int v) {
     int64_t b, e;
     thread_block(n, v, nch, b, e);
-    Part &p = part[v];
+    // accumulated in a local copy: the chunks' Part records share cache lines, and
+    // updating them in place per particle made this pass slower on two threads than on
+    // one (false sharing)
+    Part p;
     for (int64_t i = b; i < e; ++i) {
       if (status[i] != 0) {
         rad_[i] = 0.0;
@@ -218,6 +221,7 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
       }
       ++p.count;
     }
+    part[v] = p;
   });
   double rsum = 0.0, rmin = 0.0, bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};
   for (int v = 0; v < nch; ++v) {
