@@ -51,8 +51,9 @@ class FluidSystem : public System {
 
  private:
   void check_ready() const;
-  // Validate the state and build the shape-function tables at the nodes (below).
-  Report prepare(const double *y);
+  // Validate the state (unless checked: integrate's state after a step, which
+  // check_state has just passed) and build the shape-function tables at the nodes (below).
+  Report prepare(const double *y, bool checked = false);
   // Candidate neighbour lists (Verlet lists with a skin, see tables_) for the node
   // positions xn, rebuilt when a node moved more than half the skin since the last build.
   Report candidates(const double *xn);
