@@ -1128,7 +1128,8 @@ MFREE_ALWAYS_INLINE void FluidSystem::point_terms(int64_t k, const AccelArgs &ar
       S[aa][bb] = ((aa == bb ? -p : 0.0) + 2.0 * mu_ * d) * Vk;
     }
   const double Mk = mass[k];
-  const double Lk = k < n_ ? mass[k] / share(static_cast<int32_t>(k)) : 0.0;  // dummies carry no fluid mass
+  // dummies carry no fluid mass; without dummies share() is 1 (no division on the row's path)
+  const double Lk = k < n_ ? (dummy_.n ? mass[k] / dummy_.share[k] : mass[k]) : 0.0;
   pt.Mk = Mk;
   pt.Lk = Lk;
   double(&F)[D] = pt.F;
@@ -1280,6 +1281,13 @@ Report FluidSystem::accel_end(const AccelArgs &aa, double *a) {
         continue;
       }
       // the boundary force acts as an acceleration (003 Sect. 6.1 step 7)
+#ifdef __SSE2__
+      if constexpr (D == 2) {  // both components in one division (the same operations)
+        const __m128d f = _mm_add_pd(_mm_loadu_pd(ai), _mm_mul_pd(_mm_set1_pd(ai[D]), _mm_loadu_pd(g_)));
+        _mm_storeu_pd(a + i * D, _mm_add_pd(_mm_div_pd(f, _mm_set1_pd(m)), _mm_loadu_pd(ai + D + 2)));
+        continue;
+      }
+#endif
       for (int c = 0; c < D; ++c) a[i * D + c] = (ai[c] + ai[D] * g_[c]) / m + ai[D + 2 + c];
     }
   });
