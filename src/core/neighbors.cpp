@@ -28,6 +28,11 @@
 #include "kernel.hpp"
 #include "parallel.hpp"
 #include "particles.hpp"
+#include "simd.hpp"
+
+#if MFREE_SIMD_X86
+#include <immintrin.h>
+#endif
 
 namespace mfree {
 
@@ -592,6 +597,46 @@ inline void row_min_max(const int32_t *b, const int32_t *e, int32_t init_min, in
   mm[1] = z;
 }
 
+#if MFREE_SIMD_X86
+// The same with AVX2's 32-bit min/max, eight lanes (the last eight entries reloaded for
+// the tail: min and max do not mind an entry counted twice). The baseline copy above
+// was ~6 % of a 2-thread 2D search's work (the tracking only the threaded transposition
+// needs), this one about a third of that. Same values, so the same lists.
+MFREE_TARGET_AVX2 void row_min_max_avx2(const int32_t *b, const int32_t *e, int32_t init_min, int32_t *mm) {
+  if (e - b < 8) {
+    int32_t a = init_min, z = -1;
+    for (; b < e; ++b) {
+      a = *b < a ? *b : a;
+      z = *b > z ? *b : z;
+    }
+    mm[0] = a;
+    mm[1] = z;
+    return;
+  }
+  __m256i va = _mm256_set1_epi32(init_min), vz = _mm256_set1_epi32(-1);
+  const int32_t *p = b;
+  for (; e - p >= 8; p += 8) {
+    const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(p));
+    va = _mm256_min_epi32(va, v);
+    vz = _mm256_max_epi32(vz, v);
+  }
+  if (p < e) {
+    const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(e - 8));
+    va = _mm256_min_epi32(va, v);
+    vz = _mm256_max_epi32(vz, v);
+  }
+  __m128i a4 = _mm_min_epi32(_mm256_castsi256_si128(va), _mm256_extracti128_si256(va, 1));
+  __m128i z4 = _mm_max_epi32(_mm256_castsi256_si128(vz), _mm256_extracti128_si256(vz, 1));
+  a4 = _mm_min_epi32(a4, _mm_shuffle_epi32(a4, 0x4e));
+  z4 = _mm_max_epi32(z4, _mm_shuffle_epi32(z4, 0x4e));
+  a4 = _mm_min_epi32(a4, _mm_shuffle_epi32(a4, 0xb1));
+  z4 = _mm_max_epi32(z4, _mm_shuffle_epi32(z4, 0xb1));
+  mm[0] = _mm_cvtsi128_si32(a4);
+  mm[1] = _mm_cvtsi128_si32(z4);
+  _mm256_zeroupper();
+}
+#endif
+
 }  // namespace
 
 // Buffers of a search, kept by a particle set between searches (sizes settle after the
@@ -644,6 +689,19 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
   const bool track = symmetric && num_threads(nsites) > 1 && nt > 1;
   if (track) sc.lo_hi.resize(2 * static_cast<size_t>(nsites));
   int32_t *lo_hi = sc.lo_hi.data();
+#if MFREE_SIMD_X86
+  const bool avx2 = track && simd::use_avx2();
+#endif
+  auto min_max = [&](const int32_t *b, const int32_t *e, int32_t s) {
+    int32_t *mm = lo_hi + 2 * static_cast<size_t>(s);
+#if MFREE_SIMD_X86
+    if (avx2) {
+      row_min_max_avx2(b, e, nsites, mm);
+      return;
+    }
+#endif
+    row_min_max(b, e, nsites, mm);
+  };
   size_t used[64];
   for_chunks(nt, [&](int t) {
     int64_t b, e;
@@ -674,13 +732,13 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
       if (!symmetric) {
         sort_row(cols.data() + r0, cols.data() + cnt);
       } else if (track) {
-        if (prev >= 0) row_min_max(cols.data() + p0, cols.data() + p1, nsites, lo_hi + 2 * static_cast<size_t>(prev));
+        if (prev >= 0) min_max(cols.data() + p0, cols.data() + p1, prev);
         prev = s;
         p0 = r0;
         p1 = cnt;
       }
     }
-    if (prev >= 0) row_min_max(cols.data() + p0, cols.data() + p1, nsites, lo_hi + 2 * static_cast<size_t>(prev));
+    if (prev >= 0) min_max(cols.data() + p0, cols.data() + p1, prev);
     used[t] = cnt;
   });
   // row lengths by site, then prefix sums; each block knows its own buffer's end
