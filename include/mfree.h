@@ -349,7 +349,10 @@ MFREE_API mfree_status_t mfree_context_get_num_threads(const mfree_context_t *ct
  * back to the free function of the allocator that made it, even after the allocator is
  * changed, so alloc, release and user must stay valid until the objects that used them
  * are destroyed. After the first setup, mfree_approximant_update and _apply allocate
- * nothing. Both NULL restores malloc (the default).
+ * nothing. Both NULL restores the default: malloc, and on Linux with transparent huge
+ * pages available, blocks of 2 MiB or more from mappings of their own advised
+ * MADV_HUGEPAGE (fewer page faults and TLB misses; MFREE_HUGEPAGES=0 in the environment
+ * turns this off).
  * @param[in] alloc    allocation function, or NULL
  * @param[in] release  matching free function, or NULL (both NULL or neither)
  * @param[in] user     passed to both; not dereferenced by mfree
