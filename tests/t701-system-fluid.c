@@ -202,6 +202,21 @@ static void test_failures(void **s) {
   y[4 * N + 5] = -1.0;
   assert_error(ctx, mfree_system_rhs(sys, 0.0, y, yd), MFREE_FAIL_INVALID_DATA, "particle 5");
   y[4 * N + 5] = keep;
+  /* the state check's fast path (src/core/fluid.cpp) works on pairs of densities and
+   * whole particles: the last particle, an infinite density, a position, two at once */
+  keep = y[4 * N + N - 1];
+  y[4 * N + N - 1] = INFINITY;
+  assert_error(ctx, mfree_system_rhs(sys, 0.0, y, yd), MFREE_FAIL_NONFINITE, "particle 143");
+  y[4 * N + N - 1] = keep;
+  keep = y[2 * (N - 1) + 1];
+  y[2 * (N - 1) + 1] = -INFINITY;
+  assert_error(ctx, mfree_system_rhs(sys, 0.0, y, yd), MFREE_FAIL_NONFINITE, "particle 143");
+  const double keep2 = y[2 * 40];
+  y[2 * 40] = NAN;
+  assert_error(ctx, mfree_system_rhs(sys, 0.0, y, yd), MFREE_FAIL_NONFINITE, "particle 40 ");
+  y[2 * (N - 1) + 1] = keep;
+  y[2 * 40] = keep2;
+  assert_ok(ctx, mfree_system_rhs(sys, 0.0, y, yd));
 
   /* a fixed step above the CFL limit: positive status before anything changes */
   double *y0 = malloc(5 * sizeof(double) * N);

@@ -163,6 +163,33 @@ Report FluidSystem::check_state(const double *y, int64_t step) const {
     // the common case first: branch-free over flat arrays (vectorisable), then the
     // particle-by-particle search only in a block that holds an invalid particle
     bool bad = false;
+#ifdef __SSE2__
+    if (dim == 2) {  // two particles (densities) and one particle (x, v) per operation
+      const __m128d big = _mm_set1_pd(DBL_MAX), zero = _mm_setzero_pd();
+      const __m128d absm = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffLL));
+      const __m128d lo = _mm_setr_pd(lo_[0], lo_[1]), hi = _mm_setr_pd(hi_[0], hi_[1]);
+      __m128d ok = _mm_castsi128_pd(_mm_set1_epi64x(-1));
+      int64_t i = b;
+      for (; i + 2 <= e; i += 2) {
+        const __m128d r = _mm_loadu_pd(rho + i);
+        ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmpgt_pd(r, zero), _mm_cmple_pd(r, big)));
+      }
+      for (; i < e; ++i) bad |= !(rho[i] > 0.0) | !(rho[i] <= DBL_MAX);
+      for (i = b; i < e; ++i) {
+        const __m128d xi = _mm_loadu_pd(x + 2 * i), vi = _mm_loadu_pd(v + 2 * i);
+        ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmple_pd(_mm_and_pd(xi, absm), big), _mm_cmple_pd(_mm_and_pd(vi, absm), big)));
+        if (box_) ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmpge_pd(xi, lo), _mm_cmple_pd(xi, hi)));
+      }
+      if (bad || _mm_movemask_pd(ok) != 3) {
+        for (int64_t k = b; k < e; ++k)
+          if (!valid(k)) {
+            first[t] = static_cast<int32_t>(k);
+            break;
+          }
+      }
+      return;
+    }
+#endif
     for (int64_t i = b; i < e; ++i) bad |= !(rho[i] > 0.0) | !(rho[i] <= DBL_MAX);
     for (int64_t q = b * dim; q < e * dim; ++q) bad |= !(std::fabs(v[q]) <= DBL_MAX) | !(std::fabs(x[q]) <= DBL_MAX);
     if (box_)
