@@ -150,6 +150,36 @@ class CellGrid {
   }
   template <int D, bool Periodic, bool Gather>
   void query_t(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const;
+  // The counting sort's two particle passes for particles [b, e), with the dimension and
+  // the periodicity as template parameters (no per-axis loops and branches; the same
+  // arithmetic as wrap/cell_of, so the same cells): cell[i] of each valid particle
+  // (-1: invalid) counted in cnt[cell], then the scatter by the fill positions pos.
+  template <int D, bool Periodic, class Cnt>
+  void cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int64_t *cell, Cnt *cnt) const;
+  template <int D, bool Periodic, class Pos>
+  void scatter_t(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int64_t *cell, Pos *pos);
+  template <class Cnt>
+  void cells(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int64_t *cell, Cnt *cnt) const {
+    switch (dim_ * 2 + (any_periodic_ ? 1 : 0)) {
+      case 2: cells_t<1, false>(ps, status, b, e, cell, cnt); break;
+      case 3: cells_t<1, true>(ps, status, b, e, cell, cnt); break;
+      case 4: cells_t<2, false>(ps, status, b, e, cell, cnt); break;
+      case 5: cells_t<2, true>(ps, status, b, e, cell, cnt); break;
+      case 6: cells_t<3, false>(ps, status, b, e, cell, cnt); break;
+      default: cells_t<3, true>(ps, status, b, e, cell, cnt); break;
+    }
+  }
+  template <class Pos>
+  void scatter(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int64_t *cell, Pos *pos) {
+    switch (dim_ * 2 + (any_periodic_ ? 1 : 0)) {
+      case 2: scatter_t<1, false>(ps, kappa, b, e, cell, pos); break;
+      case 3: scatter_t<1, true>(ps, kappa, b, e, cell, pos); break;
+      case 4: scatter_t<2, false>(ps, kappa, b, e, cell, pos); break;
+      case 5: scatter_t<2, true>(ps, kappa, b, e, cell, pos); break;
+      case 6: scatter_t<3, false>(ps, kappa, b, e, cell, pos); break;
+      default: scatter_t<3, true>(ps, kappa, b, e, cell, pos); break;
+    }
+  }
   template <int D, bool Periodic, bool Gather>
   size_t scan(const double *xq, double ri, const Rule &rule, int64_t p0, int64_t p1, int32_t *out,
               size_t k) const;
@@ -322,24 +352,9 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   // (per-chunk histograms only while they stay small against the particle count)
   if (nch == 1 || static_cast<double>(nch) * static_cast<double>(nc) > 8.0 * (static_cast<double>(n) + 4096.0)) {
     std::fill(start_.begin(), start_.end(), 0);
-    for (int32_t i = 0; i < n; ++i) {
-      if (status[i] != 0) {
-        cell[i] = -1;
-        continue;
-      }
-      double x[3] = {0, 0, 0};
-      for (int c = 0; c < dim_; ++c) x[c] = wrap(ps.x(i, c), c);
-      cell[i] = cell_of(x);
-      ++start_[cell[i] + 1];
-    }
+    cells(ps, status.data(), 0, n, cell, start_.data() + 1);
     for (int64_t c = 0; c < nc; ++c) start_[c + 1] += start_[c];
-    for (int32_t i = 0; i < n; ++i) {
-      if (cell[i] < 0) continue;
-      const int64_t p = start_[cell[i]]++;
-      id_[p] = i;
-      if (need_srad_) srad_[p] = kappa * ps.h(i);
-      for (int c = 0; c < dim_; ++c) sx_[c][p] = wrap(ps.x(i, c), c);
-    }
+    scatter(ps, kappa, 0, n, cell, start_.data());
     // start_[c] now holds the old start_[c + 1]: shift back
     for (int64_t c = nc; c > 0; --c) start_[c] = start_[c - 1];
     start_[0] = 0;
@@ -353,16 +368,7 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
     std::fill(h, h + nc, 0);
     int64_t b, e;
     thread_block(n, v, nch, b, e);
-    for (int64_t i = b; i < e; ++i) {
-      if (status[i] != 0) {
-        cell[i] = -1;
-        continue;
-      }
-      double x[3] = {0, 0, 0};
-      for (int c = 0; c < dim_; ++c) x[c] = wrap(ps.x(static_cast<int32_t>(i), c), c);
-      cell[i] = cell_of(x);
-      ++h[cell[i]];
-    }
+    cells(ps, status.data(), b, e, cell, h);
   });
   // prefix sums over (cell, chunk), two passes over cell blocks
   int64_t block_total[64];
@@ -392,14 +398,39 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
     int32_t *f = hist + static_cast<int64_t>(v) * nc;
     int64_t b, e;
     thread_block(n, v, nch, b, e);
-    for (int64_t i = b; i < e; ++i) {
-      if (cell[i] < 0) continue;
-      const int32_t p = f[cell[i]]++;
-      id_[p] = static_cast<int32_t>(i);
-      if (need_srad_) srad_[p] = kappa * ps.h(static_cast<int32_t>(i));
-      for (int c = 0; c < dim_; ++c) sx_[c][p] = wrap(ps.x(static_cast<int32_t>(i), c), c);
-    }
+    scatter(ps, kappa, b, e, cell, f);
   });
+}
+
+template <int D, bool Periodic, class Cnt>
+void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int64_t *cell,
+                       Cnt *cnt) const {
+  for (int64_t i = b; i < e; ++i) {
+    if (status[i] != 0) {
+      cell[i] = -1;
+      continue;
+    }
+    const int32_t p = static_cast<int32_t>(i);
+    // index() order: id = (k2 * nc1 + k1) * nc0 + k0
+    int64_t id = 0;
+    for (int c = D - 1; c >= 0; --c) id = id * nc_[c] + coord(Periodic ? wrap(ps.x(p, c), c) : ps.x(p, c), c);
+    cell[i] = id;
+    ++cnt[id];
+  }
+}
+
+template <int D, bool Periodic, class Pos>
+void CellGrid::scatter_t(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int64_t *cell, Pos *pos) {
+  double *x[3] = {sx_[0].data(), sx_[D > 1 ? 1 : 0].data(), sx_[D > 2 ? 2 : 0].data()};
+  int32_t *id = id_.data();
+  for (int64_t i = b; i < e; ++i) {
+    if (cell[i] < 0) continue;
+    const int32_t p = static_cast<int32_t>(i);
+    const int64_t q = pos[cell[i]]++;
+    id[q] = p;
+    for (int c = 0; c < D; ++c) x[c][q] = Periodic ? wrap(ps.x(p, c), c) : ps.x(p, c);
+    if (need_srad_) srad_[q] = kappa * ps.h(p);
+  }
 }
 
 // Members [p0, p1) within the limit of xq, written from out[k]; returns the new count.
