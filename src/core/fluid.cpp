@@ -787,7 +787,7 @@ MFREE_TARGET_AVX2 MFREE_ALWAYS_INLINE __m256d hsum4(__m256d a, __m256d b, __m256
 // spline f = 1 - 3/2 r^2 + 3/4 r^3 (r < 1), (2 - r)^3 / 4 (1 <= r < 2) and
 // gf = -f'(r) / r = 3 - 9/4 r, 3/4 (2 - r)^2 / r in Horner form with a blend (the same
 // functions as table_rows_body's B-spline pieces, rounded differently), and the 15 moment
-// sums in registers; (C) the 3x3 moment matrix inverted by its adjugate, positive
+// sums in registers (6 with the weights, 9 in a second loop); (C) the 3x3 moment matrix inverted by its adjugate, positive
 // definiteness by its leading minors (Sylvester; LDL^T's pivots up to rounding), the exact
 // 1-norm condition number as before; (D) the values and gradients four at a time, the
 // gradients interleaved (x, y) by two unpacks and two lane permutes. The last group of a
