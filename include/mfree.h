@@ -1139,7 +1139,11 @@ MFREE_API mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const do
  * capped by dt_max (0: no cap). With cfl <= 0 the step is dt_max, and a step above the
  * CFL limit returns MFREE_FAIL_CFL before anything is changed. A non-finite state or a
  * particle outside the box stops the run with a positive status naming the step and
- * particle; y and *t then hold the last good state.
+ * particle; y and *t then hold the last good state. The message names the step that
+ * failed, nsteps + 1 ("(predictor)": the predictor-corrector's half step). A step that
+ * no longer advances t stops the run the same way with MFREE_FAIL_CFL: speeds so large
+ * that the CFL step is 0 (|v|^2 or gamma kappa / rho overflow; the fastest particle is
+ * named), or dt_max below the resolution of t.
  * @param[in,out] y   state, updated in place
  * @param[in,out] t   time
  * @param[out] nsteps steps taken (may be NULL)

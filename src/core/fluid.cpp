@@ -1645,6 +1645,30 @@ double FluidSystem::stable_dt(const double *y) const {
   return cmax > 0.0 ? h_ / cmax : INFINITY;
 }
 
+namespace {
+// A failure inside integrate's step `step` (1 for the first): the message names it.
+Report step_failed(Report r, int64_t step, const char *stage) {
+  r.message = "step " + std::to_string(step) + stage + ": " + r.message;
+  return r;
+}
+}  // namespace
+
+std::string FluidSystem::fastest(const double *y) const {
+  const size_t nd = static_cast<size_t>(dim_) * n_;
+  const double *v = y + nd, *rho = y + 2 * nd;
+  int32_t imax = 0;
+  double smax = -1.0;
+  for (int32_t i = 0; i < n_; ++i) {  // without overflow in |v|: hypot
+    double vi = 0.0;
+    for (int c = 0; c < dim_; ++c) vi = std::hypot(vi, v[static_cast<size_t>(i) * dim_ + c]);
+    const double si = std::sqrt(gamma_ * kappa_ / rho[i]) + vi;
+    if (si > smax) smax = si, imax = i;
+  }
+  std::ostringstream s;
+  s << " (fastest: particle " << imax << ", c + |v| = " << smax << ")";
+  return s.str();
+}
+
 Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                               mfree_progress_fn progress, void *user, int64_t &nsteps) {
   if (scheme != MFREE_INTEGRATOR_LEAPFROG && scheme != MFREE_INTEGRATOR_PREDICTOR_CORRECTOR)
@@ -1675,7 +1699,16 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
     if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
     if (cfl <= 0.0 && dt > limit) {
       std::ostringstream s;
-      s << "step " << nsteps << ": dt = " << dt << " exceeds the CFL limit " << limit << " (003 eq 120)";
+      s << "step " << nsteps + 1 << ": dt = " << dt << " exceeds the CFL limit " << limit << " (003 eq 120)";
+      rep.fail(MFREE_FAIL_CFL, s.str());
+      return rep;
+    }
+    if (!(t + dt > t) && dt < t_end - t) {
+      // speeds so large that h / max(c + |v|) is 0 (|v|^2 or gamma kappa / rho overflow)
+      // or a step below t's resolution: the loop would never end
+      std::ostringstream s;
+      s << "step " << nsteps + 1 << ": the step dt = " << dt << " no longer advances t = " << t;
+      if (cfl > 0.0) s << fastest(y) << " (003 eq 120)";
       rep.fail(MFREE_FAIL_CFL, s.str());
       return rep;
     }
@@ -1686,7 +1719,7 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
       // 003 Sect. 6.1: a from (x^k, rho^k, v^{k-1/2}); v^{k+1/2} = v + dt a; density rates
       // and interpolated velocities with v^{k+1/2} on the tables at x^k
       Report r = accel(v, rho, rate);
-      if (!r.ok()) return r;
+      if (!r.ok()) return step_failed(r, nsteps + 1, "");
       const int nt = light_threads(n_);
       parallel_blocks(static_cast<int64_t>(nd), nt, [&](int, int64_t b, int64_t e) {
         for (int64_t q = b; q < e; ++q) yn[nd + q] = v[q] + dt * rate[q];
@@ -1697,18 +1730,16 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
         for (int64_t i = b; i < e; ++i) yn[2 * nd + i] = rho[i] + dt * dr[i];
       });
     } else {
-      // 003 eqs 111-119
-      Report r = rhs(t, y, rate);
-      if (!r.ok()) return r;
+      // 003 eqs 111-119; f(t, y) on the tables prepared above
+      Report r = accel(v, rho, rate + nd);
+      if (!r.ok()) return step_failed(r, nsteps + 1, "");
+      kinematics(v, rho, rate, rate + 2 * nd);
       double *yp = stage_.data();
       for (size_t q = 0; q < ny; ++q) yp[q] = y[q] + 0.5 * dt * rate[q];
       r = prepare(yp);
-      if (!r.ok()) {
-        r.message = "step " + std::to_string(nsteps) + " (predictor): " + r.message;
-        return r;
-      }
+      if (!r.ok()) return step_failed(r, nsteps + 1, " (predictor)");  // the step being taken, as below
       r = accel(yp + nd, yp + 2 * nd, rate);
-      if (!r.ok()) return r;
+      if (!r.ok()) return step_failed(r, nsteps + 1, " (predictor)");
       for (size_t q = 0; q < nd; ++q) yn[nd + q] = v[q] + 0.5 * dt * rate[q];  // v^C
       kinematics(yn + nd, yp + 2 * nd, vh, dr);
       for (int32_t i = 0; i < n_; ++i) yn[2 * nd + i] = rho[i] + 0.5 * dt * dr[i];  // rho^C

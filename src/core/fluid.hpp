@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "approximant.hpp"
@@ -110,6 +111,7 @@ class FluidSystem : public System {
   // Interpolated velocities and density rates for velocity parameters v.
   void kinematics(const double *v, const double *rho, double *vhat, double *drho) const;
   double stable_dt(const double *y) const;  // h / max(c_i + |v_i|)
+  std::string fastest(const double *y) const;  // message part naming the particle of max c_i + |v_i|
   // The first invalid particle of y, if any; step >= 0 prefixes the message with it.
   Report check_state(const double *y, int64_t step) const;
   double tait(double rho, double rho0) const;  // (rho / rho0)^gamma
