@@ -269,7 +269,9 @@ typedef struct mfree_system mfree_system_t;
 typedef struct mfree_mesh mfree_mesh_t;
 
 /** Progress of a native integration: called after every accepted step; a nonzero
- * return stops the integration (MFREE_SUCCESS is returned, t tells where). */
+ * return stops the integration (MFREE_SUCCESS is returned, t tells where). It may read
+ * the state being integrated but must not change it (the fluid's next step reuses the
+ * check the state has just passed). */
 typedef int32_t (*mfree_progress_fn)(void *user, int64_t step, double t, double dt);
 /** A load history g(t): scales the boundary data of an elastodynamic system. */
 typedef double (*mfree_history_fn)(void *user, double t);
