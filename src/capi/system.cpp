@@ -194,13 +194,15 @@ mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, d
 mfree_status_t mfree_system_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t,
                                       double t_end, double cfl, double dt_max, mfree_progress_fn progress,
                                       void *user, int64_t *nsteps) {
-  return mfree::with_handle(sys, "mfree_system_integrate", [&](mfree::System &f) {
+  // steps taken is written on every return, also when integrate throws part-way
+  int64_t steps = 0;
+  const mfree_status_t status = mfree::with_handle(sys, "mfree_system_integrate", [&](mfree::System &f) {
     MFREE_REQUIRE(t && (y || f.neq() == 0), MFREE_ERR_NULL, "y or t is NULL");
-    int64_t steps = 0;
     mfree::Report rep = f.integrate(scheme, y, *t, t_end, cfl, dt_max, progress, user, steps);
-    if (nsteps) *nsteps = steps;
     return mfree::finish(sys->ctx, "mfree_system_integrate", rep);
   });
+  if (nsteps) *nsteps = steps;
+  return status;
 }
 
 mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx, mfree_assembler_t *as, double density,
