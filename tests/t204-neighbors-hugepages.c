@@ -17,6 +17,7 @@
  * Skipped where the path is off (not Linux, THP "never", MFREE_HUGEPAGES=0, small page
  * other than 4 KiB). No timing.
  */
+#include "count_alloc.h"
 #include "testutil.h"
 
 #include <math.h>
@@ -64,23 +65,6 @@ static long advised_kib(void) {
   return total;
 }
 
-typedef struct {
-  int64_t calls, frees, held;
-} counter_t;
-
-static void *count_alloc(void *user, int64_t bytes) {
-  counter_t *c = (counter_t *)user;
-  ++c->calls;
-  c->held += bytes;
-  return malloc((size_t)bytes);
-}
-
-static void count_free(void *user, void *p, int64_t bytes) {
-  counter_t *c = (counter_t *)user;
-  ++c->frees;
-  c->held -= bytes;
-  free(p);
-}
 
 enum { M = 320 }; /* 102,400 particles */
 
@@ -199,7 +183,7 @@ static void test_huge_pages(void **state) {
     }
   }
   /* a hook installed: the host's memory, balanced, and the same lists */
-  counter_t c = {0, 0, 0};
+  counter_t c = {0, 0, 0, -1};
   mfree_context_t *ctx = NULL;
   assert_ok(NULL, mfree_context_create(&ctx));
   assert_ok(ctx, mfree_context_set_allocator(ctx, count_alloc, count_free, &c));

@@ -8,27 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "count_alloc.h"
 #include "testutil.h"
 
-typedef struct {
-  int64_t calls, frees, held;
-  int64_t fail_after; /* allocations allowed before failing; < 0: never fail */
-} counter_t;
-
-static void *count_alloc(void *user, int64_t bytes) {
-  counter_t *c = (counter_t *)user;
-  if (c->fail_after >= 0 && c->calls >= c->fail_after) return NULL;
-  ++c->calls;
-  c->held += bytes;
-  return malloc((size_t)bytes);
-}
-
-static void count_free(void *user, void *p, int64_t bytes) {
-  counter_t *c = (counter_t *)user;
-  ++c->frees;
-  c->held -= bytes;
-  free(p);
-}
 
 /* A jittered m^dim lattice, spacing 1, h = 1.3 (about 21 / 70 neighbours in 2D / 3D). */
 static mfree_particles_t *lattice(mfree_context_t *ctx, int dim, int m, double **xout) {
