@@ -6,6 +6,11 @@
 #include "approximant.hpp"
 #include "basis.hpp"
 #include "parallel.hpp"
+#include "simd.hpp"
+
+#if MFREE_SIMD_X86
+#include <immintrin.h>
+#endif
 
 
 namespace mfree {
@@ -148,6 +153,92 @@ void gradient_rows_v2(int64_t b, int64_t e, const int64_t *rowptr, const int32_t
 }
 #endif
 
+#if MFREE_SIMD_X86
+// AVX2 + FMA copy for the 3D gradient of NC = 1 or 3 fields, chosen once per apply with
+// simd::use_avx2() (MFREE_SIMD=baseline keeps the two-lane kernel above). The two-lane
+// kernel needs ~15 (scalar) and ~32 (3-vector) instructions per table entry; here an
+// entry costs one or three 4-lane FMAs. Every output is summed in ONE fixed order for
+// both NC: two partial sums, fma(g_d, u_c, .) over the row's entries at even and at odd
+// positions, in row order from 0, then even + odd. For NC = 1 the lanes are d (gradient
+// components), for NC = 3 the lanes of accumulator d are the fields c: the same
+// operations on each output, so a field's gradient is bitwise the same whether applied
+// alone or as part of a 3-vector, and (a row is always done whole by one thread) for any
+// thread count. Against the baseline kernel the results differ at round-off (fused
+// multiply-add, two partial sums).
+MFREE_AVX2_BEGIN
+namespace avx2 {
+
+template <int NC, bool Add>
+void gradient_rows_3d(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
+                      const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co) {
+  static_assert(NC == 1 || NC == 3, "AVX2 3D kernel: NC = 1 or 3");
+  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);  // lanes 0-2: never reads past an entry
+  int64_t k = rowptr[b];
+  for (int64_t s = b; s < e; ++s) {
+    const int64_t k1 = rowptr[s + 1];
+    double *o = out + s * so;
+    if constexpr (NC == 1) {
+      __m256d p = _mm256_setzero_pd(), q = _mm256_setzero_pd();
+      for (; k + 1 < k1; k += 2) {
+        const double *g = grad + k * 3;
+        const __m256d ga = _mm256_loadu_pd(g);       // lane 3 = next entry's g0: unused lane
+        const __m256d gb = _mm256_maskload_pd(g + 3, m3);
+        p = _mm256_fmadd_pd(ga, _mm256_broadcast_sd(u + cols[k] * ju), p);
+        q = _mm256_fmadd_pd(gb, _mm256_broadcast_sd(u + cols[k + 1] * ju), q);
+      }
+      if (k < k1) {
+        p = _mm256_fmadd_pd(_mm256_maskload_pd(grad + k * 3, m3), _mm256_broadcast_sd(u + cols[k] * ju), p);
+        ++k;
+      }
+      alignas(32) double r[4];
+      _mm256_store_pd(r, _mm256_add_pd(p, q));
+      for (int d = 0; d < 3; ++d) {
+        if (Add) o[d * co] += r[d];
+        else o[d * co] = r[d];
+      }
+    } else {
+      __m256d p0 = _mm256_setzero_pd(), p1 = p0, p2 = p0, q0 = p0, q1 = p0, q2 = p0;
+      auto field = [&](int64_t j) {
+        const double *uj = u + j * ju;
+        if (cu == 1) return _mm256_maskload_pd(uj, m3);
+        return _mm256_set_pd(0.0, uj[2 * cu], uj[cu], uj[0]);
+      };
+      for (; k + 1 < k1; k += 2) {
+        const double *g = grad + k * 3;
+        const __m256d ua = field(cols[k]), ub = field(cols[k + 1]);
+        p0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 0), ua, p0);
+        p1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 1), ua, p1);
+        p2 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 2), ua, p2);
+        q0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 3), ub, q0);
+        q1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 4), ub, q1);
+        q2 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 5), ub, q2);
+      }
+      if (k < k1) {
+        const double *g = grad + k * 3;
+        const __m256d ua = field(cols[k]);
+        p0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 0), ua, p0);
+        p1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 1), ua, p1);
+        p2 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 2), ua, p2);
+        ++k;
+      }
+      alignas(32) double r[3][4];
+      _mm256_store_pd(r[0], _mm256_add_pd(p0, q0));
+      _mm256_store_pd(r[1], _mm256_add_pd(p1, q1));
+      _mm256_store_pd(r[2], _mm256_add_pd(p2, q2));
+      for (int c = 0; c < 3; ++c)
+        for (int d = 0; d < 3; ++d) {
+          double &w = o[(c * 3 + d) * co];
+          if (Add) w += r[d][c];
+          else w = r[d][c];
+        }
+    }
+  }
+}
+
+}  // namespace avx2
+MFREE_AVX2_END
+#endif
+
 template <int D, int NC, bool Add>
 void gradient_rows_best(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
                         const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co) {
@@ -163,7 +254,22 @@ void gradient_rows_best(int64_t b, int64_t e, const int64_t *rowptr, const int32
 template <int D>
 void gradient_block(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
                     int ncomp, const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co,
-                    bool add) {
+                    bool add, bool use_avx) {
+#if MFREE_SIMD_X86
+  if constexpr (D == 3) {
+    if (use_avx && (ncomp == 1 || ncomp == 3)) {
+      if (ncomp == 1) {
+        if (add) avx2::gradient_rows_3d<1, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+        else avx2::gradient_rows_3d<1, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+      } else {
+        if (add) avx2::gradient_rows_3d<3, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+        else avx2::gradient_rows_3d<3, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+      }
+      return;
+    }
+  }
+#endif
+  (void)use_avx;
 #define MFREE_GRAD_FIXED(NC)                                                                        \
   case NC:                                                                                          \
     if (add) gradient_rows_best<D, NC, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);  \
@@ -191,12 +297,14 @@ void Approximant::apply(int op, int ncomp, const double *u, int ulayout, int64_t
   const int64_t *rp = rowptr_.data();
   const int32_t *cl = cols_.data();
   const int nt = num_threads(static_cast<int64_t>(cols_.size()) / 8);
+  // once per call: every thread runs the same copy
+  const bool use_avx = op == MFREE_OP_GRADIENT && dim == 3 && simd::use_avx2();
   // output rows [b, e)
   auto rows = [&](int64_t b, int64_t e) {
     if (op == MFREE_OP_GRADIENT) {
-      if (dim == 1) gradient_block<1>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
-      else if (dim == 2) gradient_block<2>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
-      else gradient_block<3>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add);
+      if (dim == 1) gradient_block<1>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add, false);
+      else if (dim == 2) gradient_block<2>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add, false);
+      else gradient_block<3>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add, use_avx);
       return;
     }
     double acc[kBlock];
