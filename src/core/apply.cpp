@@ -154,7 +154,7 @@ void gradient_rows_v2(int64_t b, int64_t e, const int64_t *rowptr, const int32_t
 #endif
 
 #if MFREE_SIMD_X86
-// AVX2 + FMA copy for the 3D gradient of NC = 1 or 3 fields, chosen once per apply with
+// AVX2 + FMA copies for the 2D and 3D gradient of NC = 1 or 3 fields, chosen once per apply with
 // simd::use_avx2() (MFREE_SIMD=baseline keeps the two-lane kernel above). The two-lane
 // kernel needs ~15 (scalar) and ~32 (3-vector) instructions per table entry; here an
 // entry costs one or three 4-lane FMAs. Every output is summed in ONE fixed order for
@@ -235,6 +235,76 @@ void gradient_rows_3d(int64_t b, int64_t e, const int64_t *rowptr, const int32_t
   }
 }
 
+// The 2D copy, same summation rule: two partial sums per output (entries at even and at
+// odd positions of the row, fma in row order, then even + odd). NC = 1 takes two entries
+// per vector (lanes 0-1: the even entry's g0, g1; lanes 2-3: the odd one's), NC = 3 one
+// accumulator per gradient component with the fields in lanes 0-2, so that a field's
+// gradient is bitwise the same alone or inside a 3-vector.
+template <int NC, bool Add>
+void gradient_rows_2d(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
+                      const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co) {
+  static_assert(NC == 1 || NC == 3, "AVX2 2D kernel: NC = 1 or 3");
+  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);  // lanes 0-2
+  int64_t k = rowptr[b];
+  for (int64_t s = b; s < e; ++s) {
+    const int64_t k1 = rowptr[s + 1];
+    double *o = out + s * so;
+    if constexpr (NC == 1) {
+      __m256d p = _mm256_setzero_pd();
+      for (; k + 1 < k1; k += 2) {
+        const __m256d g = _mm256_loadu_pd(grad + k * 2);
+        const __m256d uu = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loaddup_pd(u + cols[k] * ju)),
+                                                _mm_loaddup_pd(u + cols[k + 1] * ju), 1);
+        p = _mm256_fmadd_pd(g, uu, p);
+      }
+      if (k < k1) {  // the last entry of an odd row is an even one: lanes 0-1 only
+        const __m128d lo = _mm_fmadd_pd(_mm_loadu_pd(grad + k * 2), _mm_loaddup_pd(u + cols[k] * ju),
+                                        _mm256_castpd256_pd128(p));
+        p = _mm256_insertf128_pd(p, lo, 0);
+        ++k;
+      }
+      alignas(32) double r[4];
+      _mm256_store_pd(r, p);
+      for (int d = 0; d < 2; ++d) {
+        const double v = r[d] + r[d + 2];
+        if (Add) o[d * co] += v;
+        else o[d * co] = v;
+      }
+    } else {
+      __m256d p0 = _mm256_setzero_pd(), p1 = p0, q0 = p0, q1 = p0;
+      auto field = [&](int64_t j) {
+        const double *uj = u + j * ju;
+        if (cu == 1) return _mm256_maskload_pd(uj, m3);
+        return _mm256_set_pd(0.0, uj[2 * cu], uj[cu], uj[0]);
+      };
+      for (; k + 1 < k1; k += 2) {
+        const double *g = grad + k * 2;
+        const __m256d ua = field(cols[k]), ub = field(cols[k + 1]);
+        p0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 0), ua, p0);
+        p1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 1), ua, p1);
+        q0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 2), ub, q0);
+        q1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 3), ub, q1);
+      }
+      if (k < k1) {
+        const double *g = grad + k * 2;
+        const __m256d ua = field(cols[k]);
+        p0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 0), ua, p0);
+        p1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 1), ua, p1);
+        ++k;
+      }
+      alignas(32) double r[2][4];
+      _mm256_store_pd(r[0], _mm256_add_pd(p0, q0));
+      _mm256_store_pd(r[1], _mm256_add_pd(p1, q1));
+      for (int c = 0; c < 3; ++c)
+        for (int d = 0; d < 2; ++d) {
+          double &w = o[(c * 2 + d) * co];
+          if (Add) w += r[d][c];
+          else w = r[d][c];
+        }
+    }
+  }
+}
+
 }  // namespace avx2
 MFREE_AVX2_END
 #endif
@@ -264,6 +334,18 @@ void gradient_block(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *
       } else {
         if (add) avx2::gradient_rows_3d<3, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
         else avx2::gradient_rows_3d<3, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+      }
+      return;
+    }
+  }
+  if constexpr (D == 2) {
+    if (use_avx && (ncomp == 1 || ncomp == 3)) {
+      if (ncomp == 1) {
+        if (add) avx2::gradient_rows_2d<1, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+        else avx2::gradient_rows_2d<1, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+      } else {
+        if (add) avx2::gradient_rows_2d<3, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+        else avx2::gradient_rows_2d<3, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
       }
       return;
     }
@@ -298,12 +380,12 @@ void Approximant::apply(int op, int ncomp, const double *u, int ulayout, int64_t
   const int32_t *cl = cols_.data();
   const int nt = num_threads(static_cast<int64_t>(cols_.size()) / 8);
   // once per call: every thread runs the same copy
-  const bool use_avx = op == MFREE_OP_GRADIENT && dim == 3 && simd::use_avx2();
+  const bool use_avx = op == MFREE_OP_GRADIENT && (dim == 2 || dim == 3) && simd::use_avx2();
   // output rows [b, e)
   auto rows = [&](int64_t b, int64_t e) {
     if (op == MFREE_OP_GRADIENT) {
       if (dim == 1) gradient_block<1>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add, false);
-      else if (dim == 2) gradient_block<2>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add, false);
+      else if (dim == 2) gradient_block<2>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add, use_avx);
       else gradient_block<3>(b, e, rp, cl, grad_.data(), ncomp, u, ju, cu, out, so, co, add, use_avx);
       return;
     }
