@@ -168,6 +168,48 @@ void gradient_rows_v2(int64_t b, int64_t e, const int64_t *rowptr, const int32_t
 MFREE_AVX2_BEGIN
 namespace avx2 {
 
+// One row of the gradient of NC = 3 fields (D = 2 or 3), entries [k, k1): accumulator d
+// holds d/dx_d of the three fields in lanes 0-2, with the even/odd partial sums of the rule
+// above. Returns k1.
+template <int D, bool Add>
+MFREE_ALWAYS_INLINE int64_t fields3_row(int64_t k, int64_t k1, const int32_t *cols, const double *grad,
+                                        const double *u, int64_t ju, int64_t cu, double *o, int64_t co) {
+  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);  // lanes 0-2: never reads past a field
+  auto field = [&](int64_t j) {
+    const double *uj = u + j * ju;
+    if (cu == 1) return _mm256_maskload_pd(uj, m3);
+    return _mm256_set_pd(0.0, uj[2 * cu], uj[cu], uj[0]);
+  };
+  __m256d p[D], q[D];
+#pragma GCC unroll 3
+  for (int d = 0; d < D; ++d) p[d] = q[d] = _mm256_setzero_pd();
+  for (; k + 1 < k1; k += 2) {
+    const double *g = grad + k * D;
+    const __m256d ua = field(cols[k]), ub = field(cols[k + 1]);
+#pragma GCC unroll 3
+    for (int d = 0; d < D; ++d) p[d] = _mm256_fmadd_pd(_mm256_broadcast_sd(g + d), ua, p[d]);
+#pragma GCC unroll 3
+    for (int d = 0; d < D; ++d) q[d] = _mm256_fmadd_pd(_mm256_broadcast_sd(g + D + d), ub, q[d]);
+  }
+  if (k < k1) {
+    const double *g = grad + k * D;
+    const __m256d ua = field(cols[k]);
+#pragma GCC unroll 3
+    for (int d = 0; d < D; ++d) p[d] = _mm256_fmadd_pd(_mm256_broadcast_sd(g + d), ua, p[d]);
+    ++k;
+  }
+  alignas(32) double r[D][4];
+#pragma GCC unroll 3
+  for (int d = 0; d < D; ++d) _mm256_store_pd(r[d], _mm256_add_pd(p[d], q[d]));
+  for (int c = 0; c < 3; ++c)
+    for (int d = 0; d < D; ++d) {
+      double &w = o[(c * D + d) * co];
+      if (Add) w += r[d][c];
+      else w = r[d][c];
+    }
+  return k;
+}
+
 template <int NC, bool Add>
 void gradient_rows_3d(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
                       const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co) {
@@ -197,40 +239,7 @@ void gradient_rows_3d(int64_t b, int64_t e, const int64_t *rowptr, const int32_t
         else o[d * co] = r[d];
       }
     } else {
-      __m256d p0 = _mm256_setzero_pd(), p1 = p0, p2 = p0, q0 = p0, q1 = p0, q2 = p0;
-      auto field = [&](int64_t j) {
-        const double *uj = u + j * ju;
-        if (cu == 1) return _mm256_maskload_pd(uj, m3);
-        return _mm256_set_pd(0.0, uj[2 * cu], uj[cu], uj[0]);
-      };
-      for (; k + 1 < k1; k += 2) {
-        const double *g = grad + k * 3;
-        const __m256d ua = field(cols[k]), ub = field(cols[k + 1]);
-        p0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 0), ua, p0);
-        p1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 1), ua, p1);
-        p2 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 2), ua, p2);
-        q0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 3), ub, q0);
-        q1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 4), ub, q1);
-        q2 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 5), ub, q2);
-      }
-      if (k < k1) {
-        const double *g = grad + k * 3;
-        const __m256d ua = field(cols[k]);
-        p0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 0), ua, p0);
-        p1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 1), ua, p1);
-        p2 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 2), ua, p2);
-        ++k;
-      }
-      alignas(32) double r[3][4];
-      _mm256_store_pd(r[0], _mm256_add_pd(p0, q0));
-      _mm256_store_pd(r[1], _mm256_add_pd(p1, q1));
-      _mm256_store_pd(r[2], _mm256_add_pd(p2, q2));
-      for (int c = 0; c < 3; ++c)
-        for (int d = 0; d < 3; ++d) {
-          double &w = o[(c * 3 + d) * co];
-          if (Add) w += r[d][c];
-          else w = r[d][c];
-        }
+      k = fields3_row<3, Add>(k, k1, cols, grad, u, ju, cu, o, co);
     }
   }
 }
@@ -244,7 +253,6 @@ template <int NC, bool Add>
 void gradient_rows_2d(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
                       const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co) {
   static_assert(NC == 1 || NC == 3, "AVX2 2D kernel: NC = 1 or 3");
-  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);  // lanes 0-2
   int64_t k = rowptr[b];
   for (int64_t s = b; s < e; ++s) {
     const int64_t k1 = rowptr[s + 1];
@@ -271,36 +279,7 @@ void gradient_rows_2d(int64_t b, int64_t e, const int64_t *rowptr, const int32_t
         else o[d * co] = v;
       }
     } else {
-      __m256d p0 = _mm256_setzero_pd(), p1 = p0, q0 = p0, q1 = p0;
-      auto field = [&](int64_t j) {
-        const double *uj = u + j * ju;
-        if (cu == 1) return _mm256_maskload_pd(uj, m3);
-        return _mm256_set_pd(0.0, uj[2 * cu], uj[cu], uj[0]);
-      };
-      for (; k + 1 < k1; k += 2) {
-        const double *g = grad + k * 2;
-        const __m256d ua = field(cols[k]), ub = field(cols[k + 1]);
-        p0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 0), ua, p0);
-        p1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 1), ua, p1);
-        q0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 2), ub, q0);
-        q1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 3), ub, q1);
-      }
-      if (k < k1) {
-        const double *g = grad + k * 2;
-        const __m256d ua = field(cols[k]);
-        p0 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 0), ua, p0);
-        p1 = _mm256_fmadd_pd(_mm256_broadcast_sd(g + 1), ua, p1);
-        ++k;
-      }
-      alignas(32) double r[2][4];
-      _mm256_store_pd(r[0], _mm256_add_pd(p0, q0));
-      _mm256_store_pd(r[1], _mm256_add_pd(p1, q1));
-      for (int c = 0; c < 3; ++c)
-        for (int d = 0; d < 2; ++d) {
-          double &w = o[(c * 2 + d) * co];
-          if (Add) w += r[d][c];
-          else w = r[d][c];
-        }
+      k = fields3_row<2, Add>(k, k1, cols, grad, u, ju, cu, o, co);
     }
   }
 }
