@@ -87,35 +87,42 @@ void held_free(void *user, void *p, int64_t bytes) {
 // Best of reps setups of one particle set (the repeated search of a moving-particle
 // code: from the second setup on the set reuses its grid and buffers); *held = bytes
 // held by the set-up set (lists + search scratch + copied supports), per particle.
+// With tn: the setups alternate one thread and `threads` (the context's count changed
+// between calls, so that a busy moment of the VM spoils both alike), the best of reps
+// each; the return value is the one-thread best, *tn the other. Without tn: `threads`.
 double time_mfree(int dim, int n, const double *x, double h, int threads, int reps, int64_t *nnz,
-                  mfree_particles_t **keep, double *held, double *first = nullptr) {
+                  mfree_particles_t **keep, double *held, double *first = nullptr, double *tn = nullptr) {
   mfree_context_t *ctx = nullptr;
   mfree_particles_t *ps = nullptr;
   static Held count;  // outlives a kept set (destroyed after this context)
   count.bytes = 0;
   mfree_context_create(&ctx);
   if (held) mfree_context_set_allocator(ctx, held_alloc, held_free, &count);  // (not thread-safe: 1-thread run)
-  mfree_context_set_num_threads(ctx, threads);
+  mfree_context_set_num_threads(ctx, 1);
   mfree_particles_create(ctx, dim, n, &ps);
   mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
   mfree_particles_set_support(ps, &h, 0, MFREE_COPY);
-  double best = 1e300;
-  for (int k = 0; k < reps; ++k) {
+  double best[2] = {1e300, 1e300};
+  const int rounds = tn ? 2 * reps : reps;
+  for (int r = 0; r < rounds; ++r) {
+    const int k = tn ? (r & 1) : 0;
+    mfree_context_set_num_threads(ctx, tn ? (k ? threads : 1) : threads);
     const double t0 = bench_now();
     if (mfree_particles_setup(ps) != MFREE_SUCCESS) {
       std::fprintf(stderr, "mfree_particles_setup failed\n");
       std::exit(1);
     }
     const double t = bench_now() - t0;
-    if (k == 0 && first) *first = t;  // the set's first search: allocates its buffers
-    best = std::min(best, t);
+    if (r == 0 && first) *first = t;  // the set's first search: allocates its buffers
+    best[k] = std::min(best[k], t);
   }
   mfree_particles_get_neighbor_nnz(ps, nnz);
   if (held) *held = static_cast<double>(count.bytes) / n;
+  if (tn) *tn = best[1];
   if (keep) *keep = ps;
   else mfree_particles_destroy(&ps);
   mfree_context_destroy(&ctx);
-  return best;
+  return best[0];
 }
 
 void run(int dim, double n_target) {
@@ -130,10 +137,12 @@ void run(int dim, double n_target) {
   // The one-thread set first: its first setup is the first search of this size in the
   // process (fresh pages from the kernel); the library's own allocator (no hook), as a
   // host without a hook gets it (big blocks then take huge pages, see alloc.hpp).
-  double t1_first = 0, t1_again = 0;
-  const double t1 = time_mfree(dim, n, x, h, 1, reps, &nnz, nullptr, nullptr, &t1_first);
-  const double tn = time_mfree(dim, n, x, h, bench_threads(), reps, &nnz_t, nullptr, nullptr);
-  // a new set again, right after the threaded one was destroyed (memory just freed)
+  // Its later setups alternate one and all threads.
+  double t1_first = 0, t1_again = 0, tn = 0;
+  const double t1 = time_mfree(dim, n, x, h, bench_threads(), reps, &nnz, nullptr, nullptr, &t1_first, &tn);
+  // the count of a fresh set set up on all threads only
+  time_mfree(dim, n, x, h, bench_threads(), 1, &nnz_t, nullptr, nullptr, nullptr);
+  // a new set again, right after another one was destroyed (memory just freed)
   int64_t nnz_a = 0;
   time_mfree(dim, n, x, h, 1, 1, &nnz_a, nullptr, nullptr, &t1_again);
   // the memory report (and the oracle's lists) through a counting hook
