@@ -1,9 +1,12 @@
 /*
  * t204: the huge-page path of the internal allocator (issue 8, src/core/alloc.hpp).
  *
- * Without an allocator hook, blocks of 2 MiB and more (here the neighbour lists and the
- * search's row buffers of a 10^5-particle set) get mappings of their own, advised
- * MADV_HUGEPAGE, and are unmapped when freed. Observed from outside through
+ * Without an allocator hook, blocks of 2 MiB and more (here the neighbour lists of a
+ * 10^5-particle set) get mappings of their own, advised MADV_HUGEPAGE, and are unmapped
+ * when freed. The particles are stored in random order: a one-thread search of particles
+ * in spatial order writes its lists in place on small pages (neighbors.cpp,
+ * host_order_rows; alloc.hpp, SmallPages), the general path used here on huge pages.
+ * Observed from outside through
  * /proc/self/smaps (the "hg" VmFlag that MADV_HUGEPAGE sets on a mapping):
  *  - a set-up 10^5 set holds advised mappings, and after it is destroyed every advised
  *    byte is gone again (no block is lost or unmapped twice: the advised total returns to
@@ -68,7 +71,7 @@ static long advised_kib(void) {
 
 enum { M = 320 }; /* 102,400 particles */
 
-/* Jittered M x M lattice, spacing 1, AoS. */
+/* Jittered M x M lattice, spacing 1, AoS, its points in random order. */
 static double *lattice(int32_t *n) {
   *n = M * M;
   double *x = malloc(sizeof(double) * 2 * (size_t)*n);
@@ -78,6 +81,15 @@ static double *lattice(int32_t *n) {
   for (int32_t p = 0; p < *n; ++p) {
     x[2 * p] = (p % M) + 0.3 * (2.0 * mfree_rng_uniform(&r) - 1.0);
     x[2 * p + 1] = (p / M) + 0.3 * (2.0 * mfree_rng_uniform(&r) - 1.0);
+  }
+  for (int32_t p = *n - 1; p > 0; --p) { /* Fisher-Yates */
+    int32_t q = (int32_t)(mfree_rng_uniform(&r) * (p + 1));
+    if (q > p) q = p;
+    for (int c = 0; c < 2; ++c) {
+      const double t = x[2 * p + c];
+      x[2 * p + c] = x[2 * q + c];
+      x[2 * q + c] = t;
+    }
   }
   return x;
 }

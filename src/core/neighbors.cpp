@@ -18,6 +18,11 @@
 // comparisons, see run_queries), otherwise by sorting each row. A particle set keeps
 // the grid and the buffers between searches (NeighborScratch), so a repeated search
 // allocates nothing and touches no new pages once the sizes have settled.
+//
+// On one thread, with particles stored in spatial order (lattice, curve), the rows are
+// instead found in host order and written sorted straight into the lists
+// (host_order_rows): no buffers, the fewest fresh pages for the first search of a set.
+// Either way the lists are the same sets, sorted: the same bits.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -141,6 +146,10 @@ class CellGrid {
   }
   // Host indices of the valid particles in cell order.
   const int32_t *members() const { return id_.data(); }
+  // Fraction of host-consecutive valid particles (i - 1, i) whose cells lie within one
+  // cell row (2D) or cell plane (3D) of each other in cell order: ~1 for particles stored
+  // in lattice or space-filling-curve order, ~0 for a random order.
+  double host_locality(int32_t n) const;
   int32_t num_valid() const { return nvalid_; }
 
   // Write to row[cnt...] every valid particle j with squared distance to xq (wrapped)
@@ -432,6 +441,23 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   });
 }
 
+double CellGrid::host_locality(int32_t n) const {
+  if (nvalid_ < 2 || static_cast<int64_t>(cell_idx_.size()) < n) return 0.0;
+  const int64_t w = dim_ == 1 ? 4 : (dim_ == 2 ? 2 * nc_[0] + 4 : nc_[0] * nc_[1] + 2 * nc_[0] + 4);
+  const int64_t *cell = cell_idx_.data();
+  int64_t prev = -1, near = 0, pairs = 0;
+  for (int32_t i = 0; i < n; ++i) {
+    const int64_t c = cell[i];
+    if (c < 0) continue;
+    if (prev >= 0) {
+      ++pairs;
+      near += (c - prev <= w && prev - c <= w) ? 1 : 0;
+    }
+    prev = c;
+  }
+  return pairs > 0 ? static_cast<double>(near) / static_cast<double>(pairs) : 0.0;
+}
+
 template <int D, bool Periodic, class Cnt>
 void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int64_t *cell,
                        Cnt *cnt) const {
@@ -698,6 +724,63 @@ MFREE_TARGET_AVX2 void row_min_max_avx2(const int32_t *b, const int32_t *e, int3
 }
 #endif
 
+// Sorts the n <= 64 distinct values a[0..n) into out[0..n) by rank (out[#{a_m < a_k}] =
+// a_k): n times n/4 (AVX2: n/8) compares, no data-dependent branch. The rows of a
+// host-order search (below) come in cell-scan order, ~21 (2D) or ~55 (3D) values
+// interleaved from a few runs: an insertion sort mispredicted on most of its moves (a
+// 3D search 15 % slower than with the transposition of run_queries; by rank, as fast).
+inline void rank_sort(const int32_t *a, int n, int32_t *out) {
+#if defined(__GNUC__)
+  typedef int32_t v4i __attribute__((vector_size(16)));
+  v4i v[16], r[16];
+  const int nv = (n + 3) / 4;
+  for (int q = 0; q < nv; ++q) {
+    for (int l = 0; l < 4; ++l) v[q][l] = 4 * q + l < n ? a[4 * q + l] : INT32_MAX;
+    r[q] = v4i{0, 0, 0, 0};
+  }
+  for (int m = 0; m < n; ++m) {
+    const v4i b = {a[m], a[m], a[m], a[m]};
+    for (int q = 0; q < nv; ++q) r[q] -= static_cast<v4i>(v[q] > b);
+  }
+  for (int k = 0; k < n; ++k) out[r[k / 4][k % 4]] = a[k];
+#else
+  for (int k = 0; k < n; ++k) {
+    int r = 0;
+    for (int m = 0; m < n; ++m) r += a[m] < a[k];
+    out[r] = a[k];
+  }
+#endif
+}
+
+#if MFREE_SIMD_X86
+// NV vectors of eight (n <= 8 NV), padded with INT32_MAX (ranked last, never stored).
+template <int NV>
+MFREE_TARGET_AVX2 inline void rank_sort_avx2_t(const int32_t *a, int n, int32_t *out) {
+  alignas(32) int32_t buf[8 * NV], rank[8 * NV];
+  for (int k = 0; k < 8 * NV; ++k) buf[k] = k < n ? a[k] : INT32_MAX;
+  __m256i r[NV];
+#pragma GCC unroll 8
+  for (int q = 0; q < NV; ++q) r[q] = _mm256_setzero_si256();
+  for (int m = 0; m < n; ++m) {
+    const __m256i b = _mm256_set1_epi32(buf[m]);
+#pragma GCC unroll 8
+    for (int q = 0; q < NV; ++q)
+      r[q] = _mm256_sub_epi32(
+          r[q], _mm256_cmpgt_epi32(_mm256_load_si256(reinterpret_cast<const __m256i *>(buf + 8 * q)), b));
+  }
+#pragma GCC unroll 8
+  for (int q = 0; q < NV; ++q) _mm256_store_si256(reinterpret_cast<__m256i *>(rank + 8 * q), r[q]);
+  for (int k = 0; k < n; ++k) out[rank[k]] = buf[k];
+}
+MFREE_TARGET_AVX2 void rank_sort_avx2(const int32_t *a, int n, int32_t *out) {
+  if (n <= 16) rank_sort_avx2_t<2>(a, n, out);
+  else if (n <= 32) rank_sort_avx2_t<4>(a, n, out);
+  else if (n <= 48) rank_sort_avx2_t<6>(a, n, out);
+  else rank_sort_avx2_t<8>(a, n, out);
+  _mm256_zeroupper();
+}
+#endif
+
 }  // namespace
 
 // Buffers of a search, kept by a particle set between searches (sizes settle after the
@@ -912,6 +995,91 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
     }
 }
 
+// Lists built in host order straight into out, on one thread: row j is the query of
+// particle j, sorted, appended at rp[j] (every earlier row's length is known by then).
+// No row buffers, no cell-order permutation, no transposition: a first search of a new
+// set touches the lists, the grid and nothing else (the buffers, offsets and row
+// pointers of run_queries were more than half of the fresh memory a first search
+// faulted: 2D 10^5 246 -> 134 bytes per particle, 3D 525 -> 278). The price is that the
+// queries run in host order: as fast as in cell order when host-consecutive particles
+// are spatial neighbours (lattice or curve order; the caller checks), not otherwise
+// once the grid outgrows the caches. Rows are sorted by rank (rank_sort: no
+// data-dependent branch; an insertion sort mispredicted on most moves of a 3D row).
+//
+// out's capacity is reserved for the expected rows with a margin before anything is
+// written (a failure there leaves out unchanged). A row beyond it grows the capacity
+// (a copy); if that allocation fails, out is left with no rows ({0}) and the exception
+// propagates (ParticleSet::setup then marks the set not set up). The new lists take
+// small pages: on the issue-8 VM a huge page first touched by the search costs more than
+// its small pages when the host must back it anew (alloc.hpp, SmallPages), and the
+// lists are read front to back afterwards (the TLB reach of huge pages buys little).
+void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vector<int32_t> &status,
+                     const Rule &rule, RowBuf &tmp, Csr &out) {
+  const int32_t rows = ps.num_owned();
+  const int dim = ps.dim();
+  const double kappa = ps.kappa();
+  const size_t est = static_cast<size_t>(rows) * static_cast<size_t>(1.25 * grid.expected_hits() + 8.0);
+  out.rowptr.reserve(static_cast<size_t>(rows) + 1);
+  if (out.cols.capacity() < est) {
+    SmallPages small;
+    out.cols.reserve(est);
+  }
+  out.rowptr.resize(static_cast<size_t>(rows) + 1);
+  int64_t *rp = out.rowptr.data();
+  rp[0] = 0;
+  // Entries below cols.size() exist (a repeated search: the old lists) and are simply
+  // overwritten; new ones are added in chunks (the value-initialising resize zero-fills
+  // them first, in cache, right after their first touch).
+  size_t have = out.cols.size();
+  int32_t *cols = out.cols.data();
+#if MFREE_SIMD_X86
+  const bool avx2 = simd::use_avx2();
+#endif
+  for (int32_t j = 0; j < rows; ++j) {
+    const int64_t base = rp[j];
+    if (status[j] != 0) {
+      rp[j + 1] = base;  // no row
+      continue;
+    }
+    double x[3] = {0, 0, 0};
+    for (int c = 0; c < dim; ++c) x[c] = grid.wrap(ps.x(j, c), c);
+    size_t cnt = 0;
+    grid.query(x, kappa * ps.h(j), rule, tmp, cnt);  // (the radius the grid was built from)
+    const int64_t end = base + static_cast<int64_t>(cnt);
+    rp[j + 1] = end;
+    if (static_cast<size_t>(end) > have) {
+      size_t want = std::max(static_cast<size_t>(end), have + 16384);
+      if (want > out.cols.capacity()) {
+        try {
+          SmallPages small;
+          out.cols.reserve(std::max(want, 2 * out.cols.capacity()));
+        } catch (...) {
+          out.rowptr.assign(1, 0);  // (shrinks: no allocation)
+          out.cols.clear();
+          throw;
+        }
+      }
+      want = std::min(want, out.cols.capacity());
+      out.cols.resize(want);
+      have = want;
+      cols = out.cols.data();
+    }
+    int32_t *t = tmp.data();
+    int32_t *o = cols + base;
+    if (cnt > 64) {
+      std::sort(t, t + cnt);
+      std::copy(t, t + cnt, o);
+    } else {
+#if MFREE_SIMD_X86
+      if (avx2) rank_sort_avx2(t, static_cast<int>(cnt), o);
+      else
+#endif
+        rank_sort(t, static_cast<int>(cnt), o);
+    }
+  }
+  out.cols.resize(static_cast<size_t>(rp[rows]));
+}
+
 }  // namespace
 
 void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, NeighborScratch &sc, Csr &out) {
@@ -919,6 +1087,13 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, N
   sc.grid.build(ps, status);
   const CellGrid &grid = sc.grid;
   const Rule rule{ps.search_convention(), grid.rmax()};
+  // One thread and particles stored in spatial order: straight into out, in host order.
+  // (A 2-thread search keeps run_queries: its cell-order blocks are what split the work
+  // without a serial pass over the rows.)
+  if (!grid.empty() && num_threads(ps.size()) == 1 && grid.host_locality(ps.size()) >= 0.75) {
+    host_order_rows(grid, ps, status, rule, sc.buf[0], out);
+    return;
+  }
   // owned valid particles in cell order
   const int32_t *mem = grid.members();
   const int32_t nv = grid.num_valid();

@@ -293,6 +293,9 @@ Report ParticleSet::setup() {
     }
   } catch (...) {
     site_status_.swap(prev_status_);
+    // (a search that ran out of memory after it began to overwrite the lists leaves them
+    // with no rows: the old lists are gone, so the set is no longer set up)
+    if (nbr_.rowptr.size() != static_cast<size_t>(num_owned()) + 1) setup_done_ = false;
     throw;
   }
   if (host_neighbors()) nbr_ = std::move(out);

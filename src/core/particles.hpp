@@ -135,7 +135,9 @@ class ParticleSet {
 
 // Cell-list search over the valid particles of ps (site_status[i] == 0); fills rows for
 // the owned particles, sorted. Throws Error on a periodic box too small for the supports;
-// on any exception out is unchanged. scratch holds the grid and buffers between calls.
+// on any exception out is unchanged, except when memory ran out after the one-thread
+// search began to write it in place: out then has no rows (rowptr {0}). scratch holds
+// the grid and buffers between calls.
 NeighborScratch *new_neighbor_scratch();
 void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &site_status, NeighborScratch &scratch,
                     Csr &out);
