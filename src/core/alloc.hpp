@@ -22,6 +22,8 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #endif
@@ -173,6 +175,34 @@ inline void hook_deallocate(void *p) noexcept {
   else std::free(hdr);
 }
 }  // namespace detail
+
+// Faults in the whole pages of [p, p + bytes) in one system call (MADV_POPULATE_WRITE,
+// Linux 5.14), for a block about to be written front to back for the first time: the
+// kernel fills the page tables in one pass instead of one trap per 4 KiB page (~1.5
+// against ~2.3 us per page on the issue-8 VM; ~2.2 against ~2.6-4 when the host must
+// back them anew). Only without a hook (a host's memory is the host's business) and for
+// at least 64 KiB; a kernel without it (EINVAL) is remembered. Contents are unchanged
+// (pages already present stay as they are; new ones are zero).
+inline void prefault(void *p, std::size_t bytes) noexcept {
+#if defined(__linux__)
+#ifndef MADV_POPULATE_WRITE
+#define MFREE_MADV_POPULATE_WRITE 23
+#else
+#define MFREE_MADV_POPULATE_WRITE MADV_POPULATE_WRITE
+#endif
+  static std::atomic<bool> unsupported{false};
+  if (current_alloc_hook() || bytes < (std::size_t{64} << 10) || unsupported.load(std::memory_order_relaxed)) return;
+  const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p) + 4095) & ~static_cast<std::uintptr_t>(4095);
+  const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~static_cast<std::uintptr_t>(4095);
+  if (b <= a) return;
+  if (madvise(reinterpret_cast<void *>(a), b - a, MFREE_MADV_POPULATE_WRITE) != 0 && errno == EINVAL)
+    unsupported.store(true, std::memory_order_relaxed);
+#undef MFREE_MADV_POPULATE_WRITE
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
 
 // Blocks allocated on this thread while a SmallPages scope is alive take small pages
 // (malloc) however big they are; with a hook installed nothing changes (every block is

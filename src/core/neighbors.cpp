@@ -66,6 +66,18 @@ struct NoInitAlloc : HostAllocator<T> {
 };
 template <class T>
 using Buf = std::vector<T, NoInitAlloc<T>>;
+
+// Resize a grid array (no initialisation); a new block is faulted in whole first
+// (alloc.hpp, prefault: the first search of a set writes every page of it).
+template <class T>
+void resize_fresh(Buf<T> &v, size_t n) {
+  if (n > v.capacity()) {
+    v.clear();  // (the old contents need no copy)
+    v.reserve(n);
+    prefault(v.data(), n * sizeof(T));
+  }
+  v.resize(n);
+}
 // The per-thread row buffers are scratch written once front to back and read once per
 // search: without a hook they take small pages (malloc) rather than alloc.hpp's huge
 // pages. On the issue-8 VM a huge page costs 0.2 ms when the guest recycles it but 5-17
@@ -377,14 +389,14 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   // Counting sort of the valid particles by cell, stable (ascending host index in a
   // cell) for any chunk count: chunk v's particles follow chunk v-1's in every cell.
   const int64_t nc = ncells_;
-  cell_idx_.resize(static_cast<size_t>(n));
-  start_.resize(static_cast<size_t>(nc) + 1);
-  id_.resize(static_cast<size_t>(nvalid_) + 1);
+  resize_fresh(cell_idx_, static_cast<size_t>(n));
+  resize_fresh(start_, static_cast<size_t>(nc) + 1);
+  resize_fresh(id_, static_cast<size_t>(nvalid_) + 1);
   if (need_srad_) {
-    srad_.resize(static_cast<size_t>(nvalid_) + 1);
+    resize_fresh(srad_, static_cast<size_t>(nvalid_) + 1);
     srad_[nvalid_] = 0.0;
   }
-  for (int c = 0; c < dim_; ++c) sx_[c].resize(static_cast<size_t>(nvalid_) + 1);
+  for (int c = 0; c < dim_; ++c) resize_fresh(sx_[c], static_cast<size_t>(nvalid_) + 1);
   id_[nvalid_] = 0;  // padding read by the two-lane scan
   for (int c = 0; c < dim_; ++c) sx_[c][nvalid_] = 0.0;
   int64_t *cell = cell_idx_.data();
@@ -1019,7 +1031,10 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
   const int dim = ps.dim();
   const double kappa = ps.kappa();
   const size_t est = static_cast<size_t>(rows) * static_cast<size_t>(1.25 * grid.expected_hits() + 8.0);
-  out.rowptr.reserve(static_cast<size_t>(rows) + 1);
+  if (out.rowptr.capacity() < static_cast<size_t>(rows) + 1) {
+    out.rowptr.reserve(static_cast<size_t>(rows) + 1);
+    prefault(out.rowptr.data(), (static_cast<size_t>(rows) + 1) * sizeof(int64_t));
+  }
   if (out.cols.capacity() < est) {
     SmallPages small;
     out.cols.reserve(est);
@@ -1048,7 +1063,7 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
     const int64_t end = base + static_cast<int64_t>(cnt);
     rp[j + 1] = end;
     if (static_cast<size_t>(end) > have) {
-      size_t want = std::max(static_cast<size_t>(end), have + 16384);
+      size_t want = std::max(static_cast<size_t>(end), have + 65536);
       if (want > out.cols.capacity()) {
         try {
           SmallPages small;
@@ -1060,6 +1075,7 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
         }
       }
       want = std::min(want, out.cols.capacity());
+      prefault(out.cols.data() + have, (want - have) * sizeof(int32_t));
       out.cols.resize(want);
       have = want;
       cols = out.cols.data();
