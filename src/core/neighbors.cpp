@@ -784,7 +784,43 @@ MFREE_TARGET_AVX2 inline void rank_sort_avx2_t(const int32_t *a, int n, int32_t 
   for (int q = 0; q < NV; ++q) _mm256_store_si256(reinterpret_cast<__m256i *>(rank + 8 * q), r[q]);
   for (int k = 0; k < n; ++k) out[rank[k]] = buf[k];
 }
+// The same on 16-bit offsets from the row's minimum (a row spanning less than 32767
+// host indices: particles in spatial order), sixteen lanes per vector: half the compares.
+template <int NV>
+MFREE_TARGET_AVX2 inline void rank_sort16_avx2_t(const int32_t *a, int n, int32_t lo, int32_t *out) {
+  alignas(32) int16_t buf[16 * NV], rank[16 * NV];
+  for (int k = 0; k < 16 * NV; ++k) buf[k] = k < n ? static_cast<int16_t>(a[k] - lo) : INT16_MAX;
+  __m256i v[NV], r[NV];
+#pragma GCC unroll 4
+  for (int q = 0; q < NV; ++q) {
+    v[q] = _mm256_load_si256(reinterpret_cast<const __m256i *>(buf + 16 * q));
+    r[q] = _mm256_setzero_si256();
+  }
+  for (int m = 0; m < n; ++m) {
+    const __m256i b = _mm256_set1_epi16(buf[m]);
+#pragma GCC unroll 4
+    for (int q = 0; q < NV; ++q) r[q] = _mm256_sub_epi16(r[q], _mm256_cmpgt_epi16(v[q], b));
+  }
+#pragma GCC unroll 4
+  for (int q = 0; q < NV; ++q) _mm256_store_si256(reinterpret_cast<__m256i *>(rank + 16 * q), r[q]);
+  for (int k = 0; k < n; ++k) out[rank[k]] = a[k];
+}
+// (Rows of up to 32 take the 32-bit kernel: there the range check and the conversion
+// cost more than the compares they save.)
 MFREE_TARGET_AVX2 void rank_sort_avx2(const int32_t *a, int n, int32_t *out) {
+  if (n > 32) {
+    int32_t lo = INT32_MAX, hi = INT32_MIN;
+    for (int k = 0; k < n; ++k) {
+      lo = a[k] < lo ? a[k] : lo;
+      hi = a[k] > hi ? a[k] : hi;
+    }
+    if (static_cast<int64_t>(hi) - lo < INT16_MAX) {
+      if (n <= 48) rank_sort16_avx2_t<3>(a, n, lo, out);
+      else rank_sort16_avx2_t<4>(a, n, lo, out);
+      _mm256_zeroupper();
+      return;
+    }
+  }
   if (n <= 16) rank_sort_avx2_t<2>(a, n, out);
   else if (n <= 32) rank_sort_avx2_t<4>(a, n, out);
   else if (n <= 48) rank_sort_avx2_t<6>(a, n, out);
@@ -1047,6 +1083,7 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
   // them first, in cache, right after their first touch).
   size_t have = out.cols.size();
   int32_t *cols = out.cols.data();
+  const size_t chunk = std::min<size_t>(65536, std::max<size_t>(4096, est / 32));
 #if MFREE_SIMD_X86
   const bool avx2 = simd::use_avx2();
 #endif
@@ -1063,7 +1100,7 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
     const int64_t end = base + static_cast<int64_t>(cnt);
     rp[j + 1] = end;
     if (static_cast<size_t>(end) > have) {
-      size_t want = std::max(static_cast<size_t>(end), have + 65536);
+      size_t want = std::max(static_cast<size_t>(end), have + chunk);
       if (want > out.cols.capacity()) {
         try {
           SmallPages small;
