@@ -769,10 +769,17 @@ inline void rank_sort(const int32_t *a, int n, int32_t *out) {
 template <int NV>
 MFREE_TARGET_AVX2 inline void rank_sort_avx2_t(const int32_t *a, int n, int32_t *out) {
   alignas(32) int32_t buf[8 * NV], rank[8 * NV];
-  for (int k = 0; k < 8 * NV; ++k) buf[k] = k < n ? a[k] : INT32_MAX;
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), vn = _mm256_set1_epi32(n),
+                pad = _mm256_set1_epi32(INT32_MAX);
   __m256i r[NV];
 #pragma GCC unroll 8
-  for (int q = 0; q < NV; ++q) r[q] = _mm256_setzero_si256();
+  for (int q = 0; q < NV; ++q) {
+    // lanes below n from a (masked lanes are not read), the others INT32_MAX
+    const __m256i in = _mm256_cmpgt_epi32(vn, _mm256_add_epi32(iota, _mm256_set1_epi32(8 * q)));
+    const __m256i v = _mm256_blendv_epi8(pad, _mm256_maskload_epi32(a + 8 * q, in), in);
+    _mm256_store_si256(reinterpret_cast<__m256i *>(buf + 8 * q), v);
+    r[q] = _mm256_setzero_si256();
+  }
   for (int m = 0; m < n; ++m) {
     const __m256i b = _mm256_set1_epi32(buf[m]);
 #pragma GCC unroll 8
@@ -784,16 +791,47 @@ MFREE_TARGET_AVX2 inline void rank_sort_avx2_t(const int32_t *a, int n, int32_t 
   for (int q = 0; q < NV; ++q) _mm256_store_si256(reinterpret_cast<__m256i *>(rank + 8 * q), r[q]);
   for (int k = 0; k < n; ++k) out[rank[k]] = buf[k];
 }
-// The same on 16-bit offsets from the row's minimum (a row spanning less than 32767
-// host indices: particles in spatial order), sixteen lanes per vector: half the compares.
+// The same on 16-bit offsets from the row's minimum when the row spans fewer than 32767
+// host indices (particles in spatial order), sixteen lanes per vector (NV <= 4): half the
+// compares. Returns false (nothing written) when the span is wider. Loading, range and
+// conversion in vectors (as scalar loops they cost as much as the compares).
 template <int NV>
-MFREE_TARGET_AVX2 inline void rank_sort16_avx2_t(const int32_t *a, int n, int32_t lo, int32_t *out) {
+MFREE_TARGET_AVX2 inline bool rank_sort16_avx2_t(const int32_t *a, int n, int32_t *out) {
+  const __m256i first = _mm256_set1_epi32(a[0]);  // neutral padding for the range
+  const __m256i iota8 = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), vn8 = _mm256_set1_epi32(n);
+  __m256i v32[2 * NV];
+#pragma GCC unroll 8
+  for (int q = 0; q < 2 * NV; ++q) {
+    const __m256i in = _mm256_cmpgt_epi32(vn8, _mm256_add_epi32(iota8, _mm256_set1_epi32(8 * q)));
+    v32[q] = _mm256_blendv_epi8(first, _mm256_maskload_epi32(a + 8 * q, in), in);
+  }
+  __m256i mn = v32[0], mx = v32[0];
+#pragma GCC unroll 8
+  for (int q = 1; q < 2 * NV; ++q) {
+    mn = _mm256_min_epi32(mn, v32[q]);
+    mx = _mm256_max_epi32(mx, v32[q]);
+  }
+  __m128i m4 = _mm_min_epi32(_mm256_castsi256_si128(mn), _mm256_extracti128_si256(mn, 1));
+  __m128i x4 = _mm_max_epi32(_mm256_castsi256_si128(mx), _mm256_extracti128_si256(mx, 1));
+  m4 = _mm_min_epi32(m4, _mm_shuffle_epi32(m4, 0x4e));
+  x4 = _mm_max_epi32(x4, _mm_shuffle_epi32(x4, 0x4e));
+  m4 = _mm_min_epi32(m4, _mm_shuffle_epi32(m4, 0xb1));
+  x4 = _mm_max_epi32(x4, _mm_shuffle_epi32(x4, 0xb1));
+  const int32_t lo = _mm_cvtsi128_si32(m4), hi = _mm_cvtsi128_si32(x4);
+  if (static_cast<int64_t>(hi) - lo >= INT16_MAX) return false;
+  const __m256i vlo = _mm256_set1_epi32(lo), cap = _mm256_set1_epi16(INT16_MAX), vn = _mm256_set1_epi16(
+                                                                                    static_cast<int16_t>(n));
+  const __m256i iota = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   alignas(32) int16_t buf[16 * NV], rank[16 * NV];
-  for (int k = 0; k < 16 * NV; ++k) buf[k] = k < n ? static_cast<int16_t>(a[k] - lo) : INT16_MAX;
   __m256i v[NV], r[NV];
 #pragma GCC unroll 4
   for (int q = 0; q < NV; ++q) {
-    v[q] = _mm256_load_si256(reinterpret_cast<const __m256i *>(buf + 16 * q));
+    // packs works within 128-bit halves: (a0-3 b0-3 a4-7 b4-7), put back in order
+    const __m256i p = _mm256_permute4x64_epi64(
+        _mm256_packs_epi32(_mm256_sub_epi32(v32[2 * q], vlo), _mm256_sub_epi32(v32[2 * q + 1], vlo)), 0xd8);
+    const __m256i idx = _mm256_add_epi16(iota, _mm256_set1_epi16(static_cast<int16_t>(16 * q)));
+    v[q] = _mm256_blendv_epi8(cap, p, _mm256_cmpgt_epi16(vn, idx));  // lanes >= n: INT16_MAX
+    _mm256_store_si256(reinterpret_cast<__m256i *>(buf + 16 * q), v[q]);
     r[q] = _mm256_setzero_si256();
   }
   for (int m = 0; m < n; ++m) {
@@ -804,27 +842,22 @@ MFREE_TARGET_AVX2 inline void rank_sort16_avx2_t(const int32_t *a, int n, int32_
 #pragma GCC unroll 4
   for (int q = 0; q < NV; ++q) _mm256_store_si256(reinterpret_cast<__m256i *>(rank + 16 * q), r[q]);
   for (int k = 0; k < n; ++k) out[rank[k]] = a[k];
+  return true;
 }
-// (Rows of up to 32 take the 32-bit kernel: there the range check and the conversion
-// cost more than the compares they save.)
+// (Rows of up to 32 take the 32-bit kernel: there the range and the conversion cost more
+// than the compares they save.)
 MFREE_TARGET_AVX2 void rank_sort_avx2(const int32_t *a, int n, int32_t *out) {
-  if (n > 32) {
-    int32_t lo = INT32_MAX, hi = INT32_MIN;
-    for (int k = 0; k < n; ++k) {
-      lo = a[k] < lo ? a[k] : lo;
-      hi = a[k] > hi ? a[k] : hi;
-    }
-    if (static_cast<int64_t>(hi) - lo < INT16_MAX) {
-      if (n <= 48) rank_sort16_avx2_t<3>(a, n, lo, out);
-      else rank_sort16_avx2_t<4>(a, n, lo, out);
-      _mm256_zeroupper();
-      return;
-    }
+  if (n > 48 && rank_sort16_avx2_t<4>(a, n, out)) {
+  } else if (n > 32 && n <= 48 && rank_sort16_avx2_t<3>(a, n, out)) {
+  } else if (n <= 16) {
+    rank_sort_avx2_t<2>(a, n, out);
+  } else if (n <= 32) {
+    rank_sort_avx2_t<4>(a, n, out);
+  } else if (n <= 48) {
+    rank_sort_avx2_t<6>(a, n, out);
+  } else {
+    rank_sort_avx2_t<8>(a, n, out);
   }
-  if (n <= 16) rank_sort_avx2_t<2>(a, n, out);
-  else if (n <= 32) rank_sort_avx2_t<4>(a, n, out);
-  else if (n <= 48) rank_sort_avx2_t<6>(a, n, out);
-  else rank_sort_avx2_t<8>(a, n, out);
   _mm256_zeroupper();
 }
 #endif
