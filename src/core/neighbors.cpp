@@ -1087,10 +1087,11 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
 // once the grid outgrows the caches. Rows are sorted by rank (rank_sort: no
 // data-dependent branch; an insertion sort mispredicted on most moves of a 3D row).
 //
-// out's capacity is reserved for the expected rows with a margin before anything is
-// written (a failure there leaves out unchanged). A row beyond it grows the capacity
-// (a copy); if that allocation fails, out is left with no rows ({0}) and the exception
-// propagates (ParticleSet::setup then marks the set not set up). The new lists take
+// A set's first lists get the expected rows with a margin as capacity before anything
+// is written (a failure there leaves out unchanged); a later search allocates only when
+// its rows outgrow the storage. Growing copies (doubling); if that allocation fails, out
+// is left with no rows ({0}) and the exception propagates (ParticleSet::setup then
+// marks the set not set up). The new lists take
 // small pages: on the issue-8 VM a huge page first touched by the search costs more than
 // its small pages when the host must back it anew (alloc.hpp, SmallPages), and the
 // lists are read front to back afterwards (the TLB reach of huge pages buys little).
@@ -1104,7 +1105,7 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
     out.rowptr.reserve(static_cast<size_t>(rows) + 1);
     prefault(out.rowptr.data(), (static_cast<size_t>(rows) + 1) * sizeof(int64_t));
   }
-  if (out.cols.capacity() < est) {
+  if (out.cols.capacity() == 0) {  // (later searches grow only when the rows outgrow it)
     SmallPages small;
     out.cols.reserve(est);
   }
