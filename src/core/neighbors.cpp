@@ -19,8 +19,8 @@
 // the grid and the buffers between searches (NeighborScratch), so a repeated search
 // allocates nothing and touches no new pages once the sizes have settled.
 //
-// On one thread, with particles stored in spatial order (lattice, curve), the rows are
-// instead found in host order and written sorted straight into the lists
+// On one thread with AVX2 and particles stored in spatial order (lattice, curve), the
+// rows are instead found in host order and written sorted straight into the lists
 // (host_order_rows): no buffers, the fewest fresh pages for the first search of a set.
 // Either way the lists are the same sets, sorted: the same bits.
 #include <algorithm>
@@ -736,34 +736,13 @@ MFREE_TARGET_AVX2 void row_min_max_avx2(const int32_t *b, const int32_t *e, int3
 }
 #endif
 
-// Sorts the n <= 64 distinct values a[0..n) into out[0..n) by rank (out[#{a_m < a_k}] =
-// a_k): n times n/4 (AVX2: n/8) compares, no data-dependent branch. The rows of a
-// host-order search (below) come in cell-scan order, ~21 (2D) or ~55 (3D) values
-// interleaved from a few runs: an insertion sort mispredicted on most of its moves (a
-// 3D search 15 % slower than with the transposition of run_queries; by rank, as fast).
-inline void rank_sort(const int32_t *a, int n, int32_t *out) {
-#if defined(__GNUC__)
-  typedef int32_t v4i __attribute__((vector_size(16)));
-  v4i v[16], r[16];
-  const int nv = (n + 3) / 4;
-  for (int q = 0; q < nv; ++q) {
-    for (int l = 0; l < 4; ++l) v[q][l] = 4 * q + l < n ? a[4 * q + l] : INT32_MAX;
-    r[q] = v4i{0, 0, 0, 0};
-  }
-  for (int m = 0; m < n; ++m) {
-    const v4i b = {a[m], a[m], a[m], a[m]};
-    for (int q = 0; q < nv; ++q) r[q] -= static_cast<v4i>(v[q] > b);
-  }
-  for (int k = 0; k < n; ++k) out[r[k / 4][k % 4]] = a[k];
-#else
-  for (int k = 0; k < n; ++k) {
-    int r = 0;
-    for (int m = 0; m < n; ++m) r += a[m] < a[k];
-    out[r] = a[k];
-  }
-#endif
-}
-
+// Sorting by rank: the n <= 64 distinct values a[0..n) go to out[#{a_m < a_k}], n times
+// n/8 (16-bit: n/16) AVX2 compares, no data-dependent branch. The rows of a host-order
+// search (below) come in cell-scan order, ~21 (2D) or ~55 (3D) values interleaved from
+// a few runs: an insertion sort mispredicted on most of its moves (a 3D search 15 %
+// slower than with the transposition of run_queries; by rank, faster). Without AVX2
+// (SSE2's four lanes, MFREE_SIMD=baseline) the rank sort made a repeated 3D search
+// 15-35 % slower than the transposition, so the host-order search is AVX2-only.
 #if MFREE_SIMD_X86
 // NV vectors of eight (n <= 8 NV), padded with INT32_MAX (ranked last, never stored).
 template <int NV>
@@ -1076,6 +1055,7 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
     }
 }
 
+#if MFREE_SIMD_X86
 // Lists built in host order straight into out, on one thread: row j is the query of
 // particle j, sorted, appended at rp[j] (every earlier row's length is known by then).
 // No row buffers, no cell-order permutation, no transposition: a first search of a new
@@ -1084,7 +1064,7 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
 // faulted: 2D 10^5 246 -> 134 bytes per particle, 3D 525 -> 278). The price is that the
 // queries run in host order: as fast as in cell order when host-consecutive particles
 // are spatial neighbours (lattice or curve order; the caller checks), not otherwise
-// once the grid outgrows the caches. Rows are sorted by rank (rank_sort: no
+// once the grid outgrows the caches. Rows are sorted by rank (rank_sort_avx2: no
 // data-dependent branch; an insertion sort mispredicted on most moves of a 3D row).
 //
 // A set's first lists get the expected rows with a margin as capacity before anything
@@ -1118,9 +1098,6 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
   size_t have = out.cols.size();
   int32_t *cols = out.cols.data();
   const size_t chunk = std::min<size_t>(65536, std::max<size_t>(4096, est / 32));
-#if MFREE_SIMD_X86
-  const bool avx2 = simd::use_avx2();
-#endif
   for (int32_t j = 0; j < rows; ++j) {
     const int64_t base = rp[j];
     if (status[j] != 0) {
@@ -1157,15 +1134,12 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
       std::sort(t, t + cnt);
       std::copy(t, t + cnt, o);
     } else {
-#if MFREE_SIMD_X86
-      if (avx2) rank_sort_avx2(t, static_cast<int>(cnt), o);
-      else
-#endif
-        rank_sort(t, static_cast<int>(cnt), o);
+      rank_sort_avx2(t, static_cast<int>(cnt), o);
     }
   }
   out.cols.resize(static_cast<size_t>(rp[rows]));
 }
+#endif
 
 }  // namespace
 
@@ -1174,13 +1148,15 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, N
   sc.grid.build(ps, status);
   const CellGrid &grid = sc.grid;
   const Rule rule{ps.search_convention(), grid.rmax()};
-  // One thread and particles stored in spatial order: straight into out, in host order.
+  // One thread, AVX2, particles stored in spatial order: straight into out, in host order.
   // (A 2-thread search keeps run_queries: its cell-order blocks are what split the work
   // without a serial pass over the rows.)
-  if (!grid.empty() && num_threads(ps.size()) == 1 && grid.host_locality(ps.size()) >= 0.75) {
+#if MFREE_SIMD_X86
+  if (!grid.empty() && num_threads(ps.size()) == 1 && simd::use_avx2() && grid.host_locality(ps.size()) >= 0.75) {
     host_order_rows(grid, ps, status, rule, sc.buf[0], out);
     return;
   }
+#endif
   // owned valid particles in cell order
   const int32_t *mem = grid.members();
   const int32_t nv = grid.num_valid();
