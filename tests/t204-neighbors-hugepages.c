@@ -4,7 +4,7 @@
  * Without an allocator hook, blocks of 2 MiB and more (here the neighbour lists of a
  * 10^5-particle set) get mappings of their own, advised MADV_HUGEPAGE, and are unmapped
  * when freed. The particles are stored in random order: a one-thread search of particles
- * in spatial order writes its lists in place on small pages (neighbors.cpp,
+ * in spatial order (AVX2) writes its lists in place on small pages (neighbors.cpp,
  * host_order_rows; alloc.hpp, SmallPages), the general path used here on huge pages.
  * Observed from outside through
  * /proc/self/smaps (the "hg" VmFlag that MADV_HUGEPAGE sets on a mapping):

@@ -2,8 +2,10 @@
  * t205: the one-thread host-order neighbour search against the general cell-order one
  * on the same points (issue 8, src/core/neighbors.cpp).
  *
- * A one-thread search of particles stored in spatial order finds the rows in host order
- * and writes each one, sorted by rank (32-bit lanes; 16-bit offsets for rows of more
+ * A one-thread search of particles stored in spatial order (on x86 with AVX2; elsewhere,
+ * or with MFREE_SIMD=baseline, both sides below take the general path and the test
+ * checks only that) finds the rows in host order and writes each one, sorted by rank
+ * (32-bit lanes; 16-bit offsets for rows of more
  * than 32 entries spanning fewer than 32767 indices; std::sort beyond 64), straight into
  * the lists, growing them when the estimate from the mean density falls short. The same
  * particles in random order take the general path (cell-order queries into buffers, a
