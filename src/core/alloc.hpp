@@ -6,9 +6,11 @@
 // function pair made it, so that a block goes back to its own allocator even when it is
 // freed in a later call, on another context, or after the host changed the hook. Without
 // a hook, blocks come from malloc, and on Linux big ones (>= 2 MiB) from their own
-// mapping with transparent huge pages requested (madvise), see huge_map. The big
-// per-object arrays (neighbour lists, shape function tables, per-site scratch) are HVec;
-// small bookkeeping uses std::allocator.
+// mapping with transparent huge pages requested (madvise), see huge_map, unless a
+// SmallPages scope asks for malloc's small pages (blocks whose first touch matters most);
+// prefault faults a block in with one system call. The big per-object arrays (neighbour
+// lists, shape function tables, per-site scratch) are HVec; small bookkeeping uses
+// std::allocator.
 #pragma once
 
 #include <algorithm>
