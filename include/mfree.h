@@ -492,7 +492,10 @@ MFREE_API mfree_status_t mfree_particles_set_neighbors(mfree_particles_t *ps,
  * names the particles. The set keeps the search's grid and buffers (through the
  * context's allocator; 1.5-2.5 times the size of the lists) so that the next setup of
  * the same set, e.g. every time step, allocates nothing once the sizes have settled;
- * they are freed with the set.
+ * they are freed with the set. One exception to "a failed call changes nothing": a
+ * one-thread search writes the new lists over the old ones as it goes, so if memory
+ * runs out while it grows them (MFREE_ERR_ALLOC, the rows outgrew the storage), the old
+ * lists are gone and the set is no longer set up; call setup again.
  */
 MFREE_API mfree_status_t mfree_particles_setup(mfree_particles_t *ps);
 
