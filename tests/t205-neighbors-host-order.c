@@ -12,8 +12,9 @@
  * transposition or per-row sorts). Both must give the same relation, exactly: every
  * case sets up the points in spatial order and under a random permutation and compares
  * the rows entry by entry after mapping the indices back (the permuted rows sorted again
- * by the test). A spatially ordered set with two threads (general path) must give the
- * same bits as with one. Cases:
+ * by the test). A spatially ordered set with two threads (host order too, one buffer
+ * per thread, the blocks then moved into place) must give the same bits as with one.
+ * Cases:
  *  - 3D jittered lattice, ~45 neighbours (16-bit ranks), gather and symmetric-max;
  *  - 2D, ~21 neighbours (32-bit ranks), with ghosts;
  *  - variable supports (rows beyond 64: std::sort), symmetric-mean;
@@ -28,6 +29,7 @@
 #include "testutil.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -335,12 +337,67 @@ static void test_allocation_failure(void **state) {
   cloud_free(&c);
 }
 
+/* Allocations counted from any thread (the hook may be called by both at once). */
+static atomic_llong g_calls;
+static void *atomic_alloc(void *user, int64_t bytes) {
+  (void)user;
+  atomic_fetch_add(&g_calls, 1);
+  return malloc((size_t)bytes);
+}
+static void atomic_free(void *user, void *p, int64_t bytes) {
+  (void)user;
+  (void)bytes;
+  free(p);
+}
+
+/* Two threads, host order: repeated setups of a moving set allocate nothing once the
+ * sizes have settled, and give the one-thread lists bit for bit. */
+static void test_two_threads_repeated(void **state) {
+  (void)state;
+  mfree_rng_t r;
+  mfree_rng_seed(&r, 2205);
+  cloud_t c = lattice(3, 16, &r);
+  for (int32_t i = 0; i < c.n; ++i) c.h[i] = 0.5 * cbrt(45.0 * 3.0 / (4.0 * M_PI));
+  mfree_context_t *ctx = NULL, *ctx1 = NULL;
+  assert_ok(NULL, mfree_context_create(&ctx));
+  assert_ok(NULL, mfree_context_create(&ctx1));
+  assert_ok(ctx, mfree_context_set_num_threads(ctx, 2));
+  assert_ok(ctx, mfree_context_set_allocator(ctx, atomic_alloc, atomic_free, NULL));
+  mfree_particles_t *ps = make_set(ctx, &c, MFREE_SEARCH_GATHER, 2.0, 0);
+  mfree_particles_t *ps1 = make_set(ctx1, &c, MFREE_SEARCH_GATHER, 2.0, 0);
+  assert_ok(ctx, mfree_particles_setup(ps));
+  assert_true(atomic_load(&g_calls) > 0);
+  /* a second setup settles the sizes (it keeps the previous statuses aside once) */
+  assert_ok(ctx, mfree_particles_setup(ps));
+  const long long calls = atomic_load(&g_calls);
+  for (int step = 0; step < 4; ++step) {
+    /* a slight contraction (the bounding box, hence the grid, does not grow) and jitter */
+    for (int64_t k = 0; k < 3 * (int64_t)c.n; ++k)
+      c.x[k] = 7.5 + (c.x[k] - 7.5) * 0.999 + 1e-4 * (mfree_rng_uniform(&r) - 0.5);
+    assert_ok(ctx, mfree_particles_setup(ps));
+    assert_ok(ctx1, mfree_particles_setup(ps1));
+    if (atomic_load(&g_calls) != calls)
+      fail_msg("step %d: %lld allocations in a repeated 2-thread setup", step, atomic_load(&g_calls) - calls);
+    lists_t g = fetch(ctx, ps), g1 = fetch(ctx1, ps1);
+    assert_memory_equal(g.rowptr, g1.rowptr, sizeof(int64_t) * ((size_t)c.n + 1));
+    assert_memory_equal(g.cols, g1.cols, sizeof(int32_t) * (size_t)g1.rowptr[c.n]);
+    lists_free(&g);
+    lists_free(&g1);
+  }
+  mfree_particles_destroy(&ps);
+  mfree_particles_destroy(&ps1);
+  mfree_context_destroy(&ctx);
+  mfree_context_destroy(&ctx1);
+  cloud_free(&c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_lattices),
       cmocka_unit_test(test_far_swaps),
       cmocka_unit_test(test_clustered_growth),
       cmocka_unit_test(test_allocation_failure),
+      cmocka_unit_test(test_two_threads_repeated),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

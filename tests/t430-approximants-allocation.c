@@ -154,10 +154,15 @@ static void test_blocks_return_home(void **state) {
   assert_ok(ctx, mfree_context_set_allocator(ctx, count_alloc, count_free, &b));
   assert_ok(ctx, mfree_approximant_update(ap)); /* same sizes: nothing from b */
   assert_int_equal(b.calls, 0);
-  assert_ok(ctx, mfree_particles_setup(ps)); /* new lists from b, old ones back to a */
+  assert_ok(ctx, mfree_particles_setup(ps)); /* same sizes: the lists' storage is reused */
+  assert_int_equal(b.calls, 0);
+  mfree_approximant_t *ap2 = NULL; /* a new approximant: its tables from b */
+  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &ap2));
+  assert_ok(ctx, mfree_approximant_setup(ap2));
   assert_true(b.calls > 0);
   assert_ok(ctx, mfree_approximant_setup(ap));
   assert_ok(ctx, mfree_context_set_allocator(ctx, NULL, NULL, NULL));
+  mfree_approximant_destroy(&ap2); /* b's blocks back to b, a's (ap, the lists) to a */
   mfree_approximant_destroy(&ap);
   mfree_particles_destroy(&ps);
   mfree_context_destroy(&ctx);

@@ -849,6 +849,7 @@ struct NeighborScratch {
   CellGrid grid;
   Buf<int32_t> order;
   RowBuf buf[64];
+  RowBuf row[64];  // one row at a time (host_order_blocks)
   Buf<int64_t> first, rowptr;
   Buf<int32_t> lo_hi;
   Buf<const int32_t *> src;
@@ -981,7 +982,8 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
   });
   const int64_t nnz = rp[nsites];
   out.rowptr.reserve(static_cast<size_t>(nsites) + 1);
-  out.cols.reserve(static_cast<size_t>(nnz));
+  // (a new block gets room for moves: particles drawing closer add a few pairs)
+  if (out.cols.capacity() < static_cast<size_t>(nnz)) out.cols.reserve(static_cast<size_t>(nnz + nnz / 16));
   // nothing below allocates
   if (!symmetric) out.rowptr.assign(rp, rp + nsites + 1);
   else out.rowptr.resize(static_cast<size_t>(nsites) + 1);
@@ -1139,6 +1141,68 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
   }
   out.cols.resize(static_cast<size_t>(rp[rows]));
 }
+
+// host_order_rows on several threads: static blocks of rows in host order, each thread
+// writing its block's sorted rows into its own buffer (sc.buf[t], one row at a time
+// found in sc.row[t]) with row ends relative to the block (sc.rowptr); then the blocks
+// are placed one after the other into out, each thread moving its own. The same lists
+// as on one thread: the same rows, sorted. out is written only after its capacity is
+// reserved, so running out of memory leaves it unchanged.
+void host_order_blocks(const CellGrid &grid, const ParticleSet &ps, const std::vector<int32_t> &status,
+                       const Rule &rule, NeighborScratch &sc, Csr &out, int nt) {
+  const int32_t rows = ps.num_owned();
+  const int dim = ps.dim();
+  const double kappa = ps.kappa();
+  const int nb = block_count(nt);
+  const double per_row = 1.25 * grid.expected_hits() + 8.0;
+  resize_fresh(sc.rowptr, static_cast<size_t>(rows) + 1);
+  int64_t *lrp = sc.rowptr.data();  // lrp[j + 1]: end of row j within its block's buffer
+  int64_t used[kMaxBlocks] = {};
+  parallel_blocks(rows, nt, [&](int t, int64_t b, int64_t e) {
+    RowBuf &buf = sc.buf[t], &tmp = sc.row[t];
+    if (buf.capacity() == 0) buf.reserve(static_cast<size_t>(static_cast<double>(e - b) * per_row));
+    if (buf.size() < buf.capacity()) buf.resize(buf.capacity());  // (no initialisation)
+    int64_t end = 0;
+    for (int64_t j = b; j < e; ++j) {
+      if (status[j] != 0) {
+        lrp[j + 1] = end;  // no row
+        continue;
+      }
+      double x[3] = {0, 0, 0};
+      for (int c = 0; c < dim; ++c) x[c] = grid.wrap(ps.x(static_cast<int32_t>(j), c), c);
+      size_t cnt = 0;
+      grid.query(x, kappa * ps.h(static_cast<int32_t>(j)), rule, tmp, cnt);
+      if (static_cast<size_t>(end) + cnt > buf.size()) buf.resize(std::max(buf.size() * 2, static_cast<size_t>(end) + cnt));
+      int32_t *t0 = tmp.data(), *o = buf.data() + end;
+      if (cnt > 64) {
+        std::sort(t0, t0 + cnt);
+        std::copy(t0, t0 + cnt, o);
+      } else {
+        rank_sort_avx2(t0, static_cast<int>(cnt), o);
+      }
+      end += static_cast<int64_t>(cnt);
+      lrp[j + 1] = end;
+    }
+    used[t] = end;
+  });
+  int64_t base[kMaxBlocks + 1];
+  base[0] = 0;
+  for (int t = 0; t < nb; ++t) base[t + 1] = base[t] + used[t];
+  // capacity first: a failure here leaves out as it was
+  out.rowptr.reserve(static_cast<size_t>(rows) + 1);
+  const size_t total = static_cast<size_t>(base[nb]);
+  if (out.cols.capacity() < total) out.cols.reserve(total + total / 16);  // (room for moves)
+  out.rowptr.resize(static_cast<size_t>(rows) + 1);
+  out.cols.resize(static_cast<size_t>(base[nb]));
+  int64_t *rp = out.rowptr.data();
+  int32_t *cols = out.cols.data();
+  rp[0] = 0;
+  parallel_blocks(rows, nt, [&](int t, int64_t b, int64_t e) {
+    const int64_t off = base[t];
+    std::copy(sc.buf[t].data(), sc.buf[t].data() + used[t], cols + off);
+    for (int64_t j = b; j < e; ++j) rp[j + 1] = off + lrp[j + 1];
+  });
+}
 #endif
 
 }  // namespace
@@ -1148,12 +1212,13 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, N
   sc.grid.build(ps, status);
   const CellGrid &grid = sc.grid;
   const Rule rule{ps.search_convention(), grid.rmax()};
-  // One thread, AVX2, particles stored in spatial order: straight into out, in host order.
-  // (A 2-thread search keeps run_queries: its cell-order blocks are what split the work
-  // without a serial pass over the rows.)
+  // AVX2, particles stored in spatial order: in host order, on one thread straight into
+  // out, on more through one buffer per thread.
 #if MFREE_SIMD_X86
-  if (!grid.empty() && num_threads(ps.size()) == 1 && simd::use_avx2() && grid.host_locality(ps.size()) >= 0.75) {
-    host_order_rows(grid, ps, status, rule, sc.buf[0], out);
+  if (!grid.empty() && simd::use_avx2() && grid.host_locality(ps.size()) >= 0.75) {
+    const int nt = num_threads(ps.size());
+    if (nt == 1) host_order_rows(grid, ps, status, rule, sc.buf[0], out);
+    else host_order_blocks(grid, ps, status, rule, sc, out, nt);
     return;
   }
 #endif

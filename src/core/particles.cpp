@@ -269,7 +269,7 @@ Report ParticleSet::setup() {
   prev_status_.reserve(static_cast<size_t>(n_));  // update swaps the two arrays
   prev_status_.assign(site_status_.begin(), site_status_.end());
   Report rep = validate();
-  Csr out;
+  Csr out{{}, {}};  // (empty: a search allocates nothing here; host lists fill it below)
   try {
     if (host_neighbors()) {
       const int32_t rows = num_owned();
