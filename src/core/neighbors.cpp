@@ -701,6 +701,18 @@ inline void row_min_max(const int32_t *b, const int32_t *e, int32_t init_min, in
 // the tail: min and max do not mind an entry counted twice). The baseline copy above
 // was ~6 % of a 2-thread 2D search's work (the tracking only the threaded transposition
 // needs), this one about a third of that. Same values, so the same lists.
+// The smallest of the eight lanes of mn and the largest of mx.
+MFREE_TARGET_AVX2 inline void hmin_hmax_avx2(__m256i mn, __m256i mx, int32_t &lo, int32_t &hi) {
+  __m128i a4 = _mm_min_epi32(_mm256_castsi256_si128(mn), _mm256_extracti128_si256(mn, 1));
+  __m128i z4 = _mm_max_epi32(_mm256_castsi256_si128(mx), _mm256_extracti128_si256(mx, 1));
+  a4 = _mm_min_epi32(a4, _mm_shuffle_epi32(a4, 0x4e));
+  z4 = _mm_max_epi32(z4, _mm_shuffle_epi32(z4, 0x4e));
+  a4 = _mm_min_epi32(a4, _mm_shuffle_epi32(a4, 0xb1));
+  z4 = _mm_max_epi32(z4, _mm_shuffle_epi32(z4, 0xb1));
+  lo = _mm_cvtsi128_si32(a4);
+  hi = _mm_cvtsi128_si32(z4);
+}
+
 MFREE_TARGET_AVX2 void row_min_max_avx2(const int32_t *b, const int32_t *e, int32_t init_min, int32_t *mm) {
   if (e - b < 8) {
     int32_t a = init_min, z = -1;
@@ -724,14 +736,7 @@ MFREE_TARGET_AVX2 void row_min_max_avx2(const int32_t *b, const int32_t *e, int3
     va = _mm256_min_epi32(va, v);
     vz = _mm256_max_epi32(vz, v);
   }
-  __m128i a4 = _mm_min_epi32(_mm256_castsi256_si128(va), _mm256_extracti128_si256(va, 1));
-  __m128i z4 = _mm_max_epi32(_mm256_castsi256_si128(vz), _mm256_extracti128_si256(vz, 1));
-  a4 = _mm_min_epi32(a4, _mm_shuffle_epi32(a4, 0x4e));
-  z4 = _mm_max_epi32(z4, _mm_shuffle_epi32(z4, 0x4e));
-  a4 = _mm_min_epi32(a4, _mm_shuffle_epi32(a4, 0xb1));
-  z4 = _mm_max_epi32(z4, _mm_shuffle_epi32(z4, 0xb1));
-  mm[0] = _mm_cvtsi128_si32(a4);
-  mm[1] = _mm_cvtsi128_si32(z4);
+  hmin_hmax_avx2(va, vz, mm[0], mm[1]);
   _mm256_zeroupper();
 }
 #endif
@@ -790,13 +795,8 @@ MFREE_TARGET_AVX2 inline bool rank_sort16_avx2_t(const int32_t *a, int n, int32_
     mn = _mm256_min_epi32(mn, v32[q]);
     mx = _mm256_max_epi32(mx, v32[q]);
   }
-  __m128i m4 = _mm_min_epi32(_mm256_castsi256_si128(mn), _mm256_extracti128_si256(mn, 1));
-  __m128i x4 = _mm_max_epi32(_mm256_castsi256_si128(mx), _mm256_extracti128_si256(mx, 1));
-  m4 = _mm_min_epi32(m4, _mm_shuffle_epi32(m4, 0x4e));
-  x4 = _mm_max_epi32(x4, _mm_shuffle_epi32(x4, 0x4e));
-  m4 = _mm_min_epi32(m4, _mm_shuffle_epi32(m4, 0xb1));
-  x4 = _mm_max_epi32(x4, _mm_shuffle_epi32(x4, 0xb1));
-  const int32_t lo = _mm_cvtsi128_si32(m4), hi = _mm_cvtsi128_si32(x4);
+  int32_t lo, hi;
+  hmin_hmax_avx2(mn, mx, lo, hi);
   if (static_cast<int64_t>(hi) - lo >= INT16_MAX) return false;
   const __m256i vlo = _mm256_set1_epi32(lo), cap = _mm256_set1_epi16(INT16_MAX), vn = _mm256_set1_epi16(
                                                                                     static_cast<int16_t>(n));
