@@ -284,6 +284,14 @@ void gradient_rows_2d(int64_t b, int64_t e, const int64_t *rowptr, const int32_t
   }
 }
 
+// The 2D or the 3D kernel.
+template <int D, int NC, bool Add>
+void gradient_rows_simd(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *cols, const double *grad,
+                        const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co) {
+  if constexpr (D == 2) gradient_rows_2d<NC, Add>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+  else gradient_rows_3d<NC, Add>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+}
+
 }  // namespace avx2
 MFREE_AVX2_END
 #endif
@@ -305,26 +313,14 @@ void gradient_block(int64_t b, int64_t e, const int64_t *rowptr, const int32_t *
                     int ncomp, const double *u, int64_t ju, int64_t cu, double *out, int64_t so, int64_t co,
                     bool add, bool use_avx) {
 #if MFREE_SIMD_X86
-  if constexpr (D == 3) {
+  if constexpr (D == 2 || D == 3) {
     if (use_avx && (ncomp == 1 || ncomp == 3)) {
       if (ncomp == 1) {
-        if (add) avx2::gradient_rows_3d<1, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
-        else avx2::gradient_rows_3d<1, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+        if (add) avx2::gradient_rows_simd<D, 1, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+        else avx2::gradient_rows_simd<D, 1, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
       } else {
-        if (add) avx2::gradient_rows_3d<3, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
-        else avx2::gradient_rows_3d<3, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
-      }
-      return;
-    }
-  }
-  if constexpr (D == 2) {
-    if (use_avx && (ncomp == 1 || ncomp == 3)) {
-      if (ncomp == 1) {
-        if (add) avx2::gradient_rows_2d<1, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
-        else avx2::gradient_rows_2d<1, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
-      } else {
-        if (add) avx2::gradient_rows_2d<3, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
-        else avx2::gradient_rows_2d<3, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+        if (add) avx2::gradient_rows_simd<D, 3, true>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
+        else avx2::gradient_rows_simd<D, 3, false>(b, e, rowptr, cols, grad, u, ju, cu, out, so, co);
       }
       return;
     }

@@ -1058,6 +1058,29 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
 }
 
 #if MFREE_SIMD_X86
+// One row of the host-order search: find(j, tmp) queries the grid for particle j into
+// tmp and returns the count; sort_into writes such a row sorted to o.
+struct HostRow {
+  const CellGrid &grid;
+  const ParticleSet &ps;
+  const Rule &rule;
+  size_t find(int32_t j, RowBuf &tmp) const {
+    double x[3] = {0, 0, 0};
+    for (int c = 0; c < ps.dim(); ++c) x[c] = grid.wrap(ps.x(j, c), c);
+    size_t cnt = 0;
+    grid.query(x, ps.kappa() * ps.h(j), rule, tmp, cnt);  // (the radius the grid was built from)
+    return cnt;
+  }
+  static void sort_into(int32_t *t, size_t cnt, int32_t *o) {
+    if (cnt > 64) {
+      std::sort(t, t + cnt);
+      std::copy(t, t + cnt, o);
+    } else {
+      rank_sort_avx2(t, static_cast<int>(cnt), o);
+    }
+  }
+};
+
 // Lists built in host order straight into out, on one thread: row j is the query of
 // particle j, sorted, appended at rp[j] (every earlier row's length is known by then).
 // No row buffers, no cell-order permutation, no transposition: a first search of a new
@@ -1080,8 +1103,7 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
 void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vector<int32_t> &status,
                      const Rule &rule, RowBuf &tmp, Csr &out) {
   const int32_t rows = ps.num_owned();
-  const int dim = ps.dim();
-  const double kappa = ps.kappa();
+  const HostRow row{grid, ps, rule};
   const size_t est = static_cast<size_t>(rows) * static_cast<size_t>(1.25 * grid.expected_hits() + 8.0);
   if (out.rowptr.capacity() < static_cast<size_t>(rows) + 1) {
     out.rowptr.reserve(static_cast<size_t>(rows) + 1);
@@ -1106,10 +1128,7 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
       rp[j + 1] = base;  // no row
       continue;
     }
-    double x[3] = {0, 0, 0};
-    for (int c = 0; c < dim; ++c) x[c] = grid.wrap(ps.x(j, c), c);
-    size_t cnt = 0;
-    grid.query(x, kappa * ps.h(j), rule, tmp, cnt);  // (the radius the grid was built from)
+    const size_t cnt = row.find(j, tmp);
     const int64_t end = base + static_cast<int64_t>(cnt);
     rp[j + 1] = end;
     if (static_cast<size_t>(end) > have) {
@@ -1130,14 +1149,7 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
       have = want;
       cols = out.cols.data();
     }
-    int32_t *t = tmp.data();
-    int32_t *o = cols + base;
-    if (cnt > 64) {
-      std::sort(t, t + cnt);
-      std::copy(t, t + cnt, o);
-    } else {
-      rank_sort_avx2(t, static_cast<int>(cnt), o);
-    }
+    HostRow::sort_into(tmp.data(), cnt, cols + base);
   }
   out.cols.resize(static_cast<size_t>(rp[rows]));
 }
@@ -1151,8 +1163,7 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
 void host_order_blocks(const CellGrid &grid, const ParticleSet &ps, const std::vector<int32_t> &status,
                        const Rule &rule, NeighborScratch &sc, Csr &out, int nt) {
   const int32_t rows = ps.num_owned();
-  const int dim = ps.dim();
-  const double kappa = ps.kappa();
+  const HostRow row{grid, ps, rule};
   const int nb = block_count(nt);
   const double per_row = 1.25 * grid.expected_hits() + 8.0;
   resize_fresh(sc.rowptr, static_cast<size_t>(rows) + 1);
@@ -1168,18 +1179,9 @@ void host_order_blocks(const CellGrid &grid, const ParticleSet &ps, const std::v
         lrp[j + 1] = end;  // no row
         continue;
       }
-      double x[3] = {0, 0, 0};
-      for (int c = 0; c < dim; ++c) x[c] = grid.wrap(ps.x(static_cast<int32_t>(j), c), c);
-      size_t cnt = 0;
-      grid.query(x, kappa * ps.h(static_cast<int32_t>(j)), rule, tmp, cnt);
+      const size_t cnt = row.find(static_cast<int32_t>(j), tmp);
       if (static_cast<size_t>(end) + cnt > buf.size()) buf.resize(std::max(buf.size() * 2, static_cast<size_t>(end) + cnt));
-      int32_t *t0 = tmp.data(), *o = buf.data() + end;
-      if (cnt > 64) {
-        std::sort(t0, t0 + cnt);
-        std::copy(t0, t0 + cnt, o);
-      } else {
-        rank_sort_avx2(t0, static_cast<int>(cnt), o);
-      }
+      HostRow::sort_into(tmp.data(), cnt, buf.data() + end);
       end += static_cast<int64_t>(cnt);
       lrp[j + 1] = end;
     }
