@@ -9,6 +9,9 @@
 #include <cstdlib>
 #include <vector>
 
+#include <sys/mman.h>
+#include <sys/resource.h>
+
 #include "bench_util.h"
 #include <mfree.h>
 
@@ -83,6 +86,38 @@ long long oracle_diff(int dim, int n, const double *x, double r, const int64_t *
   return bad;
 }
 
+// Minor page faults of this process so far (a first touch of a fresh page is one).
+long minor_faults() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_minflt;
+}
+
+// What a first touch of a fresh small page costs here: 16 MiB mapped, kept off huge
+// pages, written one byte per page, best of three; seconds per fault. The first setup
+// of a new set pays this for every page of its lists and buffers (on this VM ~2.8 us,
+// about ten times bare metal: the part of the first setup no search can save).
+double fault_cost() {
+  const size_t bytes = size_t{16} << 20;
+  double best = 1e300;
+  for (int r = 0; r < 3; ++r) {
+    void *m = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m == MAP_FAILED) return 0.0;
+    char *p = static_cast<char *>(m);
+#ifdef MADV_NOHUGEPAGE
+    madvise(p, bytes, MADV_NOHUGEPAGE);
+#endif
+    const long f0 = minor_faults();
+    const double t0 = bench_now();
+    for (size_t k = 0; k < bytes; k += 4096) p[k] = 1;
+    const double t = bench_now() - t0;
+    const long nf = minor_faults() - f0;
+    munmap(m, bytes);
+    if (nf > 0) best = std::min(best, t / static_cast<double>(nf));
+  }
+  return best < 1e300 ? best : 0.0;
+}
+
 // Counting allocator on the context: bytes currently held through the hook.
 struct Held {
   long long bytes = 0;
@@ -103,7 +138,8 @@ void held_free(void *user, void *p, int64_t bytes) {
 // between calls, so that a busy moment of the VM spoils both alike), the best of reps
 // each; the return value is the one-thread best, *tn the other. Without tn: `threads`.
 double time_mfree(int dim, int n, const double *x, double h, int threads, int reps, int64_t *nnz,
-                  mfree_particles_t **keep, double *held, double *first = nullptr, double *tn = nullptr) {
+                  mfree_particles_t **keep, double *held, double *first = nullptr, double *tn = nullptr,
+                  long *first_faults = nullptr) {
   mfree_context_t *ctx = nullptr;
   mfree_particles_t *ps = nullptr;
   static Held count;  // outlives a kept set (destroyed after this context)
@@ -119,6 +155,7 @@ double time_mfree(int dim, int n, const double *x, double h, int threads, int re
   for (int r = 0; r < rounds; ++r) {
     const int k = tn ? (r & 1) : 0;
     mfree_context_set_num_threads(ctx, tn ? (k ? threads : 1) : threads);
+    const long f0 = minor_faults();
     const double t0 = bench_now();
     if (mfree_particles_setup(ps) != MFREE_SUCCESS) {
       std::fprintf(stderr, "mfree_particles_setup failed\n");
@@ -126,6 +163,7 @@ double time_mfree(int dim, int n, const double *x, double h, int threads, int re
     }
     const double t = bench_now() - t0;
     if (r == 0 && first) *first = t;  // the set's first search: allocates its buffers
+    if (r == 0 && first_faults) *first_faults = minor_faults() - f0;
     best[k] = std::min(best[k], t);
   }
   mfree_particles_get_neighbor_nnz(ps, nnz);
@@ -151,7 +189,9 @@ void run(int dim, double n_target) {
   // host without a hook gets it (big blocks then take huge pages, see alloc.hpp).
   // Its later setups alternate one and all threads.
   double t1_first = 0, t1_again = 0, tn = 0;
-  const double t1 = time_mfree(dim, n, x, h, bench_threads(), reps, &nnz, nullptr, nullptr, &t1_first, &tn);
+  long faults = 0;
+  const double t1 =
+      time_mfree(dim, n, x, h, bench_threads(), reps, &nnz, nullptr, nullptr, &t1_first, &tn, &faults);
   // the count of a fresh set set up on all threads only
   time_mfree(dim, n, x, h, bench_threads(), 1, &nnz_t, nullptr, nullptr, nullptr);
   // a new set again, right after another one was destroyed (memory just freed)
@@ -195,6 +235,12 @@ void run(int dim, double n_target) {
 #else
   std::printf("      nanoflann: not found at configure time (Debian libnanoflann-dev), not measured\n");
 #endif
+  // The first setup's fresh pages, at what a first touch costs on this machine
+  const double fc = fault_cost();
+  std::printf("      first setup's page faults: %ld (%.0f bytes per particle), at %.2f us each "
+              "(measured now) %.4f s; first setup without them %.4f s (repeated setups %.4f s)\n",
+              faults, 4096.0 * static_cast<double>(faults) / n, 1e6 * fc, fc * static_cast<double>(faults),
+              t1_first - fc * static_cast<double>(faults), t1);
   if (ps) {
     std::vector<int64_t> rowptr(static_cast<size_t>(n) + 1);
     std::vector<int32_t> cols(static_cast<size_t>(nnz));
