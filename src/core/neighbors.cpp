@@ -22,6 +22,8 @@
 // On one thread with AVX2 and particles stored in spatial order (lattice, curve), the
 // rows are instead found in host order and written sorted straight into the lists
 // (host_order_rows): no buffers, the fewest fresh pages for the first search of a set.
+// There, 3D gather searches without periodic axes scan four candidates a step (AVX2,
+// query_avx2).
 // Either way the lists are the same sets, sorted: the same bits.
 #include <algorithm>
 #include <cmath>
@@ -180,6 +182,19 @@ class CellGrid {
       default: break;
     }
   }
+#if MFREE_SIMD_X86
+  // query() with the AVX2 scan (four candidates a step, hits packed by a table) where
+  // it applies: 3D, no periodic axis, the gather convention; query() otherwise. The same
+  // pair test lane by lane (no FMA), so the same rows in the same order. AVX2 only.
+  // (3D 10^5 one-thread host-order search 66 -> 48 ms; in 2D, rows of ~7.5 candidates
+  // in five ranges, it was 5-7 % slower than query's two lanes, also with two lanes in
+  // the same structure, so 2D keeps query.)
+  void query_avx2(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const {
+    if (nvalid_ == 0) return;
+    if (dim_ == 3 && !any_periodic_ && rule.conv == MFREE_SEARCH_GATHER) query_avx2_t<3>(xq, ri, rule, row, cnt);
+    else query(xq, ri, rule, row, cnt);
+  }
+#endif
 
  private:
   int64_t coord(double x, int c) const {
@@ -201,6 +216,13 @@ class CellGrid {
   }
   template <int D, bool Periodic, bool Gather>
   void query_t(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const;
+#if MFREE_SIMD_X86
+  template <int D>
+  void query_avx2_t(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const;
+  template <int D>
+  size_t scan_avx2(const double *xq, double lim2, const int64_t *P0, const int64_t *P1, int nr, int32_t *out,
+                   size_t k) const;
+#endif
   // The counting sort's two particle passes for particles [b, e), with the dimension and
   // the periodicity as template parameters (no per-axis loops and branches; the same
   // arithmetic as wrap/cell_of, so the same cells): cell[i] of each valid particle
@@ -250,8 +272,9 @@ class CellGrid {
   // the same product; the sorted radii only for the symmetric conventions' pair limit:
   // 16 bytes per particle fewer to write, 390 fewer fresh pages in a first 2D search)
   bool need_srad_ = false;
-  Buf<double> sx_[3], srad_;     // by cell order, one padding entry at the end
-  Buf<int32_t> id_;              // host index by cell order, one padding entry
+  static constexpr int kPad = 4;  // padding entries after the members (the scans read them)
+  Buf<double> sx_[3], srad_;     // by cell order, kPad padding entries at the end
+  Buf<int32_t> id_;              // host index by cell order, kPad padding entries
   Buf<int64_t> start_;           // cell c holds [start_[c], start_[c+1])
   Buf<int64_t> cell_idx_;        // cell of each host index (-1: invalid)
   Buf<int32_t> hist_;            // per-chunk cell counts, then fill positions
@@ -391,14 +414,16 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   const int64_t nc = ncells_;
   resize_fresh(cell_idx_, static_cast<size_t>(n));
   resize_fresh(start_, static_cast<size_t>(nc) + 1);
-  resize_fresh(id_, static_cast<size_t>(nvalid_) + 1);
+  // (kPad padding entries: read, never counted, by the two- and four-lane scans)
+  const size_t padded = static_cast<size_t>(nvalid_) + kPad;
+  resize_fresh(id_, padded);
   if (need_srad_) {
-    resize_fresh(srad_, static_cast<size_t>(nvalid_) + 1);
-    srad_[nvalid_] = 0.0;
+    resize_fresh(srad_, padded);
+    std::fill(srad_.begin() + nvalid_, srad_.end(), 0.0);
   }
-  for (int c = 0; c < dim_; ++c) resize_fresh(sx_[c], static_cast<size_t>(nvalid_) + 1);
-  id_[nvalid_] = 0;  // padding read by the two-lane scan
-  for (int c = 0; c < dim_; ++c) sx_[c][nvalid_] = 0.0;
+  for (int c = 0; c < dim_; ++c) resize_fresh(sx_[c], padded);
+  std::fill(id_.begin() + nvalid_, id_.end(), 0);
+  for (int c = 0; c < dim_; ++c) std::fill(sx_[c].begin() + nvalid_, sx_[c].end(), 0.0);
   int64_t *cell = cell_idx_.data();
   // (per-chunk histograms only while they stay small against the particle count)
   if (nch == 1 || static_cast<double>(nch) * static_cast<double>(nc) > 8.0 * (static_cast<double>(n) + 4096.0)) {
@@ -652,6 +677,126 @@ void CellGrid::query_t(const double *xq, double ri, const Rule &rule, RowBuf &ro
   }
   cnt = k;
 }
+
+#if MFREE_SIMD_X86
+// Packing the hits of four candidates: byte shuffle (pshufb) of four int32 lanes moving
+// the lanes set in the 4-bit mask to the front, and the number of those lanes.
+struct PackTable {
+  alignas(16) int8_t shuf[16][16];
+  int8_t count[16];
+  constexpr PackTable() : shuf(), count() {
+    for (int m = 0; m < 16; ++m) {
+      int k = 0;
+      for (int l = 0; l < 4; ++l)
+        if (m & (1 << l)) {
+          for (int b = 0; b < 4; ++b) shuf[m][4 * k + b] = static_cast<int8_t>(4 * l + b);
+          ++k;
+        }
+      count[m] = static_cast<int8_t>(k);
+      for (int b = 4 * k; b < 16; ++b) shuf[m][b] = static_cast<int8_t>(0x80);  // zero
+    }
+  }
+};
+constexpr PackTable kPack{};
+
+// AVX2 without FMA (target "avx2" alone): the pair test must round like the two-lane
+// scan's, ((d0^2 + d1^2) + d2^2) <= lim2 with every product rounded, so that the rows
+// are the same sets whichever scan found them.
+#define MFREE_TARGET_AVX2_NOFMA __attribute__((target("avx2")))
+
+// The members of the nr non-empty ranges [P0[r], P1[r]) within lim2 of xq, four a
+// step: every candidate's id is stored and the hits packed to the front; the lanes past
+// a range's end (the next cell's members or the padding, kPad entries) are masked off.
+// All ranges in one loop (one call per query: the steps of consecutive ranges overlap).
+// Writes up to out[k + sum of the lengths + 3].
+template <int D>
+MFREE_TARGET_AVX2_NOFMA size_t CellGrid::scan_avx2(const double *xq, double lim2, const int64_t *P0,
+                                                   const int64_t *P1, int nr, int32_t *out, size_t k) const {
+  const double *x0 = sx_[0].data(), *x1 = sx_[D > 1 ? 1 : 0].data(), *x2 = sx_[D > 2 ? 2 : 0].data();
+  const int32_t *id = id_.data();
+  const __m256d q0 = _mm256_set1_pd(xq[0]), q1 = _mm256_set1_pd(D > 1 ? xq[1] : 0.0),
+                q2 = _mm256_set1_pd(D > 2 ? xq[2] : 0.0), lv = _mm256_set1_pd(lim2);
+  for (int r = 0; r < nr; ++r) {
+    const int64_t e = P1[r];
+    for (int64_t p = P0[r]; p < e; p += 4) {
+      const __m256d e0 = _mm256_sub_pd(q0, _mm256_loadu_pd(x0 + p));
+      __m256d d2 = _mm256_mul_pd(e0, e0);
+      if (D > 1) {
+        const __m256d e1 = _mm256_sub_pd(q1, _mm256_loadu_pd(x1 + p));
+        d2 = _mm256_add_pd(d2, _mm256_mul_pd(e1, e1));
+      }
+      if (D > 2) {
+        const __m256d e2 = _mm256_sub_pd(q2, _mm256_loadu_pd(x2 + p));
+        d2 = _mm256_add_pd(d2, _mm256_mul_pd(e2, e2));
+      }
+      const int64_t left = e - p;  // >= 1
+      const int m = _mm256_movemask_pd(_mm256_cmp_pd(d2, lv, _CMP_LE_OQ)) & ((1 << (left < 4 ? left : 4)) - 1);
+      const __m128i ids = _mm_loadu_si128(reinterpret_cast<const __m128i *>(id + p));
+      const __m128i sh = _mm_load_si128(reinterpret_cast<const __m128i *>(kPack.shuf[m]));
+      _mm_storeu_si128(reinterpret_cast<__m128i *>(out + k), _mm_shuffle_epi8(ids, sh));
+      k += static_cast<size_t>(kPack.count[m]);
+    }
+  }
+  return k;
+}
+
+// query_t<D, false, true> with scan_avx2: the member ranges of the stencil's rows of
+// cells collected first (kRows at a time), then scanned in one call. (Per range a call
+// of a four-lane loop was no faster than query_t's two lanes: the short loops' exits
+// were mispredicted and their latency not overlapped; collected, 3D 10^5 66 -> 48 ms.)
+template <int D>
+MFREE_TARGET_AVX2_NOFMA void CellGrid::query_avx2_t(const double *xq, double ri, const Rule &rule, RowBuf &row,
+                                                    size_t &cnt) const {
+  const double R = rule.query(ri) * (1.0 + 1e-12);  // as query_t
+  const double R2 = R * R;
+  const double lim2 = ri * ri * (1.0 + kEdgeTol2);  // as scan
+  int64_t kmin[3] = {0, 0, 0}, kmax[3] = {0, 0, 0};
+  for (int c = 0; c < D; ++c) {
+    kmin[c] = coord(xq[c] - R, c);
+    kmax[c] = coord(xq[c] + R, c);
+  }
+  auto gap2 = [&](int c, int64_t k) {
+    const double a = lo_[c] + static_cast<double>(k) * cell_[c], b = a + cell_[c];
+    double g = std::max(a - xq[c], xq[c] - b) - margin_[c];
+    g = g > 0.0 ? g : 0.0;
+    return g * g;
+  };
+  const int64_t *st = start_.data();
+  // room: every member between the stencil's first and last cell, and a step's overrun
+  const int64_t need = static_cast<int64_t>(cnt) + st[index(kmax) + 1] - st[index(kmin)] + 4;
+  if (static_cast<int64_t>(row.size()) < need) row.resize(2 * static_cast<size_t>(need));
+  int32_t *out = row.data();
+  size_t k = cnt;
+  constexpr int kRows = 32;
+  int64_t P0[kRows], P1[kRows];
+  int nr = 0;
+  // Rows of cells are never skipped along one axis (the extreme ones hold xq - R and xq
+  // + R), only the corners of a 3D stencil: gy[k1 - kmin1] is the squared gap of row k1.
+  double gy[kRows];
+  const int64_t ny = kmax[1] - kmin[1] + 1;
+  const bool corners = D > 2 && ny <= kRows;
+  if (corners)
+    for (int64_t k1 = kmin[1]; k1 <= kmax[1]; ++k1) gy[k1 - kmin[1]] = gap2(1, k1);
+  for (int64_t k2 = kmin[2]; k2 <= kmax[2]; ++k2) {
+    const double gz = D > 2 ? gap2(2, k2) : 0.0;
+    for (int64_t k1 = kmin[1]; k1 <= kmax[1]; ++k1) {
+      const int64_t base = (k2 * nc_[1] + k1) * nc_[0];
+      const int64_t p0 = st[base + kmin[0]], p1 = st[base + kmax[0] + 1];
+      // (kept by a select: which corner rows of a 3D stencil miss the sphere varies
+      // from query to query, a branch there was mispredicted)
+      const bool keep = p1 > p0 && !(corners && gz + gy[k1 - kmin[1]] > R2);
+      P0[nr] = p0;
+      P1[nr] = p1;
+      nr += keep ? 1 : 0;
+      if (nr == kRows) {
+        k = scan_avx2<D>(xq, lim2, P0, P1, nr, out, k);
+        nr = 0;
+      }
+    }
+  }
+  cnt = scan_avx2<D>(xq, lim2, P0, P1, nr, out, k);
+}
+#endif
 
 // Rows are short (tens) and, for particles stored in lattice or cell order, nearly
 // sorted already: insertion sort beats std::sort's set-up there.
@@ -1068,7 +1213,7 @@ struct HostRow {
     double x[3] = {0, 0, 0};
     for (int c = 0; c < ps.dim(); ++c) x[c] = grid.wrap(ps.x(j, c), c);
     size_t cnt = 0;
-    grid.query(x, ps.kappa() * ps.h(j), rule, tmp, cnt);  // (the radius the grid was built from)
+    grid.query_avx2(x, ps.kappa() * ps.h(j), rule, tmp, cnt);  // (the radius the grid was built from)
     return cnt;
   }
   static void sort_into(int32_t *t, size_t cnt, int32_t *o) {
