@@ -662,7 +662,10 @@ void CellGrid::query_t(const double *xq, double ri, const Rule &rule, RowBuf &ro
     if (gz > R2) continue;
     const int64_t w2 = Periodic && periodic_[2] ? ((k2 % nc_[2]) + nc_[2]) % nc_[2] : k2;
     for (int64_t k1 = kmin[1]; k1 <= kmax[1]; ++k1) {
-      if (D > 1 && gz + gap2(1, k1) > R2) continue;
+      // (only the corners of a 3D stencil can miss the sphere: along one axis the
+      // extreme rows hold xq - R and xq + R, or lie within R of xq's cell when periodic;
+      // the test cost 9 % of a 2D search and never skipped a row there)
+      if (D > 2 && gz + gap2(1, k1) > R2) continue;
       const int64_t w1 = Periodic && periodic_[1] ? ((k1 % nc_[1]) + nc_[1]) % nc_[1] : k1;
       const int64_t base = (w2 * nc_[1] + w1) * nc_[0];
       for (int sg = 0; sg < nseg; ++sg) {
@@ -975,6 +978,8 @@ MFREE_TARGET_AVX2 void rank_sort_avx2(const int32_t *a, int n, int32_t *out) {
   } else if (n > 32 && n <= 48 && rank_sort16_avx2_t<3>(a, n, out)) {
   } else if (n <= 16) {
     rank_sort_avx2_t<2>(a, n, out);
+  } else if (n <= 24) {  // (2D rows, ~21: 3 % of a 2D search against four vectors)
+    rank_sort_avx2_t<3>(a, n, out);
   } else if (n <= 32) {
     rank_sort_avx2_t<4>(a, n, out);
   } else if (n <= 48) {
