@@ -228,11 +228,11 @@ class CellGrid {
   // arithmetic as wrap/cell_of, so the same cells): cell[i] of each valid particle
   // (-1: invalid) counted in cnt[cell], then the scatter by the fill positions pos.
   template <int D, bool Periodic, class Cnt>
-  void cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int64_t *cell, Cnt *cnt) const;
+  void cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell, Cnt *cnt) const;
   template <int D, bool Periodic, class Pos>
-  void scatter_t(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int64_t *cell, Pos *pos);
+  void scatter_t(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int32_t *cell, Pos *pos);
   template <class Cnt>
-  void cells(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int64_t *cell, Cnt *cnt) const {
+  void cells(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell, Cnt *cnt) const {
     switch (dim_ * 2 + (any_periodic_ ? 1 : 0)) {
       case 2: cells_t<1, false>(ps, status, b, e, cell, cnt); break;
       case 3: cells_t<1, true>(ps, status, b, e, cell, cnt); break;
@@ -243,7 +243,7 @@ class CellGrid {
     }
   }
   template <class Pos>
-  void scatter(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int64_t *cell, Pos *pos) {
+  void scatter(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int32_t *cell, Pos *pos) {
     switch (dim_ * 2 + (any_periodic_ ? 1 : 0)) {
       case 2: scatter_t<1, false>(ps, kappa, b, e, cell, pos); break;
       case 3: scatter_t<1, true>(ps, kappa, b, e, cell, pos); break;
@@ -275,8 +275,10 @@ class CellGrid {
   static constexpr int kPad = 4;  // padding entries after the members (the scans read them)
   Buf<double> sx_[3], srad_;     // by cell order, kPad padding entries at the end
   Buf<int32_t> id_;              // host index by cell order, kPad padding entries
-  Buf<int64_t> start_;           // cell c holds [start_[c], start_[c+1])
-  Buf<int64_t> cell_idx_;        // cell of each host index (-1: invalid)
+  // (32-bit cell starts and indices: nvalid < 2^31 and at most 2^31 - 2 cells; half the
+  // fresh pages and the memory traffic of 64-bit ones)
+  Buf<int32_t> start_;           // cell c holds [start_[c], start_[c+1])
+  Buf<int32_t> cell_idx_;        // cell of each host index (-1: invalid)
   Buf<int32_t> hist_;            // per-chunk cell counts, then fill positions
 };
 
@@ -367,7 +369,7 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   // always correct because coordinates are clamped into the grid, and never reaches an
   // out-of-range cast.
   double edge = 0.5 * rsum / static_cast<double>(nvalid_);
-  const double max_cells = 2.0 * static_cast<double>(nvalid_) + 64.0;
+  const double max_cells = std::min(2.0 * static_cast<double>(nvalid_) + 64.0, 2147483646.0);
   auto span = [](double ext, double e) {
     const double k = std::floor(ext / e);
     return std::isfinite(k) ? k : 0.0;
@@ -413,7 +415,7 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   // cell) for any chunk count: chunk v's particles follow chunk v-1's in every cell.
   const int64_t nc = ncells_;
   resize_fresh(cell_idx_, static_cast<size_t>(n));
-  resize_fresh(start_, static_cast<size_t>(nc) + 1);
+  resize_fresh(start_, static_cast<size_t>(nc) + 2);
   // (kPad padding entries: read, never counted, by the two- and four-lane scans)
   const size_t padded = static_cast<size_t>(nvalid_) + kPad;
   resize_fresh(id_, padded);
@@ -424,16 +426,17 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   for (int c = 0; c < dim_; ++c) resize_fresh(sx_[c], padded);
   std::fill(id_.begin() + nvalid_, id_.end(), 0);
   for (int c = 0; c < dim_; ++c) std::fill(sx_[c].begin() + nvalid_, sx_[c].end(), 0.0);
-  int64_t *cell = cell_idx_.data();
+  int32_t *cell = cell_idx_.data();
   // (per-chunk histograms only while they stay small against the particle count)
   if (nch == 1 || static_cast<double>(nch) * static_cast<double>(nc) > 8.0 * (static_cast<double>(n) + 4096.0)) {
-    std::fill(start_.begin(), start_.end(), 0);
-    cells(ps, status.data(), 0, n, cell, start_.data() + 1);
-    for (int64_t c = 0; c < nc; ++c) start_[c + 1] += start_[c];
-    scatter(ps, kappa, 0, n, cell, start_.data());
-    // start_[c] now holds the old start_[c + 1]: shift back
-    for (int64_t c = nc; c > 0; --c) start_[c] = start_[c - 1];
-    start_[0] = 0;
+    // counts in start_[c + 2], their prefix sums make start_[c + 1] the start of cell c,
+    // the scatter's fill positions, which it leaves at the start of cell c + 1 (one
+    // entry more than the cells need: no pass shifting them back)
+    int32_t *s2 = start_.data();
+    std::fill(s2, s2 + nc + 2, 0);
+    cells(ps, status.data(), 0, n, cell, s2 + 2);
+    for (int64_t c = 2; c <= nc + 1; ++c) s2[c] += s2[c - 1];
+    scatter(ps, kappa, 0, n, cell, s2 + 1);
     return;
   }
   // chunk counts (nvalid < 2^31, so every count and position fits 32 bits)
@@ -460,7 +463,7 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
     int64_t b, e, s = v > 0 ? block_total[v - 1] : 0;
     thread_block(nc, v, nch, b, e);
     for (int64_t c = b; c < e; ++c) {
-      start_[c] = s;
+      start_[c] = static_cast<int32_t>(s);
       for (int u = 0; u < nch; ++u) {
         int32_t &h = hist[static_cast<int64_t>(u) * nc + c];
         const int32_t cnt = h;
@@ -481,7 +484,7 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
 double CellGrid::host_locality(int32_t n) const {
   if (nvalid_ < 2 || static_cast<int64_t>(cell_idx_.size()) < n) return 0.0;
   const int64_t w = dim_ == 1 ? 4 : (dim_ == 2 ? 2 * nc_[0] + 4 : nc_[0] * nc_[1] + 2 * nc_[0] + 4);
-  const int64_t *cell = cell_idx_.data();
+  const int32_t *cell = cell_idx_.data();
   int64_t prev = -1, near = 0, pairs = 0;
   for (int32_t i = 0; i < n; ++i) {
     const int64_t c = cell[i];
@@ -496,7 +499,7 @@ double CellGrid::host_locality(int32_t n) const {
 }
 
 template <int D, bool Periodic, class Cnt>
-void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int64_t *cell,
+void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell,
                        Cnt *cnt) const {
   for (int64_t i = b; i < e; ++i) {
     if (status[i] != 0) {
@@ -507,13 +510,13 @@ void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, 
     // index() order: id = (k2 * nc1 + k1) * nc0 + k0
     int64_t id = 0;
     for (int c = D - 1; c >= 0; --c) id = id * nc_[c] + coord(Periodic ? wrap(ps.x(p, c), c) : ps.x(p, c), c);
-    cell[i] = id;
+    cell[i] = static_cast<int32_t>(id);
     ++cnt[id];
   }
 }
 
 template <int D, bool Periodic, class Pos>
-void CellGrid::scatter_t(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int64_t *cell, Pos *pos) {
+void CellGrid::scatter_t(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int32_t *cell, Pos *pos) {
   double *x[3] = {sx_[0].data(), sx_[D > 1 ? 1 : 0].data(), sx_[D > 2 ? 2 : 0].data()};
   int32_t *id = id_.data();
   for (int64_t i = b; i < e; ++i) {
@@ -646,7 +649,7 @@ void CellGrid::query_t(const double *xq, double ri, const Rule &rule, RowBuf &ro
   // Room for every member the rows can hold (+1 for the two-lane scan's overrun). Without
   // periodic axes the scanned rows lie between the stencil's first and last cell in cell
   // order, so one check per query suffices.
-  const int64_t *st = start_.data();
+  const int32_t *st = start_.data();
   bool checked = false;
   if (!Periodic) {
     const int64_t need = static_cast<int64_t>(cnt) + st[index(kmax) + 1] - st[index(kmin)] + 1;
@@ -764,7 +767,7 @@ MFREE_TARGET_AVX2_NOFMA void CellGrid::query_avx2_t(const double *xq, double ri,
     g = g > 0.0 ? g : 0.0;
     return g * g;
   };
-  const int64_t *st = start_.data();
+  const int32_t *st = start_.data();
   // room: every member between the stencil's first and last cell, and a step's overrun
   const int64_t need = static_cast<int64_t>(cnt) + st[index(kmax) + 1] - st[index(kmin)] + 4;
   if (static_cast<int64_t>(row.size()) < need) row.resize(2 * static_cast<size_t>(need));
