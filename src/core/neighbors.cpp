@@ -197,15 +197,22 @@ class CellGrid {
 #endif
 
  private:
+  // floor((x - lo) / cell), clamped or wrapped. (Without std::floor: baseline x86-64 has
+  // no roundsd, and its branchy software floor was most of the cell pass of the build
+  // and of a 2D query's set-up. Truncation is the floor for q > 0; where q may be
+  // negative, one compare corrects it. The same cells as with floor.)
   int64_t coord(double x, int c) const {
-    const double f = std::floor((x - lo_[c]) / cell_[c]);
+    const double q = (x - lo_[c]) / cell_[c];
     int64_t k;
     if (periodic_[c]) {
-      k = static_cast<int64_t>(f) % nc_[c];
+      // (q lies within a cell or so of [0, nc]: x was wrapped)
+      k = static_cast<int64_t>(q);
+      k -= q < static_cast<double>(k) ? 1 : 0;
+      k %= nc_[c];
       if (k < 0) k += nc_[c];
     } else {
       // clamp in double first: far-away host points must not overflow the cast
-      k = f <= 0.0 ? 0 : (f >= static_cast<double>(nc_[c] - 1) ? nc_[c] - 1 : static_cast<int64_t>(f));
+      k = q <= 0.0 ? 0 : (q >= static_cast<double>(nc_[c] - 1) ? nc_[c] - 1 : static_cast<int64_t>(q));
     }
     return k;
   }
