@@ -202,7 +202,9 @@ class CellGrid {
   // and of a 2D query's set-up. Truncation is the floor for q > 0; where q may be
   // negative, one compare corrects it. The same cells as with floor.)
   int64_t coord(double x, int c) const {
-    const double q = (x - lo_[c]) / cell_[c];
+    // (by the reciprocal: a division was most of the cell pass; monotone in x like the
+    // quotient, and within an ulp or two of it, far inside margin_)
+    const double q = inv_ok_ ? (x - lo_[c]) * inv_[c] : (x - lo_[c]) / cell_[c];
     int64_t k;
     if (periodic_[c]) {
       // (q lies within a cell or so of [0, nc]: x was wrapped)
@@ -266,6 +268,8 @@ class CellGrid {
 
   int dim_ = 1;
   double lo_[3] = {0, 0, 0}, cell_[3] = {1, 1, 1}, L_[3] = {0, 0, 0};
+  double inv_[3] = {1, 1, 1};  // 1 / cell_, used when all are finite and normal (inv_ok_)
+  bool inv_ok_ = true;
   double margin_[3] = {0, 0, 0};  // slack of the geometric cell bounds (query)
   int64_t nc_[3] = {1, 1, 1};
   int64_t ncells_ = 1;
@@ -403,6 +407,11 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   }
   ncells_ = 1;
   for (int c = 0; c < dim_; ++c) ncells_ *= nc_[c];
+  inv_ok_ = true;
+  for (int c = 0; c < 3; ++c) {
+    inv_[c] = 1.0 / cell_[c];
+    inv_ok_ = inv_ok_ && std::isnormal(inv_[c]) && std::isnormal(cell_[c]);
+  }
   {
     // expected row length if the particles filled the grid's box evenly
     const double r = rsum / static_cast<double>(nvalid_);
