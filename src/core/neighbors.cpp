@@ -28,7 +28,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
+#include <type_traits>
 #include <utility>
 
 #include "approximant.hpp"
@@ -327,21 +329,44 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
     // accumulated in a local copy: the chunks' Part records share cache lines, and
     // updating them in place per particle made this pass slower on two threads than on
     // one (false sharing)
-    Part p;
-    for (int64_t i = b; i < e; ++i) {
-      if (status[i] != 0) continue;
-      const double r = kappa * ps.h(static_cast<int32_t>(i));
-      if (p.count == 0 || r < p.rmin) p.rmin = r;
-      if (r > p.rmax) p.rmax = r;
-      p.rsum += r;
-      for (int c = 0; c < dim_; ++c) {
-        const double x = wrap(ps.x(static_cast<int32_t>(i), c), c);
-        if (p.count == 0 || x < p.bmin[c]) p.bmin[c] = x;
-        if (p.count == 0 || x > p.bmax[c]) p.bmax[c] = x;
+    // (strided loads, the dimension a template parameter and infinite starting bounds:
+    // min and max without branches; the same values, the same sum)
+    const double *X = ps.pos_data(), *H = ps.h_data();
+    const int64_t si = ps.pos_step_i(), sc = ps.pos_step_c(), sh = ps.h_step();
+    auto pass = [&](auto dc) {
+      constexpr int D = decltype(dc)::value;
+      const double inf = std::numeric_limits<double>::infinity();
+      Part p;
+      double rmin = inf, rmax = 0.0, rsum = 0.0, lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
+      int32_t count = 0;
+      const bool per = any_periodic_;
+      for (int64_t i = b; i < e; ++i) {
+        if (status[i] != 0) continue;
+        const double r = kappa * H[i * sh];
+        rmin = r < rmin ? r : rmin;
+        rmax = r > rmax ? r : rmax;
+        rsum += r;
+#pragma GCC unroll 3
+        for (int c = 0; c < D; ++c) {
+          const double x = per ? wrap(X[i * si + c * sc], c) : X[i * si + c * sc];
+          lo[c] = x < lo[c] ? x : lo[c];
+          hi[c] = x > hi[c] ? x : hi[c];
+        }
+        ++count;
       }
-      ++p.count;
-    }
-    part[v] = p;
+      p.rmin = rmin;
+      p.rmax = rmax;
+      p.rsum = rsum;
+      p.count = count;
+      for (int c = 0; c < D; ++c) {
+        p.bmin[c] = lo[c];
+        p.bmax[c] = hi[c];
+      }
+      part[v] = p;
+    };
+    if (dim_ == 1) pass(std::integral_constant<int, 1>());
+    else if (dim_ == 2) pass(std::integral_constant<int, 2>());
+    else pass(std::integral_constant<int, 3>());
   });
   double rsum = 0.0, rmin = 0.0, bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0};
   for (int v = 0; v < nch; ++v) {
@@ -517,15 +542,19 @@ double CellGrid::host_locality(int32_t n) const {
 template <int D, bool Periodic, class Cnt>
 void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell,
                        Cnt *cnt) const {
+  const double *X = ps.pos_data();
+  const int64_t si = ps.pos_step_i(), sc = ps.pos_step_c();
   for (int64_t i = b; i < e; ++i) {
     if (status[i] != 0) {
       cell[i] = -1;
       continue;
     }
-    const int32_t p = static_cast<int32_t>(i);
     // index() order: id = (k2 * nc1 + k1) * nc0 + k0
     int64_t id = 0;
-    for (int c = D - 1; c >= 0; --c) id = id * nc_[c] + coord(Periodic ? wrap(ps.x(p, c), c) : ps.x(p, c), c);
+    for (int c = D - 1; c >= 0; --c) {
+      const double x = X[i * si + c * sc];
+      id = id * nc_[c] + coord(Periodic ? wrap(x, c) : x, c);
+    }
     cell[i] = static_cast<int32_t>(id);
     ++cnt[id];
   }
@@ -535,13 +564,17 @@ template <int D, bool Periodic, class Pos>
 void CellGrid::scatter_t(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int32_t *cell, Pos *pos) {
   double *x[3] = {sx_[0].data(), sx_[D > 1 ? 1 : 0].data(), sx_[D > 2 ? 2 : 0].data()};
   int32_t *id = id_.data();
+  const double *X = ps.pos_data(), *H = ps.h_data();
+  const int64_t si = ps.pos_step_i(), sc = ps.pos_step_c(), sh = ps.h_step();
   for (int64_t i = b; i < e; ++i) {
     if (cell[i] < 0) continue;
-    const int32_t p = static_cast<int32_t>(i);
     const int64_t q = pos[cell[i]]++;
-    id[q] = p;
-    for (int c = 0; c < D; ++c) x[c][q] = Periodic ? wrap(ps.x(p, c), c) : ps.x(p, c);
-    if (need_srad_) srad_[q] = kappa * ps.h(p);
+    id[q] = static_cast<int32_t>(i);
+    for (int c = 0; c < D; ++c) {
+      const double xc = X[i * si + c * sc];
+      x[c][q] = Periodic ? wrap(xc, c) : xc;
+    }
+    if (need_srad_) srad_[q] = kappa * H[i * sh];
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "parallel.hpp"
@@ -201,15 +202,28 @@ Report ParticleSet::validate() {
   {
     const int nt = std::min(num_threads(n_), 64);
     char fail[64] = {0};
+    // (one array at a time with strided loads and no early exit: loops without branches;
+    // a value shared by all, stride 0, checked once)
     parallel_blocks(n_, nt, [&](int t, int64_t b, int64_t e) {
-      bool f = false;
-      for (int64_t i = b; i < e; ++i) {
-        const int32_t p = static_cast<int32_t>(i);
-        for (int c = 0; c < dim_; ++c) f = f || !std::isfinite(pos_(p, c));
-        auto bad = [&](const ScalarArray &a) { return a.set() && !(std::isfinite(a(p)) && a(p) > 0.0); };
-        f = f || bad(h_) || bad(vol_) || bad(mass_) || bad(rho_);
+      const double big = std::numeric_limits<double>::max();
+      bool ok = true;
+      const double *X = pos_data();
+      const int64_t si = pos_step_i(), sc = pos_step_c();
+      for (int c = 0; c < dim_; ++c) {
+        bool okc = true;
+        for (int64_t i = b; i < e; ++i) okc &= std::fabs(X[i * si + c * sc]) <= big;  // finite
+        ok = ok && okc;
       }
-      fail[t] = f;
+      for (const ScalarArray *a : {&h_, &vol_, &mass_, &rho_}) {
+        if (!a->set()) continue;
+        const double *v = a->ptr;
+        const int64_t st = a->stride;
+        const int64_t e1 = st == 0 ? std::min<int64_t>(e, b + 1) : e;
+        bool oka = true;
+        for (int64_t i = b; i < e1; ++i) oka &= v[i * st] > 0.0 && v[i * st] <= big;  // finite, > 0
+        ok = ok && oka;
+      }
+      fail[t] = !ok;
     });
     bool any = false;
     for (int t = 0; t < nt; ++t) any = any || fail[t];

@@ -76,6 +76,13 @@ class ParticleSet {
 
   double x(int32_t i, int c) const { return pos_(i, c); }
   double h(int32_t i) const { return h_(i); }
+  // The same values for tight loops, without the layout test per access:
+  // x(i, c) == pos_data()[i * pos_step_i() + c * pos_step_c()], h(i) == h_data()[i * h_step()].
+  const double *pos_data() const { return pos_.ptr; }
+  int64_t pos_step_i() const { return pos_.layout == MFREE_LAYOUT_AOS ? pos_.ld : 1; }
+  int64_t pos_step_c() const { return pos_.layout == MFREE_LAYOUT_AOS ? 1 : pos_.ld; }
+  const double *h_data() const { return h_.ptr; }
+  int64_t h_step() const { return h_.stride; }
   bool has_support() const { return h_.set(); }
   bool has_volumes() const { return vol_.set() || (mass_.set() && rho_.set()); }
   double volume(int32_t i) const { return vol_.set() ? vol_(i) : mass_(i) / rho_(i); }
