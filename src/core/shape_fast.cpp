@@ -100,7 +100,7 @@ void FastScratch::reserve(int maxrow) {
   const int need = (maxrow + 4) / 4 * 4;
   if (need <= cap) return;
   cap = need;
-  buf.assign(static_cast<size_t>(cap) * 12, 0.0);
+  buf.assign(static_cast<size_t>(cap) * 14, 0.0);
   sval.assign(static_cast<size_t>(cap), 0.0);
   sgrad.assign(static_cast<size_t>(cap) * 3, 0.0);
 }

@@ -39,9 +39,9 @@ struct FastTables {
   double *grad = nullptr;  // nullptr when the gradient table is not built
 };
 
-// Per-thread scratch, sized for the longest row before the sites are computed: twelve
-// arrays of SoA neighbour data, d(0) .. d(11) (cap >= the longest row rounded up to
-// whole groups of four; the corrected rows of RL and KB 1 use two sets of six), and a
+// Per-thread scratch, sized for the longest row before the sites are computed: fourteen
+// arrays of SoA neighbour data, d(0) .. d(13) (cap >= the longest row rounded up to
+// whole groups of four; the corrected rows: two sets of six, of seven for KB 1 in 3D), and a
 // staging area for one row of values and up to three gradients.
 struct FastScratch {
   HVec<double> buf, sval, sgrad;
