@@ -192,10 +192,14 @@ class CellGrid {
   // host-order search 66 -> 48 ms, a loop per range inline was 23 % slower); 2D, five
   // ranges of ~7.5 candidates, scans each range inline (query2_avx2: 6 % faster than
   // query's two lanes, collecting was 7 % slower than them).
-  void query_avx2(const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const {
-    if (nvalid_ == 0) return;
-    if (dim_ == 3 && !any_periodic_ && rule.conv == MFREE_SEARCH_GATHER) query_avx2_t<3>(xq, ri, rule, row, cnt);
-    else if (dim_ == 2 && !any_periodic_ && rule.conv == MFREE_SEARCH_GATHER) query2_avx2(xq, ri, rule, row, cnt);
+  // kind = avx2_kind(rule), asked once per search: 2 or 3 for the AVX2 queries, 0 for
+  // query().
+  int avx2_kind(const Rule &rule) const {
+    return nvalid_ == 0 || any_periodic_ || rule.conv != MFREE_SEARCH_GATHER || dim_ < 2 ? 0 : dim_;
+  }
+  void query_avx2(int kind, const double *xq, double ri, const Rule &rule, RowBuf &row, size_t &cnt) const {
+    if (kind == 2) query2_avx2(xq, ri, rule, row, cnt);
+    else if (kind == 3) query_avx2_t<3>(xq, ri, rule, row, cnt);
     else query(xq, ri, rule, row, cnt);
   }
 #endif
@@ -1304,11 +1308,16 @@ struct HostRow {
   const CellGrid &grid;
   const ParticleSet &ps;
   const Rule &rule;
+  // (asked once: strided access, the query's kind)
+  const double *X = ps.pos_data(), *H = ps.h_data();
+  const int64_t si = ps.pos_step_i(), sc = ps.pos_step_c(), sh = ps.h_step();
+  const int dim = ps.dim(), kind = grid.avx2_kind(rule);
+  const double kappa = ps.kappa();
   size_t find(int32_t j, RowBuf &tmp) const {
     double x[3] = {0, 0, 0};
-    for (int c = 0; c < ps.dim(); ++c) x[c] = grid.wrap(ps.x(j, c), c);
+    for (int c = 0; c < dim; ++c) x[c] = grid.wrap(X[j * si + c * sc], c);
     size_t cnt = 0;
-    grid.query_avx2(x, ps.kappa() * ps.h(j), rule, tmp, cnt);  // (the radius the grid was built from)
+    grid.query_avx2(kind, x, kappa * H[j * sh], rule, tmp, cnt);  // (the radius the grid was built from)
     return cnt;
   }
   static void sort_into(int32_t *t, size_t cnt, int32_t *o) {
