@@ -1,0 +1,158 @@
+/*
+ * t207: the host-order neighbour search's strided reads and four-lane scans (issue 8,
+ * src/core/neighbors.cpp: query2_avx2 in 2D, query_avx2_t in 3D, on x86 with AVX2;
+ * elsewhere, or with MFREE_SIMD=baseline, the general path, and the test checks that).
+ *
+ * Jittered lattices stored in lattice order (host order = spatial order), gather
+ * convention, supports varying by a factor ~2 from particle to particle (query radii and
+ * member ranges of every length, rows past the lanes' masks), given
+ *  - as AoS positions with stride-1 supports, and
+ *  - as SoA positions with a padded leading dimension (n + 5) and the supports read with
+ *    stride 3 out of an interleaved array:
+ * both must give the same lists bit for bit, with one thread and with two, and every row
+ * must equal the O(N^2) oracle's: j in row i iff |x_i - x_j| <= kappa h_i, for every pair
+ * farther than 1e-9 (relative) from that threshold (pairs closer to it are not judged: the
+ * library's closed-support tolerance decides them); the test also asserts that at least
+ * one row has more than 32 entries and one fewer than 16. No timing.
+ */
+#include "testutil.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+typedef struct {
+  int64_t *rowptr;
+  int32_t *cols;
+} lists_t;
+
+static lists_t search(int dim, int32_t n, const double *x, int layout, int64_t ld, const double *h, int64_t hs,
+                      int threads) {
+  mfree_context_t *ctx = NULL;
+  mfree_particles_t *ps = NULL;
+  assert_ok(NULL, mfree_context_create(&ctx));
+  assert_ok(ctx, mfree_context_set_num_threads(ctx, threads));
+  assert_ok(ctx, mfree_particles_create(ctx, dim, n, &ps));
+  assert_ok(ctx, mfree_particles_set_positions(ps, x, (mfree_layout_t)layout, ld, MFREE_BORROW));
+  assert_ok(ctx, mfree_particles_set_support(ps, h, hs, MFREE_BORROW));
+  assert_ok(ctx, mfree_particles_set_search(ps, MFREE_SEARCH_GATHER, 2.0));
+  assert_ok(ctx, mfree_particles_setup(ps));
+  int64_t nnz = 0;
+  assert_ok(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz));
+  lists_t g;
+  g.rowptr = malloc(sizeof(int64_t) * ((size_t)n + 1));
+  g.cols = malloc(sizeof(int32_t) * (size_t)(nnz > 0 ? nnz : 1));
+  assert_non_null(g.rowptr);
+  assert_non_null(g.cols);
+  assert_ok(ctx, mfree_particles_get_neighbors(ps, g.rowptr, g.cols));
+  assert_int_equal(g.rowptr[n], nnz);
+  mfree_particles_destroy(&ps);
+  mfree_context_destroy(&ctx);
+  return g;
+}
+
+static void run(int dim, int m, double neighbours, uint64_t seed) {
+  mfree_rng_t r;
+  mfree_rng_seed(&r, seed);
+  int32_t n = 1;
+  for (int d = 0; d < dim; ++d) n *= m;
+  const int64_t ld = (int64_t)n + 5;
+  double *aos = malloc(sizeof(double) * (size_t)n * dim), *soa = malloc(sizeof(double) * (size_t)ld * dim);
+  double *h = malloc(sizeof(double) * (size_t)n), *h3 = malloc(sizeof(double) * 3 * (size_t)n);
+  assert_non_null(aos);
+  assert_non_null(soa);
+  assert_non_null(h);
+  assert_non_null(h3);
+  /* mean support radius 2 h for `neighbours` neighbours at unit density */
+  const double rad = dim == 2 ? sqrt(neighbours / M_PI) : cbrt(neighbours * 3.0 / (4.0 * M_PI));
+  for (int32_t p = 0; p < n; ++p) {
+    int32_t q = p;
+    for (int d = 0; d < dim; ++d) {
+      const double v = (q % m) + 0.3 * (2.0 * mfree_rng_uniform(&r) - 1.0);
+      aos[(size_t)dim * p + d] = v;
+      soa[(size_t)d * ld + p] = v;
+      q /= m;
+    }
+    h[p] = 0.5 * rad * (0.6 + 0.8 * mfree_rng_uniform(&r));
+    h3[3 * (size_t)p] = h[p];
+    h3[3 * (size_t)p + 1] = -1.0; /* never read */
+    h3[3 * (size_t)p + 2] = NAN;
+  }
+  for (int64_t p = n; p < ld; ++p)
+    for (int d = 0; d < dim; ++d) soa[(size_t)d * ld + p] = NAN; /* padding, never read */
+
+  const lists_t ref = search(dim, n, aos, MFREE_LAYOUT_AOS, dim, h, 1, 1);
+  const size_t nnz = (size_t)ref.rowptr[n];
+  for (int threads = 1; threads <= 2; ++threads) {
+    lists_t g = search(dim, n, soa, MFREE_LAYOUT_SOA, ld, h3, 3, threads);
+    assert_memory_equal(g.rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)n + 1));
+    assert_memory_equal(g.cols, ref.cols, sizeof(int32_t) * nnz);
+    free(g.rowptr);
+    free(g.cols);
+    if (threads == 2) {
+      g = search(dim, n, aos, MFREE_LAYOUT_AOS, dim, h, 1, 2);
+      assert_memory_equal(g.rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)n + 1));
+      assert_memory_equal(g.cols, ref.cols, sizeof(int32_t) * nnz);
+      free(g.rowptr);
+      free(g.cols);
+    }
+  }
+
+  /* the oracle, row by row: clear pairs only */
+  int64_t longest = 0, shortest = n, judged = 0;
+  for (int32_t i = 0; i < n; ++i) {
+    const int64_t b = ref.rowptr[i], e = ref.rowptr[i + 1];
+    if (e - b > longest) longest = e - b;
+    if (e - b < shortest) shortest = e - b;
+    for (int64_t k = b + 1; k < e; ++k) assert_true(ref.cols[k - 1] < ref.cols[k]);
+    const double lim2 = (2.0 * h[i]) * (2.0 * h[i]);
+    int64_t k = b;
+    for (int32_t j = 0; j < n; ++j) {
+      double d2 = 0.0;
+      for (int d = 0; d < dim; ++d) {
+        const double t = aos[(size_t)dim * i + d] - aos[(size_t)dim * j + d];
+        d2 += t * t;
+      }
+      const int listed = k < e && ref.cols[k] == j;
+      if (listed) ++k;
+      if (fabs(d2 - lim2) <= 1e-9 * lim2) continue;
+      ++judged;
+      if ((d2 < lim2) != listed)
+        fail_msg("%dD row %d, particle %d: distance^2 %.17g, limit^2 %.17g, %s", dim, i, j, d2, lim2,
+                 listed ? "listed" : "missing");
+    }
+    if (k != e) fail_msg("%dD row %d: entries not in the oracle's order", dim, i);
+  }
+  assert_true(judged > 0);
+  if (!(longest > 32 && shortest < 16))
+    fail_msg("%dD rows of %lld to %lld entries: the range the test means to cover is missed", dim,
+             (long long)shortest, (long long)longest);
+  free(ref.rowptr);
+  free(ref.cols);
+  free(aos);
+  free(soa);
+  free(h);
+  free(h3);
+}
+
+static void test_2d(void **state) {
+  (void)state;
+  run(2, 60, 21.0, 2071);
+}
+
+static void test_3d(void **state) {
+  (void)state;
+  run(3, 15, 45.0, 2072);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_2d),
+      cmocka_unit_test(test_3d),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
