@@ -13,8 +13,14 @@
  * must equal the O(N^2) oracle's: j in row i iff |x_i - x_j| <= kappa h_i, for every pair
  * farther than 1e-9 (relative) from that threshold (pairs closer to it are not judged: the
  * library's closed-support tolerance decides them); the test also asserts that at least
- * one row has more than 32 entries and one fewer than 16. No timing.
+ * one row has more than 32 entries and one fewer than 16.
+ * And a repeated one-thread setup whose rows outgrow the row buffer and the lists (the
+ * supports doubled in the borrowed array) with every allocation failing in turn, through
+ * a failing allocator hook: MFREE_ERR_ALLOC, the set then not set up (not half-written
+ * lists that still count as set up), a retry equal to a fresh set's lists, every block
+ * returned. No timing.
  */
+#include "count_alloc.h"
 #include "testutil.h"
 
 #include <math.h>
@@ -149,10 +155,82 @@ static void test_3d(void **state) {
   run(3, 15, 45.0, 2072);
 }
 
+static void test_growth_failure(void **state) {
+  (void)state;
+  mfree_rng_t r;
+  mfree_rng_seed(&r, 2073);
+  const int m = 12, dim = 3;
+  const int32_t n = m * m * m;
+  double *x = malloc(sizeof(double) * 3 * (size_t)n), *h = malloc(sizeof(double) * (size_t)n);
+  assert_non_null(x);
+  assert_non_null(h);
+  for (int32_t p = 0; p < n; ++p) {
+    int32_t q = p;
+    for (int d = 0; d < dim; ++d) {
+      x[(size_t)dim * p + d] = (q % m) + 0.3 * (2.0 * mfree_rng_uniform(&r) - 1.0);
+      q /= m;
+    }
+  }
+  const double small = 0.5 * cbrt(20.0 * 3.0 / (4.0 * M_PI)), big = 2.0 * small; /* ~20, ~160 neighbours */
+  /* the reference: a fresh set with the big supports */
+  for (int32_t p = 0; p < n; ++p) h[p] = big;
+  const lists_t ref = search(dim, n, x, MFREE_LAYOUT_AOS, dim, h, 1, 1);
+  counter_t cnt = {0, 0, 0, -1};
+  mfree_context_t *ctx = NULL;
+  assert_ok(NULL, mfree_context_create(&ctx));
+  assert_ok(ctx, mfree_context_set_num_threads(ctx, 1));
+  assert_ok(ctx, mfree_context_set_allocator(ctx, count_alloc, count_free, &cnt));
+  int64_t calls = -1;
+  for (int64_t allow = -1; allow < calls || calls < 0; ++allow) {
+    mfree_particles_t *ps = NULL;
+    assert_ok(ctx, mfree_particles_create(ctx, dim, n, &ps));
+    assert_ok(ctx, mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW));
+    assert_ok(ctx, mfree_particles_set_support(ps, h, 1, MFREE_BORROW));
+    for (int32_t p = 0; p < n; ++p) h[p] = small;
+    assert_ok(ctx, mfree_particles_setup(ps));
+    for (int32_t p = 0; p < n; ++p) h[p] = big; /* borrowed: the next setup sees them */
+    const int64_t before = cnt.calls;
+    if (allow < 0) {
+      /* count the repeated setup's allocations */
+      assert_ok(ctx, mfree_particles_setup(ps));
+      calls = cnt.calls - before;
+      assert_true(calls >= 2); /* the row buffer and the lists grow */
+    } else {
+      cnt.fail_after = before + allow;
+      assert_error(ctx, mfree_particles_setup(ps), MFREE_ERR_ALLOC, "memory");
+      cnt.fail_after = -1;
+      int64_t nnz = 0;
+      assert_error(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz), MFREE_ERR_STATE, "not set up");
+      assert_ok(ctx, mfree_particles_setup(ps));
+    }
+    int64_t nnz = 0;
+    assert_ok(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz));
+    assert_int_equal(nnz, ref.rowptr[n]);
+    int64_t *rowptr = malloc(sizeof(int64_t) * ((size_t)n + 1));
+    int32_t *cols = malloc(sizeof(int32_t) * (size_t)nnz);
+    assert_non_null(rowptr);
+    assert_non_null(cols);
+    assert_ok(ctx, mfree_particles_get_neighbors(ps, rowptr, cols));
+    assert_memory_equal(rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)n + 1));
+    assert_memory_equal(cols, ref.cols, sizeof(int32_t) * (size_t)nnz);
+    free(rowptr);
+    free(cols);
+    mfree_particles_destroy(&ps);
+  }
+  mfree_context_destroy(&ctx);
+  assert_int_equal(cnt.held, 0);
+  assert_int_equal(cnt.frees, cnt.calls);
+  free(ref.rowptr);
+  free(ref.cols);
+  free(x);
+  free(h);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_2d),
       cmocka_unit_test(test_3d),
+      cmocka_unit_test(test_growth_failure),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1371,34 +1371,38 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
   size_t have = out.cols.size();
   int32_t *cols = out.cols.data();
   const size_t chunk = std::min<size_t>(65536, std::max<size_t>(4096, est / 32));
-  for (int32_t j = 0; j < rows; ++j) {
-    const int64_t base = rp[j];
-    if (status[j] != 0) {
-      rp[j + 1] = base;  // no row
-      continue;
-    }
-    const size_t cnt = row.find(j, tmp);
-    const int64_t end = base + static_cast<int64_t>(cnt);
-    rp[j + 1] = end;
-    if (static_cast<size_t>(end) > have) {
-      size_t want = std::max(static_cast<size_t>(end), have + chunk);
-      if (want > out.cols.capacity()) {
-        try {
+  // Any exception from here on (the row buffer or the lists growing) leaves out with no
+  // rows: its row pointers are already being rewritten. (The row buffer's growth was
+  // outside this guard: a repeated search whose rows outgrew it and ran out of memory
+  // left half-written lists that still counted as set up.)
+  try {
+    for (int32_t j = 0; j < rows; ++j) {
+      const int64_t base = rp[j];
+      if (status[j] != 0) {
+        rp[j + 1] = base;  // no row
+        continue;
+      }
+      const size_t cnt = row.find(j, tmp);
+      const int64_t end = base + static_cast<int64_t>(cnt);
+      rp[j + 1] = end;
+      if (static_cast<size_t>(end) > have) {
+        size_t want = std::max(static_cast<size_t>(end), have + chunk);
+        if (want > out.cols.capacity()) {
           SmallPages small;
           out.cols.reserve(std::max(want, 2 * out.cols.capacity()));
-        } catch (...) {
-          out.rowptr.assign(1, 0);  // (shrinks: no allocation)
-          out.cols.clear();
-          throw;
         }
+        want = std::min(want, out.cols.capacity());
+        prefault(out.cols.data() + have, (want - have) * sizeof(int32_t));
+        out.cols.resize(want);
+        have = want;
+        cols = out.cols.data();
       }
-      want = std::min(want, out.cols.capacity());
-      prefault(out.cols.data() + have, (want - have) * sizeof(int32_t));
-      out.cols.resize(want);
-      have = want;
-      cols = out.cols.data();
+      HostRow::sort_into(tmp.data(), cnt, cols + base);
     }
-    HostRow::sort_into(tmp.data(), cnt, cols + base);
+  } catch (...) {
+    out.rowptr.assign(1, 0);  // (shrinks: no allocation)
+    out.cols.clear();
+    throw;
   }
   out.cols.resize(static_cast<size_t>(rp[rows]));
 }
