@@ -25,6 +25,10 @@ bool hessian_needs_d2w(int m) {
   return m == MFREE_METHOD_SPH || m == MFREE_METHOD_SHEPARD || m == MFREE_METHOD_MLS ||
          m == MFREE_METHOD_RKPM || m == MFREE_METHOD_MSPH;
 }
+// Doubles per particle record of pack(): coordinates, volume and support, except in 3D:
+// x y z vol (32 bytes, one aligned load per neighbour in the fast path, never split
+// across cache lines), the supports in an array after the records.
+int record_length(int dim) { return dim == 3 ? 4 : dim + 2; }
 const char *method_name(int m) {
   static const char *names[] = {"?", "SPH", "SPH symmetric", "Shepard", "MLS", "RKPM",
                                 "Johnson-Beissel", "Randles-Libersky", "KB Method 1",
@@ -247,18 +251,21 @@ void Approximant::pack() {
   const int32_t np = ps_->size();
   const bool have_vol = ps_->has_volumes();
   const size_t N = static_cast<size_t>(np);
-  // AoS, one record per particle (coordinates, volume, support): the data of a
-  // neighbour come in one cache line
-  const size_t S = static_cast<size_t>(dim) + 2;
-  pack_.resize(S * N);
+  // AoS, one record per particle (coordinates, volume, support; record_length): the data
+  // of a neighbour come in one cache line
+  const size_t S = static_cast<size_t>(record_length(dim));
+  const bool hsep = S < static_cast<size_t>(dim) + 2;  // supports after the records
+  pack_.resize(S * N + (hsep ? N : 0));
   double *P = pack_.data();
+  double *H = hsep ? P + S * N : P + dim + 1;
+  const size_t HS = hsep ? 1 : S;
   parallel_blocks(np, num_threads(np), [&](int, int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) {
       const int32_t j = static_cast<int32_t>(i);
       double *r = P + S * static_cast<size_t>(i);
       for (int c = 0; c < dim; ++c) r[c] = ps_->x(j, c);
       r[dim] = have_vol ? ps_->volume(j) : 1.0;
-      r[dim + 1] = ps_->h(j);
+      H[HS * static_cast<size_t>(i)] = ps_->h(j);
     }
   });
   if (!points_) {
@@ -303,10 +310,15 @@ void Approximant::build_pattern() {
   // the order of the neighbour list, the particle itself always (appended when a host
   // list omits it). Counted in a first pass and written in a second, both over static
   // blocks of sites, so that the pattern is the same for any thread count.
-  // records of pack() (particles: coordinates, volume, support) and of the sites
-  const int64_t PS = dim + 2, SS = points_ ? dim + 1 : PS;
+  // records of pack() (particles: coordinates, volume, support; record_length) and of the
+  // sites; the supports PH (particles) and SH (sites) with their strides
+  const int64_t PS = record_length(dim), SS = points_ ? dim + 1 : PS;
   const double *P = pack_.data(), *SP = points_ ? spack_.data() : P;
-  const int SHO = points_ ? dim : dim + 1;  // support within a site record
+  const bool hsep = PS < dim + 2;
+  const double *PH = hsep ? P + PS * ps_->size() : P + dim + 1;
+  const int64_t PHS = hsep ? 1 : PS;
+  const double *SH = points_ ? SP + dim : PH;
+  const int64_t SHS = points_ ? SS : PHS;
   bool per[3] = {false, false, false};
   double period[3] = {0, 0, 0};
   for (int c = 0; c < dim; ++c) {
@@ -343,7 +355,7 @@ void Approximant::build_pattern() {
         continue;
       }
       const double *sr = SP + s * SS;
-      const double hs = sr[SHO];
+      const double hs = SH[s * SHS];
       const double xs[3] = {sr[0], dim > 1 ? sr[1] : 0.0, dim > 2 ? sr[2] : 0.0};
       int64_t at_self = -1;
       if (conv == MFREE_SEARCH_GATHER && !any_periodic) {
@@ -353,7 +365,7 @@ void Approximant::build_pattern() {
         auto scan = [&](auto dimc) {
           constexpr int D = decltype(dimc)::value;
           const int pd = D > 0 ? D : dim;
-          const int64_t ps = pd + 2;
+          const int64_t ps = D == 2 || D == 3 ? 4 : PS;
           for (int64_t q = srp[s]; q < srp[s + 1]; ++q) {
             const int32_t j = scl[q];
             const double *pj = P + j * ps;
@@ -384,7 +396,7 @@ void Approximant::build_pattern() {
             if (per[c]) v -= period[c] * std::nearbyint(v / period[c]);
             r2 += v * v;
           }
-          const double hj = P[j * PS + dim + 1];
+          const double hj = PH[j * PHS];
           const double hp = conv == MFREE_SEARCH_SYMMETRIC_MAX    ? std::max(hs, hj)
                             : conv == MFREE_SEARCH_SYMMETRIC_MEAN ? 0.5 * (hs + hj)
                                                                   : hs;
@@ -517,11 +529,15 @@ Report Approximant::compute(const char *what) {
       ft.periodic[c] = ps_->periodic(c);
       ft.period[c] = ps_->box_hi(c) - ps_->box_lo(c);
     }
+    const int64_t PS = record_length(dim);
+    const bool hsep = PS < dim + 2;
     ft.vol = pack_.data() + dim;
-    ft.h = pack_.data() + dim + 1;
+    ft.h = hsep ? pack_.data() + PS * ps_->size() : pack_.data() + dim + 1;
+    ft.hstride = hsep ? 1 : PS;
     ft.sh = points_ ? spack_.data() + dim : ft.h;
-    ft.stride = dim + 2;
-    ft.sstride = points_ ? dim + 1 : dim + 2;
+    ft.shstride = points_ ? dim + 1 : ft.hstride;
+    ft.stride = PS;
+    ft.sstride = points_ ? dim + 1 : PS;
     ft.convention = ps_->search_convention();
     ft.val = fv ? val_.data() : nullptr;
     ft.grad = fg ? grad_.data() : nullptr;

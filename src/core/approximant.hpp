@@ -136,8 +136,9 @@ class Approximant {
     FastScratch fast;
   };
   HVec<SiteScratch> scratch_;
-  // SoA copies: particles (dim coordinates, volumes, supports) and host points (dim
-  // coordinates, supports)
+  // AoS copies: particles (dim coordinates, volume, support; in 3D the supports after
+  // 32-byte records x y z vol, see record_length in approximant.cpp) and host points
+  // (dim coordinates, support)
   HVec<double> pack_, spack_;
 };
 

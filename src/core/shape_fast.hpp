@@ -23,15 +23,15 @@ struct FastTables {
   const int32_t *self = nullptr;  // position of the site in its row, -1 at host points
   // particles, one record of `stride` doubles each: coordinate c of particle j at
   // x[c][j * stride] with x[c] == x[0] + c, volume (1 when the set has none)
-  // vol[j * stride], support h[j * stride]
+  // vol[j * stride]; support h[j * hstride] (in the record or after the records)
   const double *x[3] = {nullptr, nullptr, nullptr};
   const double *vol = nullptr;
   const double *h = nullptr;
-  int64_t stride = 1;
-  // sites (the particles themselves or host points), likewise with sstride
+  int64_t stride = 1, hstride = 1;
+  // sites (the particles themselves or host points), likewise with sstride, shstride
   const double *sx[3] = {nullptr, nullptr, nullptr};
   const double *sh = nullptr;
-  int64_t sstride = 1;
+  int64_t sstride = 1, shstride = 1;
   int convention = MFREE_SEARCH_GATHER;
   bool periodic[3] = {false, false, false};
   double period[3] = {0, 0, 0};
