@@ -881,10 +881,11 @@ MFREE_TARGET_AVX2_NOFMA void CellGrid::query_avx2_t(const double *xq, double ri,
       const int64_t p0 = st[base + kmin[0]], p1 = st[base + kmax[0] + 1];
       // (kept by a select: which corner rows of a 3D stencil miss the sphere varies
       // from query to query, a branch there was mispredicted)
-      const bool keep = p1 > p0 && !(corners && gz + gy[k1 - kmin[1]] > R2);
+      const double gyk = corners ? gy[k1 - kmin[1]] : 0.0;
+      const int keep = static_cast<int>(p1 > p0) & static_cast<int>(gz + gyk <= R2);  // (& not &&: no branch)
       P0[nr] = p0;
       P1[nr] = p1;
-      nr += keep ? 1 : 0;
+      nr += keep;
       if (nr == kRows) {
         k = scan_avx2<D>(xq, lim2, P0, P1, nr, out, k);
         nr = 0;
