@@ -1098,6 +1098,7 @@ struct NeighborScratch {
   Buf<int64_t> first, rowptr;
   Buf<int32_t> lo_hi;
   Buf<const int32_t *> src;
+  Csr next;  // the lists host_order_blocks writes, then swaps with the set's
 };
 
 NeighborScratch *new_neighbor_scratch() { return new NeighborScratch; }
@@ -1409,55 +1410,115 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
 }
 
 // host_order_rows on several threads: static blocks of rows in host order, each thread
-// writing its block's sorted rows into its own buffer (sc.buf[t], one row at a time
-// found in sc.row[t]) with row ends relative to the block (sc.rowptr); then the blocks
-// are placed one after the other into out, each thread moving its own. The same lists
-// as on one thread: the same rows, sorted. out is written only after its capacity is
-// reserved, so running out of memory leaves it unchanged.
+// writing its block's sorted rows straight into the spare lists sc.next from a guessed
+// offset g[t] (the block's offset in the current lists when the set was set up before
+// with as many rows: exact for particles that did not move; otherwise a share of the
+// storage), as far as the room up to the next block's guess allows, the rest of the
+// block into its own buffer sc.buf[t]. When every guess was right and nothing spilled,
+// the lists are done; otherwise the blocks are moved into place (memmove: right-moving
+// blocks last to first, then the others first to last, so that no block overwrites one
+// not yet moved) and the row ends of the moved blocks shifted. Then the spare lists and
+// out swap storage. (Before: every block into its buffer, then all copied into place,
+// 9 ms of 80 (2D) and 20 of 330 (3D) at 10^6 on two threads; a repeated search of a
+// set at rest now moves nothing.) The same lists as on one thread: the same rows,
+// sorted. out changes only by the final swap, so running out of memory leaves it
+// unchanged.
 void host_order_blocks(const CellGrid &grid, const ParticleSet &ps, const std::vector<int32_t> &status,
                        const Rule &rule, NeighborScratch &sc, Csr &out, int nt) {
   const int32_t rows = ps.num_owned();
   const HostRow row{grid, ps, rule};
   const int nb = block_count(nt);
+  int64_t first[kMaxBlocks + 1];
+  for (int t = 0; t < nb; ++t) {
+    int64_t b, e;
+    thread_block(rows, t, nb, b, e);
+    first[t] = b;
+  }
+  first[nb] = rows;
+  const bool again = out.rowptr.size() == static_cast<size_t>(rows) + 1;
   const double per_row = 1.25 * grid.expected_hits() + 8.0;
-  resize_fresh(sc.rowptr, static_cast<size_t>(rows) + 1);
-  int64_t *lrp = sc.rowptr.data();  // lrp[j + 1]: end of row j within its block's buffer
-  int64_t used[kMaxBlocks] = {};
-  parallel_blocks(rows, nt, [&](int t, int64_t b, int64_t e) {
-    RowBuf &buf = sc.buf[t], &tmp = sc.row[t];
-    if (buf.capacity() == 0) buf.reserve(static_cast<size_t>(static_cast<double>(e - b) * per_row));
-    if (buf.size() < buf.capacity()) buf.resize(buf.capacity());  // (no initialisation)
-    int64_t end = 0;
-    for (int64_t j = b; j < e; ++j) {
-      if (status[j] != 0) {
-        lrp[j + 1] = end;  // no row
-        continue;
+  Csr &nx = sc.next;
+  if (nx.cols.capacity() == 0) {
+    SmallPages small;
+    nx.cols.reserve(static_cast<size_t>(static_cast<double>(rows) * per_row));
+  }
+  nx.rowptr.resize(static_cast<size_t>(rows) + 1);
+  const int64_t cap = static_cast<int64_t>(nx.cols.capacity());
+  int64_t g[kMaxBlocks + 1];
+  for (int t = 0; t < nb; ++t)
+    g[t] = again ? std::min(out.rowptr[static_cast<size_t>(first[t])], cap)
+                 : (rows > 0 ? static_cast<int64_t>(static_cast<double>(cap) * static_cast<double>(first[t]) /
+                                                    static_cast<double>(rows))
+                             : 0);
+  g[0] = 0;
+  g[nb] = cap;
+  for (int t = 1; t <= nb; ++t) g[t] = std::max(g[t], g[t - 1]);
+  int64_t used[kMaxBlocks] = {}, inpl[kMaxBlocks] = {};
+  {
+    nx.cols.resize(static_cast<size_t>(cap));  // (zero-fills only storage never used before)
+    int64_t *rp = nx.rowptr.data();
+    int32_t *cols = nx.cols.data();
+    rp[0] = 0;
+    parallel_blocks(rows, nt, [&](int t, int64_t b, int64_t e) {
+      RowBuf &spill = sc.buf[t], &tmp = sc.row[t];
+      // (room for rows that outgrow the guess, so that the small changes of a moving
+      // set allocate nothing after its first search)
+      if (spill.capacity() == 0) spill.reserve(static_cast<size_t>(static_cast<double>(e - b) * per_row / 16.0) + 64);
+      const int64_t off = g[t], room = g[t + 1] - g[t];
+      int32_t *dst = cols + off;
+      int64_t end = 0, in = -1;  // in >= 0: rows from end = in on go to spill
+      for (int64_t j = b; j < e; ++j) {
+        if (status[j] == 0) {
+          const size_t cnt = row.find(static_cast<int32_t>(j), tmp);
+          const int64_t c = static_cast<int64_t>(cnt);
+          if (in < 0 && end + c > room) in = end;
+          if (in < 0) {
+            HostRow::sort_into(tmp.data(), cnt, dst + end);
+          } else {
+            const size_t o = static_cast<size_t>(end - in);
+            if (o + cnt > spill.size()) spill.resize(std::max(2 * spill.size(), o + cnt));
+            HostRow::sort_into(tmp.data(), cnt, spill.data() + o);
+          }
+          end += c;
+        }
+        rp[j + 1] = off + end;
       }
-      const size_t cnt = row.find(static_cast<int32_t>(j), tmp);
-      if (static_cast<size_t>(end) + cnt > buf.size()) buf.resize(std::max(buf.size() * 2, static_cast<size_t>(end) + cnt));
-      HostRow::sort_into(tmp.data(), cnt, buf.data() + end);
-      end += static_cast<int64_t>(cnt);
-      lrp[j + 1] = end;
+      used[t] = end;
+      inpl[t] = in < 0 ? end : in;
+    });
+    int64_t base[kMaxBlocks + 1];
+    base[0] = 0;
+    bool moved = false;
+    for (int t = 0; t < nb; ++t) {
+      base[t + 1] = base[t] + used[t];
+      moved = moved || base[t] != g[t] || inpl[t] != used[t];
     }
-    used[t] = end;
-  });
-  int64_t base[kMaxBlocks + 1];
-  base[0] = 0;
-  for (int t = 0; t < nb; ++t) base[t + 1] = base[t] + used[t];
-  // capacity first: a failure here leaves out as it was
-  out.rowptr.reserve(static_cast<size_t>(rows) + 1);
-  const size_t total = static_cast<size_t>(base[nb]);
-  if (out.cols.capacity() < total) out.cols.reserve(total + total / 16);  // (room for moves)
-  out.rowptr.resize(static_cast<size_t>(rows) + 1);
-  out.cols.resize(static_cast<size_t>(base[nb]));
-  int64_t *rp = out.rowptr.data();
-  int32_t *cols = out.cols.data();
-  rp[0] = 0;
-  parallel_blocks(rows, nt, [&](int t, int64_t b, int64_t e) {
-    const int64_t off = base[t];
-    std::copy(sc.buf[t].data(), sc.buf[t].data() + used[t], cols + off);
-    for (int64_t j = b; j < e; ++j) rp[j + 1] = off + lrp[j + 1];
-  });
+    if (moved) {
+      if (base[nb] > cap) {  // (keeps the entries where they are)
+        nx.cols.reserve(static_cast<size_t>(base[nb] + base[nb] / 16));
+        nx.cols.resize(static_cast<size_t>(base[nb]));
+        cols = nx.cols.data();
+      }
+      auto place = [&](int t) {
+        if (base[t] != g[t] && inpl[t] > 0)
+          std::memmove(cols + base[t], cols + g[t], static_cast<size_t>(inpl[t]) * sizeof(int32_t));
+        if (used[t] > inpl[t])
+          std::memcpy(cols + base[t] + inpl[t], sc.buf[t].data(), static_cast<size_t>(used[t] - inpl[t]) * sizeof(int32_t));
+      };
+      for (int t = nb - 1; t >= 0; --t)
+        if (base[t] > g[t]) place(t);
+      for (int t = 0; t < nb; ++t)
+        if (base[t] <= g[t]) place(t);
+      parallel_blocks(rows, nt, [&](int t, int64_t b, int64_t e) {
+        const int64_t d = base[t] - g[t];
+        if (d != 0)
+          for (int64_t j = b; j < e; ++j) rp[j + 1] += d;
+      });
+    }
+    nx.cols.resize(static_cast<size_t>(base[nb]));  // (shrinks: no allocation)
+  }
+  std::swap(out.rowptr, nx.rowptr);
+  std::swap(out.cols, nx.cols);
 }
 #endif
 
