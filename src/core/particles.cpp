@@ -195,7 +195,9 @@ void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int3
 
 Report ParticleSet::validate() {
   Report rep;
-  site_status_.assign(n_, 0);
+  // (zeroed below by the threads, each its block: a serial assign was a pass of its own)
+  site_status_.resize(static_cast<size_t>(n_));
+  int32_t *status = site_status_.data();
   // Common case first, over the context's threads: every particle valid (a search is
   // otherwise parallel, and this pass would bound its speed-up); the messages below are
   // built only when some particle fails.
@@ -205,6 +207,7 @@ Report ParticleSet::validate() {
     // (one array at a time with strided loads and no early exit: loops without branches;
     // a value shared by all, stride 0, checked once)
     parallel_blocks(n_, nt, [&](int t, int64_t b, int64_t e) {
+      std::fill(status + b, status + e, 0);
       const double big = std::numeric_limits<double>::max();
       bool ok = true;
       const double *X = pos_data();
@@ -280,8 +283,10 @@ Report ParticleSet::setup() {
   }
   // A negative failure (periodic box too small, no memory) changes nothing: the old
   // statuses go back with the old lists.
-  prev_status_.reserve(static_cast<size_t>(n_));  // update swaps the two arrays
-  prev_status_.assign(site_status_.begin(), site_status_.end());
+  // (the old statuses change places with the spare array rather than being copied to it)
+  prev_status_.reserve(static_cast<size_t>(n_));  // update swaps the two arrays: both
+  site_status_.reserve(static_cast<size_t>(n_));  // hold n entries without allocating
+  prev_status_.swap(site_status_);
   Report rep = validate();
   Csr out{{}, {}};  // (empty: a search allocates nothing here; host lists fill it below)
   try {
