@@ -248,26 +248,34 @@ class CellGrid {
   // The cells pass also counts, for host_locality, the host-consecutive valid pairs whose
   // cells lie within loc_w_ of each other (Loc: that count, the valid particles and the
   // first and last valid cell of [b, e); chunks join by their boundary pairs).
+  // With Split, the pass also counts the valid particles whose cell lies below split_
+  // (Loc::below; two chunks: the prefix sums' first cell block, no pass of its own).
   struct Loc {
-    int64_t near = 0, valid = 0, first = -1, last = -1;
+    int64_t near = 0, valid = 0, first = -1, last = -1, below = 0;
   };
-  template <int D, bool Periodic, class Cnt>
+  template <int D, bool Periodic, bool Split, class Cnt>
   void cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell, Cnt *cnt,
                Loc &loc) const;
   void join_locality(const Loc *loc, int nch);
   template <int D, bool Periodic, class Pos>
   void scatter_t(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int32_t *cell, Pos *pos);
-  template <class Cnt>
-  void cells(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell, Cnt *cnt,
-             Loc &loc) const {
+  template <bool Split, class Cnt>
+  void cells_s(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell, Cnt *cnt,
+               Loc &loc) const {
     switch (dim_ * 2 + (any_periodic_ ? 1 : 0)) {
-      case 2: cells_t<1, false>(ps, status, b, e, cell, cnt, loc); break;
-      case 3: cells_t<1, true>(ps, status, b, e, cell, cnt, loc); break;
-      case 4: cells_t<2, false>(ps, status, b, e, cell, cnt, loc); break;
-      case 5: cells_t<2, true>(ps, status, b, e, cell, cnt, loc); break;
-      case 6: cells_t<3, false>(ps, status, b, e, cell, cnt, loc); break;
-      default: cells_t<3, true>(ps, status, b, e, cell, cnt, loc); break;
+      case 2: cells_t<1, false, Split>(ps, status, b, e, cell, cnt, loc); break;
+      case 3: cells_t<1, true, Split>(ps, status, b, e, cell, cnt, loc); break;
+      case 4: cells_t<2, false, Split>(ps, status, b, e, cell, cnt, loc); break;
+      case 5: cells_t<2, true, Split>(ps, status, b, e, cell, cnt, loc); break;
+      case 6: cells_t<3, false, Split>(ps, status, b, e, cell, cnt, loc); break;
+      default: cells_t<3, true, Split>(ps, status, b, e, cell, cnt, loc); break;
     }
+  }
+  template <class Cnt>
+  void cells(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell, Cnt *cnt, Loc &loc,
+             bool split = false) const {
+    if (split) cells_s<true>(ps, status, b, e, cell, cnt, loc);
+    else cells_s<false>(ps, status, b, e, cell, cnt, loc);
   }
   template <class Pos>
   void scatter(const ParticleSet &ps, double kappa, int64_t b, int64_t e, const int32_t *cell, Pos *pos) {
@@ -296,6 +304,7 @@ class CellGrid {
   bool uniform_ = true;  // one search radius for every valid particle
   double rmax_ = 0.0;
   double hits_ = 0.0;
+  int64_t split_ = 0;       // Loc::below counts cells below this one
   int64_t loc_w_ = 0;       // cells "near" in host_locality's sense: |difference| <= loc_w_
   double locality_ = 0.0;   // host_locality's fraction, found by the cells pass
   int32_t nvalid_ = 0;
@@ -506,26 +515,37 @@ void CellGrid::build(const ParticleSet &ps, const std::vector<int32_t> &status) 
   hist_.resize(static_cast<size_t>(nch) * static_cast<size_t>(nc));
   int32_t *hist = hist_.data();
   Loc loc[64];
+  const bool two = nch == 2;
+  if (two) {
+    int64_t b, e;
+    thread_block(nc, 1, 2, b, e);
+    split_ = b;  // (the second cell block of the prefix sums below starts here)
+  }
   for_chunks(nch, [&](int v) {
     int32_t *h = hist + static_cast<int64_t>(v) * nc;
     std::fill(h, h + nc, 0);
     int64_t b, e;
     thread_block(n, v, nch, b, e);
     Loc l;  // (a local copy: the chunks' records share cache lines)
-    cells(ps, status.data(), b, e, cell, h, l);
+    cells(ps, status.data(), b, e, cell, h, l, two);
     loc[v] = l;
   });
   join_locality(loc, nch);
   // prefix sums over (cell, chunk), two passes over cell blocks
   int64_t block_total[64];
-  for_chunks(nch, [&](int v) {
-    int64_t b, e, s = 0;
-    thread_block(nc, v, nch, b, e);
-    for (int64_t c = b; c < e; ++c)
-      for (int u = 0; u < nch; ++u) s += hist[static_cast<int64_t>(u) * nc + c];
-    block_total[v] = s;
-  });
-  for (int v = 1; v < nch; ++v) block_total[v] += block_total[v - 1];
+  if (two) {  // (counted by the cells pass)
+    block_total[0] = loc[0].below + loc[1].below;
+    block_total[1] = nvalid_;
+  } else {
+    for_chunks(nch, [&](int v) {
+      int64_t b, e, s = 0;
+      thread_block(nc, v, nch, b, e);
+      for (int64_t c = b; c < e; ++c)
+        for (int u = 0; u < nch; ++u) s += hist[static_cast<int64_t>(u) * nc + c];
+      block_total[v] = s;
+    });
+    for (int v = 1; v < nch; ++v) block_total[v] += block_total[v - 1];
+  }
   for_chunks(nch, [&](int v) {
     int64_t b, e, s = v > 0 ? block_total[v - 1] : 0;
     thread_block(nc, v, nch, b, e);
@@ -568,7 +588,7 @@ void CellGrid::join_locality(const Loc *loc, int nch) {
   locality_ = valid > 1 ? static_cast<double>(near) / static_cast<double>(valid - 1) : 0.0;
 }
 
-template <int D, bool Periodic, class Cnt>
+template <int D, bool Periodic, bool Split, class Cnt>
 void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, int64_t e, int32_t *cell,
                        Cnt *cnt, Loc &loc) const {
   const double *X = ps.pos_data();
@@ -576,7 +596,8 @@ void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, 
   // (prev starts far from every cell: the first valid particle counts no pair; near
   // without a branch: |id - prev| <= w as one unsigned comparison)
   const uint64_t w = static_cast<uint64_t>(loc_w_);
-  int64_t prev = -(int64_t{1} << 62), near = 0, valid = 0;
+  int64_t prev = -(int64_t{1} << 62), near = 0, valid = 0, below = 0;
+  const int64_t split = split_;
   for (int64_t i = b; i < e; ++i) {
     if (status[i] != 0) {
       cell[i] = -1;
@@ -591,9 +612,11 @@ void CellGrid::cells_t(const ParticleSet &ps, const int32_t *status, int64_t b, 
     cell[i] = static_cast<int32_t>(id);
     ++cnt[id];
     near += static_cast<uint64_t>(id - prev) + w <= 2 * w ? 1 : 0;
+    if (Split) below += id < split ? 1 : 0;
     prev = id;
     ++valid;
   }
+  loc.below = below;
   loc.near = near;
   loc.valid = valid;
   loc.last = valid > 0 ? prev : -1;
