@@ -180,7 +180,7 @@ void run(int dim, double n_target) {
   const int m = bench_side(dim, n_target);
   double *x = bench_lattice(dim, m, 0.3, &n);
   const double r = bench_radius(dim), h = 0.5 * r;  // cubic spline: support 2h
-  const int reps = n <= 200000 ? 5 : 2;
+  const int reps = n <= 200000 ? 5 : 3;
   int64_t nnz = 0, nnz_t = 0;
   mfree_particles_t *ps = nullptr;
   double held = 0;

@@ -12,8 +12,9 @@
  * transposition or per-row sorts). Both must give the same relation, exactly: every
  * case sets up the points in spatial order and under a random permutation and compares
  * the rows entry by entry after mapping the indices back (the permuted rows sorted again
- * by the test). A spatially ordered set with two threads (host order too, one buffer
- * per thread, the blocks then moved into place) must give the same bits as with one.
+ * by the test). A spatially ordered set with two threads (host order too: each block
+ * of rows written into spare lists at a guessed offset, spills moved into place; t208
+ * tests moving blocks) must give the same bits as with one.
  * Cases:
  *  - 3D jittered lattice, ~45 neighbours (16-bit ranks), gather and symmetric-max;
  *  - 2D, ~21 neighbours (32-bit ranks), with ghosts;
