@@ -28,6 +28,7 @@
  */
 #include "count_alloc.h"
 #include "testutil.h"
+#include "nbr_lists.h"
 
 #include <math.h>
 #include <stdatomic.h>
@@ -44,12 +45,6 @@ typedef struct {
   double *x; /* AoS, dim per point */
   double *h;
 } cloud_t;
-
-typedef struct {
-  int64_t *rowptr;
-  int32_t *cols;
-  int32_t rows;
-} lists_t;
 
 static cloud_t cloud_new(int dim, int32_t n) {
   cloud_t c = {dim, n, calloc((size_t)n * dim, sizeof(double)), calloc((size_t)n, sizeof(double))};
@@ -68,13 +63,7 @@ static cloud_t lattice(int dim, int m, mfree_rng_t *r) {
   int32_t n = 1;
   for (int d = 0; d < dim; ++d) n *= m;
   cloud_t c = cloud_new(dim, n);
-  for (int32_t p = 0; p < n; ++p) {
-    int32_t q = p;
-    for (int d = 0; d < dim; ++d) {
-      c.x[(size_t)dim * p + d] = (q % m) + 0.3 * (2.0 * mfree_rng_uniform(r) - 1.0);
-      q /= m;
-    }
-  }
+  jittered_lattice(c.x, dim, m, r);
   return c;
 }
 
@@ -139,27 +128,6 @@ static mfree_particles_t *make_set(mfree_context_t *ctx, const cloud_t *c, int c
   return ps;
 }
 
-static lists_t fetch(mfree_context_t *ctx, mfree_particles_t *ps) {
-  lists_t g;
-  int32_t n = 0, ng = 0;
-  int64_t nnz = 0;
-  assert_ok(ctx, mfree_particles_get_size(ps, &n, &ng));
-  assert_ok(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz));
-  g.rows = n - ng;
-  g.rowptr = malloc(sizeof(int64_t) * ((size_t)g.rows + 1));
-  g.cols = malloc(sizeof(int32_t) * (size_t)(nnz > 0 ? nnz : 1));
-  assert_non_null(g.rowptr);
-  assert_non_null(g.cols);
-  assert_ok(ctx, mfree_particles_get_neighbors(ps, g.rowptr, g.cols));
-  assert_int_equal(g.rowptr[g.rows], nnz);
-  return g;
-}
-
-static void lists_free(lists_t *g) {
-  free(g->rowptr);
-  free(g->cols);
-}
-
 static int cmp_i32(const void *a, const void *b) {
   const int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
   return (x > y) - (x < y);
@@ -197,14 +165,14 @@ static int64_t compare_orders(const cloud_t *c, int conv, double kappa, int32_t 
     assert_ok(ctx, mfree_context_set_num_threads(ctx, threads));
     mfree_particles_t *ps = make_set(ctx, c, conv, kappa, ng);
     assert_ok(ctx, mfree_particles_setup(ps));
-    lists_t g = fetch(ctx, ps);
+    lists_t g = lists_fetch(ctx, ps);
     mfree_particles_destroy(&ps);
     if (threads == 1) {
       ref = g;
       /* the permuted copy, one thread (random order: the general path) */
       ps = make_set(ctx, &p, conv, kappa, ng);
       assert_ok(ctx, mfree_particles_setup(ps));
-      lists_t gp = fetch(ctx, ps);
+      lists_t gp = lists_fetch(ctx, ps);
       mfree_particles_destroy(&ps);
       assert_int_equal(gp.rowptr[no], ref.rowptr[no]);
       int32_t *row = malloc(sizeof(int32_t) * (size_t)(n > 0 ? n : 1));
@@ -223,8 +191,7 @@ static int64_t compare_orders(const cloud_t *c, int conv, double kappa, int32_t 
       free(row);
       lists_free(&gp);
     } else {
-      assert_memory_equal(g.rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)no + 1));
-      assert_memory_equal(g.cols, ref.cols, sizeof(int32_t) * (size_t)ref.rowptr[no]);
+      assert_lists_equal(&g, &ref);
       lists_free(&g);
     }
     mfree_context_destroy(&ctx);
@@ -315,7 +282,7 @@ static void test_allocation_failure(void **state) {
   assert_ok(ctx, mfree_particles_setup(ps));
   const int64_t calls = cnt.calls - before;
   assert_true(calls > 0);
-  lists_t ref = fetch(ctx, ps);
+  lists_t ref = lists_fetch(ctx, ps);
   mfree_particles_destroy(&ps);
   for (int64_t allow = 0; allow < calls; ++allow) {
     ps = make_set(ctx, &c, MFREE_SEARCH_GATHER, 2.0, 0);
@@ -325,9 +292,8 @@ static void test_allocation_failure(void **state) {
     assert_error(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz), MFREE_ERR_STATE, "not set up");
     cnt.fail_after = -1;
     assert_ok(ctx, mfree_particles_setup(ps));
-    lists_t g = fetch(ctx, ps);
-    assert_memory_equal(g.rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)c.n + 1));
-    assert_memory_equal(g.cols, ref.cols, sizeof(int32_t) * (size_t)ref.rowptr[c.n]);
+    lists_t g = lists_fetch(ctx, ps);
+    assert_lists_equal(&g, &ref);
     lists_free(&g);
     mfree_particles_destroy(&ps);
   }
@@ -379,9 +345,8 @@ static void test_two_threads_repeated(void **state) {
     assert_ok(ctx1, mfree_particles_setup(ps1));
     if (atomic_load(&g_calls) != calls)
       fail_msg("step %d: %lld allocations in a repeated 2-thread setup", step, atomic_load(&g_calls) - calls);
-    lists_t g = fetch(ctx, ps), g1 = fetch(ctx1, ps1);
-    assert_memory_equal(g.rowptr, g1.rowptr, sizeof(int64_t) * ((size_t)c.n + 1));
-    assert_memory_equal(g.cols, g1.cols, sizeof(int32_t) * (size_t)g1.rowptr[c.n]);
+    lists_t g = lists_fetch(ctx, ps), g1 = lists_fetch(ctx1, ps1);
+    assert_lists_equal(&g, &g1);
     lists_free(&g);
     lists_free(&g1);
   }

@@ -18,6 +18,7 @@
  * No timing.
  */
 #include "testutil.h"
+#include "nbr_lists.h"
 
 #include <math.h>
 #include <stdatomic.h>
@@ -58,12 +59,6 @@ typedef struct {
   double *x; /* AoS, 3 per point */
   double h;
 } cloud_t;
-
-typedef struct {
-  int64_t *rowptr;
-  int32_t *cols;
-  int32_t rows;
-} lists_t;
 
 static int cmp_key(const void *pa, const void *pb) {
   const double *a = pa, *b = pb;
@@ -124,30 +119,6 @@ static mfree_particles_t *make_set(mfree_context_t *ctx, const cloud_t *c) {
   return ps;
 }
 
-static lists_t fetch(mfree_context_t *ctx, mfree_particles_t *ps) {
-  lists_t g;
-  int64_t nnz = 0;
-  assert_ok(ctx, mfree_particles_get_size(ps, &g.rows, NULL));
-  assert_ok(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz));
-  g.rowptr = malloc(sizeof(int64_t) * ((size_t)g.rows + 1));
-  g.cols = malloc(sizeof(int32_t) * (size_t)(nnz > 0 ? nnz : 1));
-  assert_non_null(g.rowptr);
-  assert_non_null(g.cols);
-  assert_ok(ctx, mfree_particles_get_neighbors(ps, g.rowptr, g.cols));
-  return g;
-}
-
-static void assert_lists_equal(const lists_t *a, const lists_t *b) {
-  assert_int_equal(a->rows, b->rows);
-  assert_memory_equal(a->rowptr, b->rowptr, sizeof(int64_t) * ((size_t)a->rows + 1));
-  assert_memory_equal(a->cols, b->cols, sizeof(int32_t) * (size_t)a->rowptr[a->rows]);
-}
-
-static void lists_free(lists_t *g) {
-  free(g->rowptr);
-  free(g->cols);
-}
-
 /* The lists of c from a one-thread setup without a hook. */
 static lists_t reference(const cloud_t *c) {
   mfree_context_t *ctx = NULL;
@@ -155,7 +126,7 @@ static lists_t reference(const cloud_t *c) {
   assert_ok(ctx, mfree_context_set_num_threads(ctx, 1));
   mfree_particles_t *ps = make_set(ctx, c);
   assert_ok(ctx, mfree_particles_setup(ps));
-  lists_t g = fetch(ctx, ps);
+  lists_t g = lists_fetch(ctx, ps);
   mfree_particles_destroy(&ps);
   mfree_context_destroy(&ctx);
   return g;
@@ -171,7 +142,7 @@ static mfree_context_t *two_thread_context(void) {
 
 /* First setup of a new set on two threads, every allocation failing in turn. */
 static void first_setup_failing(const cloud_t *c) {
-  const lists_t ref = reference(c);
+  lists_t ref = reference(c);
   mfree_context_t *ctx = two_thread_context();
   atomic_store(&g_fail_from, -1);
   mfree_particles_t *ps = make_set(ctx, c);
@@ -179,7 +150,7 @@ static void first_setup_failing(const cloud_t *c) {
   assert_ok(ctx, mfree_particles_setup(ps));
   const long long calls = atomic_load(&g_calls) - before;
   assert_true(calls > 0);
-  lists_t g = fetch(ctx, ps);
+  lists_t g = lists_fetch(ctx, ps);
   assert_lists_equal(&g, &ref);
   lists_free(&g);
   mfree_particles_destroy(&ps);
@@ -191,7 +162,7 @@ static void first_setup_failing(const cloud_t *c) {
     int64_t nnz = 0;
     assert_error(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz), MFREE_ERR_STATE, "not set up");
     assert_ok(ctx, mfree_particles_setup(ps));
-    g = fetch(ctx, ps);
+    g = lists_fetch(ctx, ps);
     assert_lists_equal(&g, &ref);
     lists_free(&g);
     mfree_particles_destroy(&ps);
@@ -199,8 +170,7 @@ static void first_setup_failing(const cloud_t *c) {
   mfree_context_destroy(&ctx);
   assert_int_equal(atomic_load(&g_held), 0);
   assert_int_equal(atomic_load(&g_frees), atomic_load(&g_calls));
-  lists_t r = ref;
-  lists_free(&r);
+  lists_free(&ref);
 }
 
 /* A set up set whose particles draw together (x -> centre + 0.8 (x - centre): rows
@@ -211,9 +181,9 @@ static void resetup_failing(const cloud_t *c) {
   assert_non_null(moved.x);
   double *x = moved.x; /* the set borrows x: the host moves its particles here */
   memcpy(x, c->x, sizeof(double) * 3 * (size_t)c->n);
-  const lists_t before_ref = reference(&moved);
+  lists_t before_ref = reference(&moved);
   for (int64_t k = 0; k < 3 * (int64_t)c->n; ++k) x[k] = 10.0 + 0.8 * (c->x[k] - 10.0);
-  const lists_t after_ref = reference(&moved);
+  lists_t after_ref = reference(&moved);
   assert_true(after_ref.rowptr[c->n] > before_ref.rowptr[c->n]);
   mfree_context_t *ctx = two_thread_context();
   atomic_store(&g_fail_from, -1);
@@ -226,7 +196,7 @@ static void resetup_failing(const cloud_t *c) {
   assert_ok(ctx, mfree_particles_setup(ps));
   calls = atomic_load(&g_calls) - calls;
   assert_true(calls > 0); /* the rows outgrew the lists */
-  lists_t g = fetch(ctx, ps);
+  lists_t g = lists_fetch(ctx, ps);
   assert_lists_equal(&g, &after_ref);
   lists_free(&g);
   mfree_particles_destroy(&ps);
@@ -238,12 +208,12 @@ static void resetup_failing(const cloud_t *c) {
     atomic_store(&g_fail_from, atomic_load(&g_calls) + allow);
     assert_error(ctx, mfree_particles_setup(ps), MFREE_ERR_ALLOC, "memory");
     atomic_store(&g_fail_from, -1);
-    g = fetch(ctx, ps);
+    g = lists_fetch(ctx, ps);
     assert_lists_equal(&g, &before_ref);
     lists_free(&g);
     /* and a retry finds the new lists */
     assert_ok(ctx, mfree_particles_setup(ps));
-    g = fetch(ctx, ps);
+    g = lists_fetch(ctx, ps);
     assert_lists_equal(&g, &after_ref);
     lists_free(&g);
     mfree_particles_destroy(&ps);
@@ -251,48 +221,44 @@ static void resetup_failing(const cloud_t *c) {
   mfree_context_destroy(&ctx);
   assert_int_equal(atomic_load(&g_held), 0);
   assert_int_equal(atomic_load(&g_frees), atomic_load(&g_calls));
-  lists_t r1 = before_ref, r2 = after_ref;
-  lists_free(&r1);
-  lists_free(&r2);
+  lists_free(&before_ref);
+  lists_free(&after_ref);
   free(moved.x);
+}
+
+/* Clustered points from the seed, in spatial order or shuffled, through one case. */
+static void run_case(uint64_t seed, int shuffle, void (*body)(const cloud_t *)) {
+  mfree_rng_t r;
+  mfree_rng_seed(&r, seed);
+  cloud_t c = clustered(4000, &r);
+  if (shuffle) {
+    cloud_t p = shuffled(&c, &r);
+    body(&p);
+    free(p.x);
+  } else {
+    body(&c);
+  }
+  free(c.x);
 }
 
 static void test_first_setup_spatial_order(void **state) {
   (void)state;
-  mfree_rng_t r;
-  mfree_rng_seed(&r, 2061);
-  cloud_t c = clustered(4000, &r);
-  first_setup_failing(&c);
-  free(c.x);
+  run_case(2061, 0, first_setup_failing);
 }
 
 static void test_first_setup_random_order(void **state) {
   (void)state;
-  mfree_rng_t r;
-  mfree_rng_seed(&r, 2062);
-  cloud_t c = clustered(4000, &r), p = shuffled(&c, &r);
-  first_setup_failing(&p);
-  free(c.x);
-  free(p.x);
+  run_case(2062, 1, first_setup_failing);
 }
 
 static void test_resetup_spatial_order(void **state) {
   (void)state;
-  mfree_rng_t r;
-  mfree_rng_seed(&r, 2063);
-  cloud_t c = clustered(4000, &r);
-  resetup_failing(&c);
-  free(c.x);
+  run_case(2063, 0, resetup_failing);
 }
 
 static void test_resetup_random_order(void **state) {
   (void)state;
-  mfree_rng_t r;
-  mfree_rng_seed(&r, 2064);
-  cloud_t c = clustered(4000, &r), p = shuffled(&c, &r);
-  resetup_failing(&p);
-  free(c.x);
-  free(p.x);
+  run_case(2064, 1, resetup_failing);
 }
 
 int main(void) {

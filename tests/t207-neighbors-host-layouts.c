@@ -24,6 +24,7 @@
  */
 #include "count_alloc.h"
 #include "testutil.h"
+#include "nbr_lists.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -32,11 +33,6 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-typedef struct {
-  int64_t *rowptr;
-  int32_t *cols;
-} lists_t;
 
 static lists_t search(int dim, int32_t n, const double *x, int layout, int64_t ld, const double *h, int64_t hs,
                       int threads) {
@@ -49,15 +45,7 @@ static lists_t search(int dim, int32_t n, const double *x, int layout, int64_t l
   assert_ok(ctx, mfree_particles_set_support(ps, h, hs, MFREE_BORROW));
   assert_ok(ctx, mfree_particles_set_search(ps, MFREE_SEARCH_GATHER, 2.0));
   assert_ok(ctx, mfree_particles_setup(ps));
-  int64_t nnz = 0;
-  assert_ok(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz));
-  lists_t g;
-  g.rowptr = malloc(sizeof(int64_t) * ((size_t)n + 1));
-  g.cols = malloc(sizeof(int32_t) * (size_t)(nnz > 0 ? nnz : 1));
-  assert_non_null(g.rowptr);
-  assert_non_null(g.cols);
-  assert_ok(ctx, mfree_particles_get_neighbors(ps, g.rowptr, g.cols));
-  assert_int_equal(g.rowptr[n], nnz);
+  lists_t g = lists_fetch(ctx, ps);
   mfree_particles_destroy(&ps);
   mfree_context_destroy(&ctx);
   return g;
@@ -77,14 +65,9 @@ static void run(int dim, int m, double neighbours, uint64_t seed) {
   assert_non_null(h3);
   /* mean support radius 2 h for `neighbours` neighbours at unit density */
   const double rad = dim == 2 ? sqrt(neighbours / M_PI) : cbrt(neighbours * 3.0 / (4.0 * M_PI));
+  jittered_lattice(aos, dim, m, &r);
   for (int32_t p = 0; p < n; ++p) {
-    int32_t q = p;
-    for (int d = 0; d < dim; ++d) {
-      const double v = (q % m) + 0.3 * (2.0 * mfree_rng_uniform(&r) - 1.0);
-      aos[(size_t)dim * p + d] = v;
-      soa[(size_t)d * ld + p] = v;
-      q /= m;
-    }
+    for (int d = 0; d < dim; ++d) soa[(size_t)d * ld + p] = aos[(size_t)dim * p + d];
     h[p] = 0.5 * rad * (0.6 + 0.8 * mfree_rng_uniform(&r));
     h3[3 * (size_t)p] = h[p];
     h3[3 * (size_t)p + 1] = -1.0; /* never read */
@@ -93,20 +76,15 @@ static void run(int dim, int m, double neighbours, uint64_t seed) {
   for (int64_t p = n; p < ld; ++p)
     for (int d = 0; d < dim; ++d) soa[(size_t)d * ld + p] = NAN; /* padding, never read */
 
-  const lists_t ref = search(dim, n, aos, MFREE_LAYOUT_AOS, dim, h, 1, 1);
-  const size_t nnz = (size_t)ref.rowptr[n];
+  lists_t ref = search(dim, n, aos, MFREE_LAYOUT_AOS, dim, h, 1, 1);
   for (int threads = 1; threads <= 2; ++threads) {
     lists_t g = search(dim, n, soa, MFREE_LAYOUT_SOA, ld, h3, 3, threads);
-    assert_memory_equal(g.rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)n + 1));
-    assert_memory_equal(g.cols, ref.cols, sizeof(int32_t) * nnz);
-    free(g.rowptr);
-    free(g.cols);
+    assert_lists_equal(&g, &ref);
+    lists_free(&g);
     if (threads == 2) {
       g = search(dim, n, aos, MFREE_LAYOUT_AOS, dim, h, 1, 2);
-      assert_memory_equal(g.rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)n + 1));
-      assert_memory_equal(g.cols, ref.cols, sizeof(int32_t) * nnz);
-      free(g.rowptr);
-      free(g.cols);
+      assert_lists_equal(&g, &ref);
+      lists_free(&g);
     }
   }
 
@@ -139,8 +117,7 @@ static void run(int dim, int m, double neighbours, uint64_t seed) {
   if (!(longest > 32 && shortest < 16))
     fail_msg("%dD rows of %lld to %lld entries: the range the test means to cover is missed", dim,
              (long long)shortest, (long long)longest);
-  free(ref.rowptr);
-  free(ref.cols);
+  lists_free(&ref);
   free(aos);
   free(soa);
   free(h);
@@ -166,19 +143,13 @@ static void test_growth_failure(void **state) {
   double *x = malloc(sizeof(double) * 3 * (size_t)n), *h = malloc(sizeof(double) * (size_t)n);
   assert_non_null(x);
   assert_non_null(h);
-  for (int32_t p = 0; p < n; ++p) {
-    int32_t q = p;
-    for (int d = 0; d < dim; ++d) {
-      x[(size_t)dim * p + d] = (q % m) + 0.3 * (2.0 * mfree_rng_uniform(&r) - 1.0);
-      q /= m;
-    }
-  }
+  jittered_lattice(x, dim, m, &r);
   const double small = 0.5 * cbrt(20.0 * 3.0 / (4.0 * M_PI)), big = 2.0 * small; /* ~20, ~160 neighbours */
   /* the references: fresh sets with the small and the big supports */
   for (int32_t p = 0; p < n; ++p) h[p] = small;
-  const lists_t old = search(dim, n, x, MFREE_LAYOUT_AOS, dim, h, 1, 1);
+  lists_t old = search(dim, n, x, MFREE_LAYOUT_AOS, dim, h, 1, 1);
   for (int32_t p = 0; p < n; ++p) h[p] = big;
-  const lists_t ref = search(dim, n, x, MFREE_LAYOUT_AOS, dim, h, 1, 1);
+  lists_t ref = search(dim, n, x, MFREE_LAYOUT_AOS, dim, h, 1, 1);
   counter_t cnt = {0, 0, 0, -1};
   mfree_context_t *ctx = NULL;
   assert_ok(NULL, mfree_context_create(&ctx));
@@ -206,42 +177,24 @@ static void test_growth_failure(void **state) {
       int64_t nnz = 0;
       if (mfree_particles_get_neighbor_nnz(ps, &nnz) == MFREE_SUCCESS) {
         /* still set up: the previous lists, unchanged */
-        assert_int_equal(nnz, old.rowptr[n]);
-        int64_t *rowptr = malloc(sizeof(int64_t) * ((size_t)n + 1));
-        int32_t *cols = malloc(sizeof(int32_t) * (size_t)(nnz > 0 ? nnz : 1));
-        assert_non_null(rowptr);
-        assert_non_null(cols);
-        assert_ok(ctx, mfree_particles_get_neighbors(ps, rowptr, cols));
-        assert_memory_equal(rowptr, old.rowptr, sizeof(int64_t) * ((size_t)n + 1));
-        assert_memory_equal(cols, old.cols, sizeof(int32_t) * (size_t)nnz);
-        free(rowptr);
-        free(cols);
+        lists_t g = lists_fetch(ctx, ps);
+        assert_lists_equal(&g, &old);
+        lists_free(&g);
       } else {
         assert_error(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz), MFREE_ERR_STATE, "not set up");
       }
       assert_ok(ctx, mfree_particles_setup(ps));
     }
-    int64_t nnz = 0;
-    assert_ok(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz));
-    assert_int_equal(nnz, ref.rowptr[n]);
-    int64_t *rowptr = malloc(sizeof(int64_t) * ((size_t)n + 1));
-    int32_t *cols = malloc(sizeof(int32_t) * (size_t)nnz);
-    assert_non_null(rowptr);
-    assert_non_null(cols);
-    assert_ok(ctx, mfree_particles_get_neighbors(ps, rowptr, cols));
-    assert_memory_equal(rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)n + 1));
-    assert_memory_equal(cols, ref.cols, sizeof(int32_t) * (size_t)nnz);
-    free(rowptr);
-    free(cols);
+    lists_t g = lists_fetch(ctx, ps);
+    assert_lists_equal(&g, &ref);
+    lists_free(&g);
     mfree_particles_destroy(&ps);
   }
   mfree_context_destroy(&ctx);
   assert_int_equal(cnt.held, 0);
   assert_int_equal(cnt.frees, cnt.calls);
-  free(ref.rowptr);
-  free(ref.cols);
-  free(old.rowptr);
-  free(old.cols);
+  lists_free(&ref);
+  lists_free(&old);
   free(x);
   free(h);
 }

@@ -15,37 +15,11 @@
  * Holds without AVX2 too (general path on both sides). No timing.
  */
 #include "testutil.h"
+#include "nbr_lists.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct {
-  int64_t *rowptr;
-  int32_t *cols;
-  int32_t rows;
-} lists_t;
-
-static lists_t fetch(mfree_context_t *ctx, mfree_particles_t *ps) {
-  lists_t g;
-  int32_t n = 0, ng = 0;
-  int64_t nnz = 0;
-  assert_ok(ctx, mfree_particles_get_size(ps, &n, &ng));
-  assert_ok(ctx, mfree_particles_get_neighbor_nnz(ps, &nnz));
-  g.rows = n - ng;
-  g.rowptr = malloc(sizeof(int64_t) * ((size_t)g.rows + 1));
-  g.cols = malloc(sizeof(int32_t) * (size_t)(nnz > 0 ? nnz : 1));
-  assert_non_null(g.rowptr);
-  assert_non_null(g.cols);
-  assert_ok(ctx, mfree_particles_get_neighbors(ps, g.rowptr, g.cols));
-  assert_int_equal(g.rowptr[g.rows], nnz);
-  return g;
-}
-
-static void lists_free(lists_t *g) {
-  free(g->rowptr);
-  free(g->cols);
-}
 
 /* Scale the slowest axis about its middle: by a below the middle, by b above. */
 static void warp(double *x, const double *x0, int dim, int32_t n, double mid, double a, double b) {
@@ -67,14 +41,8 @@ static void run_case(int dim, int m, int conv, int32_t ng) {
   assert_non_null(x0);
   assert_non_null(x);
   assert_non_null(h);
-  for (int32_t p = 0; p < n; ++p) {
-    int32_t q = p;
-    for (int d = 0; d < dim; ++d) {
-      x0[(size_t)dim * p + d] = (q % m) + 0.3 * (2.0 * mfree_rng_uniform(&r) - 1.0);
-      q /= m;
-    }
-    h[p] = (dim == 2 ? 1.3 : 1.1) * (1.0 + 0.4 * mfree_rng_uniform(&r));
-  }
+  jittered_lattice(x0, dim, m, &r);
+  for (int32_t p = 0; p < n; ++p) h[p] = (dim == 2 ? 1.3 : 1.1) * (1.0 + 0.4 * mfree_rng_uniform(&r));
   memcpy(x, x0, sizeof(double) * (size_t)dim * (size_t)n);
   const int threads[5] = {1, 2, 3, 5, 8};
   mfree_context_t *ctx[5];
@@ -96,10 +64,10 @@ static void run_case(int dim, int m, int conv, int32_t ng) {
   for (int s = 0; s < nsteps; ++s) {
     warp(x, x0, dim, n, mid, steps[s][0], steps[s][1]);
     for (int k = 0; k < 5; ++k) assert_ok(ctx[k], mfree_particles_setup(ps[k]));
-    lists_t ref = fetch(ctx[0], ps[0]);
+    lists_t ref = lists_fetch(ctx[0], ps[0]);
     assert_true(ref.rowptr[ref.rows] > 10 * (int64_t)ref.rows);
     for (int k = 1; k < 5; ++k) {
-      lists_t g = fetch(ctx[k], ps[k]);
+      lists_t g = lists_fetch(ctx[k], ps[k]);
       assert_int_equal(g.rows, ref.rows);
       if (memcmp(g.rowptr, ref.rowptr, sizeof(int64_t) * ((size_t)ref.rows + 1)) != 0 ||
           memcmp(g.cols, ref.cols, sizeof(int32_t) * (size_t)ref.rowptr[ref.rows]) != 0)
