@@ -28,7 +28,17 @@ bool hessian_needs_d2w(int m) {
 // Doubles per particle record of pack(): coordinates, volume and support, except in 3D:
 // x y z vol (32 bytes, one aligned load per neighbour in the fast path, never split
 // across cache lines), the supports in an array after the records.
-int record_length(int dim) { return dim == 3 ? 4 : dim + 2; }
+constexpr int record_length(int dim) { return dim == 3 ? 4 : dim + 2; }
+// Where pack() puts the n particles' supports in its block P: the support of particle
+// i is h[i * stride] (after the records in 3D, inside them otherwise).
+struct PackedSupports {
+  double *h;
+  int64_t stride;
+};
+PackedSupports packed_supports(double *P, int dim, int64_t n) {
+  const int64_t S = record_length(dim);
+  return S < dim + 2 ? PackedSupports{P + S * n, 1} : PackedSupports{P + dim + 1, S};
+}
 const char *method_name(int m) {
   static const char *names[] = {"?", "SPH", "SPH symmetric", "Shepard", "MLS", "RKPM",
                                 "Johnson-Beissel", "Randles-Libersky", "KB Method 1",
@@ -254,11 +264,11 @@ void Approximant::pack() {
   // AoS, one record per particle (coordinates, volume, support; record_length): the data
   // of a neighbour come in one cache line
   const size_t S = static_cast<size_t>(record_length(dim));
-  const bool hsep = S < static_cast<size_t>(dim) + 2;  // supports after the records
-  pack_.resize(S * N + (hsep ? N : 0));
+  pack_.resize(S * N + (S < static_cast<size_t>(dim) + 2 ? N : 0));  // (+ supports after the records)
   double *P = pack_.data();
-  double *H = hsep ? P + S * N : P + dim + 1;
-  const size_t HS = hsep ? 1 : S;
+  const PackedSupports ph = packed_supports(P, dim, np);
+  double *H = ph.h;
+  const size_t HS = static_cast<size_t>(ph.stride);
   parallel_blocks(np, num_threads(np), [&](int, int64_t b, int64_t e) {
     for (int64_t i = b; i < e; ++i) {
       const int32_t j = static_cast<int32_t>(i);
@@ -314,9 +324,9 @@ void Approximant::build_pattern() {
   // sites; the supports PH (particles) and SH (sites) with their strides
   const int64_t PS = record_length(dim), SS = points_ ? dim + 1 : PS;
   const double *P = pack_.data(), *SP = points_ ? spack_.data() : P;
-  const bool hsep = PS < dim + 2;
-  const double *PH = hsep ? P + PS * ps_->size() : P + dim + 1;
-  const int64_t PHS = hsep ? 1 : PS;
+  const PackedSupports ph = packed_supports(pack_.data(), dim, ps_->size());
+  const double *PH = ph.h;
+  const int64_t PHS = ph.stride;
   const double *SH = points_ ? SP + dim : PH;
   const int64_t SHS = points_ ? SS : PHS;
   bool per[3] = {false, false, false};
@@ -365,7 +375,7 @@ void Approximant::build_pattern() {
         auto scan = [&](auto dimc) {
           constexpr int D = decltype(dimc)::value;
           const int pd = D > 0 ? D : dim;
-          const int64_t ps = D == 2 || D == 3 ? 4 : PS;
+          const int64_t ps = D > 0 ? record_length(D) : PS;
           for (int64_t q = srp[s]; q < srp[s + 1]; ++q) {
             const int32_t j = scl[q];
             const double *pj = P + j * ps;
@@ -530,10 +540,10 @@ Report Approximant::compute(const char *what) {
       ft.period[c] = ps_->box_hi(c) - ps_->box_lo(c);
     }
     const int64_t PS = record_length(dim);
-    const bool hsep = PS < dim + 2;
+    const PackedSupports ph = packed_supports(pack_.data(), dim, ps_->size());
     ft.vol = pack_.data() + dim;
-    ft.h = hsep ? pack_.data() + PS * ps_->size() : pack_.data() + dim + 1;
-    ft.hstride = hsep ? 1 : PS;
+    ft.h = ph.h;
+    ft.hstride = ph.stride;
     ft.sh = points_ ? spack_.data() + dim : ft.h;
     ft.shstride = points_ ? dim + 1 : ft.hstride;
     ft.stride = PS;
