@@ -1,11 +1,12 @@
 !> module mfree: Fortran 2008 bindings of the mfree C ABI (include/mfree.h).
 !>
 !> Two layers, both public:
-!>  - raw interfaces named <C name>_c, one per public C function, bound with
-!>    bind(C, name="<C name>") and declared with the exact C types (int32_t ->
-!>    integer(c_int32_t), int64_t -> integer(c_int64_t), double -> real(c_double),
-!>    enumerations -> integer(c_int), handles -> type(c_ptr), function pointers ->
-!>    type(c_funptr); pointers that may be NULL are type(c_ptr), value);
+!>  - raw interfaces named after the C function with the suffix _c, one per public C
+!>    function, bound with bind(C, name=...) to the C name and declared with the exact
+!>    C types (int32_t -> integer(c_int32_t), int64_t -> integer(c_int64_t),
+!>    double -> real(c_double), enumerations -> integer(c_int), handles ->
+!>    type(c_ptr), function pointers -> type(c_funptr); pointers that may be NULL are
+!>    type(c_ptr), value);
 !>  - typed wrappers named exactly like the C functions, taking the handle types
 !>    type(mfree_context), type(mfree_particles), ... so that the compiler rejects a
 !>    particle set passed where an approximant is expected, optional arguments where C

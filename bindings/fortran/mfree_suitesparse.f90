@@ -3,7 +3,7 @@
 !> Built into libmfree_fortran_suitesparse only when the adapter is built; the core
 !> module mfree (libmfree_fortran) never depends on SuiteSparse.
 !>
-!> Same two layers as module mfree: raw bind(C) interfaces <C name>_c with the exact C
+!> Same two layers as module mfree: raw bind(C) interfaces, the C name with _c, with the exact C
 !> types, and typed wrappers with the C names. The solver handle is type(mfree_solver)
 !> (C: mfree_suitesparse_t): a type named mfree_suitesparse would clash with this
 !> module's name in every program that uses it.
