@@ -76,6 +76,7 @@ consumer_pkgconfig() {
   ldirs=$(pkg-config --libs-only-L mfree) || fail "pkg-config --libs-only-L mfree"
   # The private libraries are what the archive itself needs (the C++ runtime).
   static_private=$(pkg-config --static --libs-only-l mfree | sed 's/-lmfree\b//')
+  grep -qx 'License: BSD-3-Clause' "$pcdir/mfree.pc" || fail "mfree.pc names no BSD-3-Clause licence"
 
   step "pkg-config, shared: cc main.c $cflags $libs"
   # shellcheck disable=SC2086
