@@ -16,7 +16,7 @@ jobs="$(nproc 2>/dev/null || echo 2)"
 cmake --build --preset default -j"$jobs" --target mfree_dam_break
 
 out="$root/build/default/demo_dam_break"
-data="$root/../shared/data/martin_moyce_1952.csv"
+data="$root/data/martin_moyce_1952.csv"
 mkdir -p "$out"
 echo
 echo "== Dam break (paper 003 Galerkin SPH) vs Martin & Moyce (1952)"

@@ -60,7 +60,7 @@ static void usage(FILE *f) {
           "  --offset F      walls set back by F d from the fluid's edge (default 0.5)\n"
           "  --scheme S      leapfrog (default) | pc (predictor-corrector)\n"
           "  --lumping L     galerkin (default, 003 eq 56) | physical (eq 58)\n"
-          "  --data PATH     Martin & Moyce CSV (default ../shared/data/martin_moyce_1952.csv)\n"
+          "  --data PATH     Martin & Moyce CSV (default: the repository's data/martin_moyce_1952.csv)\n"
           "  --out DIR       output directory (default dam_break_out)\n"
           "  --vtu-every T   VTU interval in units of T (default 0.25; 0 = no VTU)\n"
           "  --no-plot       do not run gnuplot\n"
@@ -206,7 +206,7 @@ static int fail(mfree_context_t *ctx, mfree_status_t st, const char *what) {
 int main(int argc, char **argv) {
   options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 0.05, 0.25,
                  24,      0,   0,   1,   1,   MFREE_INTEGRATOR_LEAPFROG, MFREE_LUMP_GALERKIN,
-                 "dam_break_out", "../shared/data/martin_moyce_1952.csv"};
+                 "dam_break_out", MFREE_DATA_DIR "/martin_moyce_1952.csv"};
   if (!parse(argc, argv, &o)) {
     usage(stderr);
     return 2;

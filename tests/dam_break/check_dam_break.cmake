@@ -3,17 +3,15 @@
 # failure, the mass is exact (constant particle masses, none lost through a wall, and the
 # Galerkin lumped masses of 003 eq 57 summing to the total), and the surge front
 # Z = z/a lies within 20 % of Martin & Moyce (1952, Phil. Trans. R. Soc. A 244, Fig. 3,
-# n^2 = 2; shared/data/martin_moyce_1952.csv) at their points with 1 <= T <= 3.
+# n^2 = 2; data/martin_moyce_1952.csv of the repository) at their points with 1 <= T <= 3.
 # Usage: cmake -DEXE=<mfree_dam_break> -DOUT=<dir> -DDATA=<csv> [-DNX=<n>|default] -P check_dam_break.cmake
 cmake_minimum_required(VERSION 3.20)
 include(${CMAKE_CURRENT_LIST_DIR}/../examples/json_checks.cmake)
 file(MAKE_DIRECTORY ${OUT})
-if(EXISTS "${DATA}")
-  set(_data --data ${DATA})
-else()
-  message(STATUS "Martin & Moyce data not found at ${DATA}: the front comparison is skipped")
-  set(_data --data ${OUT}/no-data.csv)
+if(NOT EXISTS "${DATA}")
+  message(FATAL_ERROR "Martin & Moyce data not found at ${DATA} (data/ of the repository)")
 endif()
+set(_data --data ${DATA})
 if(NOT DEFINED NX)
   set(NX 10)
 endif()
@@ -42,12 +40,8 @@ foreach(f front.csv dam_break.pvd dam_break_0000.vtu)
     message(SEND_ERROR "examples/dam_break did not write ${f}")
   endif()
 endforeach()
-if(EXISTS "${DATA}")
-  expect_equal("${compared}" "3" "Martin & Moyce points with 1 <= T <= 3 (T = 1.219, 1.997, 2.547)")
-  # SPH fronts typically run 10-15 % ahead of this experiment; measured 3.97 % at nx = 10,
-  # 10.05 % at the default nx = 24
-  expect_range(${dev} 0 0.20 "Martin & Moyce (1952) Fig. 3, n^2 = 2: front within 20 % for 1 <= T <= 3")
-  message(STATUS "dam break front: max relative deviation from Martin & Moyce ${dev} (${compared} points)")
-else()
-  expect_range(${dev} -1 -1 "examples/dam_break without data: max_rel_dev = -1")
-endif()
+expect_equal("${compared}" "3" "Martin & Moyce points with 1 <= T <= 3 (T = 1.219, 1.997, 2.547)")
+# SPH fronts typically run 10-15 % ahead of this experiment; measured 3.97 % at nx = 10,
+# 10.05 % at the default nx = 24
+expect_range(${dev} 0 0.20 "Martin & Moyce (1952) Fig. 3, n^2 = 2: front within 20 % for 1 <= T <= 3")
+message(STATUS "dam break front: max relative deviation from Martin & Moyce ${dev} (${compared} points)")

@@ -1,7 +1,7 @@
 # Header hygiene of the public C ABI (run with cmake -P).
 #   -DCOMPILER=<C or C++ compiler> -DSOURCE=<file including mfree.h>
 #   -DFLAGS=<;-list of flags> -DINCLUDES=<;-list of include dirs>
-#   -DHEADER=<path of mfree.h>: when set, also check the ABI types of ../shared/STYLE.md
+#   -DHEADER=<path of mfree.h>: when set, also check the ABI types of the style rules (ABI.md)
 #     (no bool, no long, no varargs) in the header with its comments removed.
 cmake_minimum_required(VERSION 3.25)  # policies of a -P script
 foreach(v COMPILER SOURCE FLAGS INCLUDES)
