@@ -28,7 +28,6 @@
  * "wall_seconds":..,...}, where max_rel_dev is the largest |Z - Z_exp| / Z_exp over the
  * data points with 1 <= T <= 3 (Z linearly interpolated in T); -1 when no data file. */
 #define _XOPEN_SOURCE 700
-#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -38,6 +37,8 @@
 #include <unistd.h>
 
 #include <mfree.h>
+
+#include "util.h"
 
 static const double kG = 9.81, kRho0 = 1000.0, kGamma = 7.0;
 
@@ -105,26 +106,6 @@ static int parse(int argc, char **argv, options_t *o) {
          o->mu >= 0 && o->strength >= 0 && o->offset >= 0 && o->vtu_dt >= 0;
 }
 
-static int on_path(const char *name) {
-  const char *path = getenv("PATH");
-  if (!path) return 0;
-  char buf[4096];
-  const char *p = path;
-  while (*p) {
-    const char *e = strchr(p, ':');
-    const size_t len = e ? (size_t)(e - p) : strlen(p);
-    if (len > 0 && len + strlen(name) + 2 < sizeof buf) {
-      memcpy(buf, p, len);
-      buf[len] = '/';
-      strcpy(buf + len + 1, name);
-      if (access(buf, X_OK) == 0) return 1;
-    }
-    if (!e) break;
-    p = e + 1;
-  }
-  return 0;
-}
-
 /* Martin & Moyce points (T, Z); returns the count, 0 if the file is missing. */
 static int read_data(const char *path, double *T, double *Z, int cap) {
   FILE *f = path ? fopen(path, "r") : NULL;
@@ -142,27 +123,6 @@ static int read_data(const char *path, double *T, double *Z, int cap) {
   }
   fclose(f);
   return n;
-}
-
-typedef struct {
-  int quiet, last;
-  double t0, t1;
-  int64_t base; /* steps of earlier integrate calls */
-} progress_t;
-
-static int32_t progress_cb(void *user, int64_t step, double t, double dt) {
-  progress_t *p = user;
-  (void)dt;
-  if (p->quiet) return 0;
-  const int pct = (int)(100.0 * (t - p->t0) / (p->t1 - p->t0));
-  if (pct != p->last) {
-    p->last = pct;
-    const int w = 40, fill = pct * w / 100;
-    fprintf(stderr, "\r[%.*s%*s] %3d%%  t = %.4f s  step %lld", fill,
-            "########################################", w - fill, "", pct, t, (long long)(p->base + step));
-    fflush(stderr);
-  }
-  return 0;
 }
 
 static int write_vtu(const char *path, int n, const double *y, const double *vhat, const double *p) {
@@ -294,7 +254,8 @@ int main(int argc, char **argv) {
   double t = 0.0, next_vtu = 0.0;
   int64_t steps = 0;
   mfree_status_t run = MFREE_SUCCESS;
-  progress_t prog = {o.quiet, -1, 0.0, o.t_end / tscale, 0};
+  ex_progress_t prog;
+  ex_progress_init(&prog, o.quiet, 0.0, o.t_end / tscale);
   struct timespec c0, c1;
   clock_gettime(CLOCK_MONOTONIC, &c0);
   for (int io = 0; io <= nout; ++io) {
@@ -302,9 +263,9 @@ int main(int argc, char **argv) {
     if (io > 0) {
       int64_t ns_ = 0;
       run = mfree_system_integrate(sys, (mfree_integrator_t)o.scheme, y, &t, T_target / tscale, o.cfl, 0.0,
-                                   progress_cb, &prog, &ns_);
+                                   ex_progress, &prog, &ns_);
       steps += ns_;
-      prog.base = steps;
+      ex_progress_steps(&prog, ns_);
       if (run != MFREE_SUCCESS) break;
     }
     double xmax = -1e300, xfloor = -1e300;
@@ -332,7 +293,7 @@ int main(int argc, char **argv) {
   }
   clock_gettime(CLOCK_MONOTONIC, &c1);
   const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
-  if (!o.quiet) fprintf(stderr, "\n");
+  ex_progress_done(&prog, "mfree_dam_break", t);
   fclose(csv);
   if (pvd) {
     fprintf(pvd, "</Collection>\n</VTKFile>\n");
@@ -371,24 +332,25 @@ int main(int argc, char **argv) {
   }
   if (ndata && !compared) maxdev = -1.0;
 
-  /* ---- plot ---- */
-  if (o.plot && on_path("gnuplot")) {
-    char data_abs[PATH_MAX] = "";
-    if (ndata && !realpath(o.data, data_abs)) data_abs[0] = '\0';
-    snprintf(path, sizeof path, "%s/front.gp", o.out_dir);
-    FILE *gp = fopen(path, "w");
+  /* ---- plot: the front against the experiment ---- */
+  char gp_path[4096] = "", png_path[4096] = "", csv_path[4096] = "";
+  ex_join(gp_path, sizeof gp_path, o.out_dir, "front.gp");
+  ex_join(png_path, sizeof png_path, o.out_dir, "front.png");
+  ex_join(csv_path, sizeof csv_path, o.out_dir, "front.csv");
+  if (o.plot && ex_plot_path_ok(png_path) && ex_plot_path_ok(o.data)) {
+    FILE *gp = fopen(gp_path, "w");
     if (gp) {
-      fprintf(gp, "set terminal pngcairo size 800,560\nset output 'front.png'\nset datafile separator ','\n"
+      fprintf(gp, "set terminal pngcairo size 800,560\nset output '%s'\nset datafile separator ','\n"
                   "set key top left\nset grid\nset xlabel 'T = t (2g/a)^{1/2}'\nset ylabel 'Z = z/a'\n"
-                  "set title 'Dam break, n^2 = 2: Galerkin SPH (003) vs Martin and Moyce (1952)'\nset xrange [0:%g]\n"
-                  "plot 'front.csv' using 1:2 with lines lw 2 title 'front, all particles (%d)', "
-                  "'front.csv' using 1:3 with lines dt 2 title 'front, particles on the floor'", o.t_end + 0.5, n);
-      if (data_abs[0]) fprintf(gp, ", '%s' using 1:2 with points pt 7 title 'Martin and Moyce (1952), n^2 = 2'", data_abs);
+                  "set title 'Dam break, n^2 = 2: Galerkin SPH (Cueto-Felgueroso et al. 2004) vs Martin and Moyce (1952)'\n"
+                  "set xrange [0:%g]\n"
+                  "plot '%s' using 1:2 with lines lw 2 title 'front, all particles (%d)', "
+                  "'%s' using 1:3 with lines dt 2 title 'front, particles on the floor'",
+              png_path, o.t_end + 0.5, csv_path, n, csv_path);
+      if (ndata) fprintf(gp, ", '%s' using 1:2 with points pt 7 title 'Martin and Moyce (1952), n^2 = 2'", o.data);
       fprintf(gp, "\n");
       fclose(gp);
-      char cmd[8192];
-      snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot front.gp > /dev/null 2>&1", o.out_dir);
-      if (system(cmd) != 0 && !o.quiet) fprintf(stderr, "mfree_dam_break: gnuplot failed\n");
+      ex_plot(gp_path, png_path, csv_path, o.json ? stderr : stdout);
     }
   }
 

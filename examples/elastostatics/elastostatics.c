@@ -43,6 +43,7 @@
 #include <unistd.h>
 
 #include "es.h"
+#include "util.h"
 
 /* 000 Table III: energy and L2 rates, beam then hole; negative = "NC". */
 static const double kPaper[ES_NSCHEMES][4] = {
@@ -469,24 +470,6 @@ static int write_gp(const char *path, const char *png, const char *dat[2], const
   return fclose(f) != 0;
 }
 
-static int on_path(const char *prog) {
-  const char *path = getenv("PATH");
-  if (!path) return 0;
-  char buf[4096];
-  while (*path) {
-    const char *e = strchr(path, ':');
-    const size_t len = e ? (size_t)(e - path) : strlen(path);
-    if (len > 0 && len + strlen(prog) + 2 < sizeof buf) {
-      memcpy(buf, path, len);
-      buf[len] = '/';
-      strcpy(buf + len + 1, prog);
-      if (access(buf, X_OK) == 0) return 1;
-    }
-    path += len + (e ? 1 : 0);
-  }
-  return 0;
-}
-
 int main(int argc, char **argv) {
   options_t o = {0, 1, 5, 1, {1, 1, 0}, ".", ES_BC_AUTO, -1, 0, 0, 0, 0, 0};
   if (parse(argc, argv, &o)) {
@@ -498,7 +481,7 @@ int main(int argc, char **argv) {
     fprintf(stderr, "error: --out %s is not a writable directory\n", o.out);
     return 1;
   }
-  if (strchr(o.out, '\'')) {
+  if (!ex_plot_path_ok(o.out)) {
     fprintf(stderr, "error: --out directory must not contain quotes\n");
     return 1;
   }
@@ -523,19 +506,12 @@ int main(int argc, char **argv) {
   snprintf(dat[1], sizeof dat[1], "%s/elastostatics_hole.dat", o.out);
   snprintf(gp, sizeof gp, "%s/elastostatics.gp", o.out);
   snprintf(png, sizeof png, "%s/elastostatics.png", o.out);
-  int have_png = 0;
-  if (o.run[0] || o.run[1]) {
-    if ((o.run[0] && write_dat(dat[0], "cantilever beam", &S[0])) ||
-        (o.run[1] && write_dat(dat[1], "plate with a hole", &S[1])) || write_gp(gp, png, datp, o.run))
-      return 1;
-    if (o.plot && on_path("gnuplot")) {
-      char cmd[9000];
-      snprintf(cmd, sizeof cmd, "gnuplot '%s' 1>&2", gp);
-      FILE *pp = popen(cmd, "r");
-      have_png = pp && pclose(pp) == 0;
-      if (!have_png) fprintf(stderr, "warning: gnuplot failed on %s; no plot made\n", gp);
-    }
-  }
+  const int curves = o.run[0] || o.run[1];
+  if (curves && ((o.run[0] && write_dat(dat[0], "cantilever beam", &S[0])) ||
+                 (o.run[1] && write_dat(dat[1], "plate with a hole", &S[1])) ||
+                 write_gp(gp, png, datp, o.run)))
+    return 1;
+  if (curves && o.plot && o.json) ex_plot(gp, png, o.run[0] ? dat[0] : dat[1], stderr);
 
   if (o.json) {
     printf("{\"paper\":\"000 Table III\",\"plane\":\"stress\",\"kernel\":\"cubic spline, s = sqrt(2) dx\","
@@ -591,8 +567,8 @@ int main(int argc, char **argv) {
   if (o.run[2]) print_patch(&P);
   if (o.run[0] || o.run[1]) {
     printf("\ndata: %s%s%s\n", o.run[0] ? dat[0] : "", o.run[0] && o.run[1] ? ", " : "", o.run[1] ? dat[1] : "");
-    if (have_png) printf("plot: %s\n", png);
-    else printf("plot: not made; run gnuplot %s\n", gp);
+    if (o.plot) ex_plot(gp, png, o.run[0] ? dat[0] : dat[1], stdout);
+    else printf("plot: not made (--no-plot); run gnuplot %s\n", gp);
   }
   return 0;
 }

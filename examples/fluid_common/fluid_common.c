@@ -36,22 +36,6 @@ void fc_walls_free(fc_walls_t *w) {
   w->n = w->cap = 0;
 }
 
-int32_t fc_progress(void *user, int64_t step, double t, double dt) {
-  fc_progress_t *p = user;
-  (void)dt;
-  if (p->quiet) return 0;
-  int pct = (int)(100.0 * (t - p->t0) / (p->t1 - p->t0));
-  if (pct > 100) pct = 100;
-  if (pct != p->last) {
-    p->last = pct;
-    const int w = 40, fill = pct * w / 100;
-    fprintf(stderr, "\r[%.*s%*s] %3d%%  t = %.4f s  step %lld", fill, "########################################",
-            w - fill, "", pct, t, (long long)step);
-    fflush(stderr);
-  }
-  return 0;
-}
-
 int fc_write_vtu(const char *path, int n, const double *y, const double *vhat, const double *p,
                  const int *tag) {
   FILE *f = fopen(path, "w");

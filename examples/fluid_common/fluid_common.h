@@ -1,6 +1,6 @@
 /* Shared pieces of the free-surface flow examples of paper 003 (ramp, gravity_current):
- * wall particles (003 Sect. 6.2: spacing d/3, normals into the fluid), a terminal
- * progress bar for mfree_system_integrate, and VTU/PVD output for ParaView. */
+ * wall particles (003 Sect. 6.2: spacing d/3, normals into the fluid) and VTU/PVD output
+ * for ParaView (the progress bar is examples/util's). */
 #ifndef MFREE_EXAMPLES_FLUID_COMMON_H
 #define MFREE_EXAMPLES_FLUID_COMMON_H
 
@@ -20,13 +20,6 @@ typedef struct {
 int fc_walls_segment(fc_walls_t *w, double x0, double z0, double x1, double z1, double ds, double nx,
                      double nz, int skip_first);
 void fc_walls_free(fc_walls_t *w);
-
-/* Progress bar on stderr (mfree_progress_fn; user = fc_progress_t *). */
-typedef struct {
-  int quiet, last;
-  double t0, t1;
-} fc_progress_t;
-int32_t fc_progress(void *user, int64_t step, double t, double dt);
 
 /* VTU of the particles (position, interpolated velocity, pressure, density, and an
  * optional integer tag such as the fluid). Returns 0 on success. */

@@ -25,8 +25,10 @@
  * 0.217 m/s (003 eq 126; the paper reports about 0.2 m/s). The run stops when the head
  * has travelled L1 - D (or at --tend).
  *
- * Output in --out DIR (default gravity_current_out): head.csv, gravity_current.pvd with
- * VTU snapshots every --vtu-every s (default 0.05, 0 = none; point data "fluid" = 1 or 2).
+ * Output in --out DIR (default gravity_current_out): head.csv and head.png (the head's
+ * travel against Rottman & Simpson's speed; gnuplot on PATH, not --no-plot),
+ * gravity_current.pvd with VTU snapshots every --vtu-every s (default 0.05, 0 = none;
+ * point data "fluid" = 1 or 2).
  * --json: {"status":..,"t":..,"steps":..,"particles":..,"head_speed":..,"reference":0.217,
  * "rel_dev":..,"fit_points":..,"mass_rel_error":..,"wall_seconds":..} (head_speed and
  * rel_dev null when fewer than 3 head positions fell in the window). */
@@ -40,23 +42,25 @@
 #include <unistd.h>
 
 #include "fluid_common.h"
+#include "util.h"
 
 static const double kG = 9.81, kGamma = 7.0, kD = 0.06, kRho1 = 1000.0, kRho2 = 1500.0;
 
 static void usage(FILE *f) {
   fprintf(f, "usage: mfree_gravity_current [--nz N (34)] [--light L1 (0.12 m)] [--tend T (s; default: until\n"
              "       the head has travelled L1 - D, at most 1.5 s)] [--mu MU (0.01)] [--cfl C (0.25)]\n"
-             "       [--out DIR] [--vtu-every T (0.05 s; 0 = none)] [--quiet] [--json]\n");
+             "       [--out DIR] [--vtu-every T (0.05 s; 0 = none)] [--no-plot] [--quiet] [--json]\n");
 }
 
 int main(int argc, char **argv) {
-  int nz = 34, json = 0, quiet = 0;
+  int nz = 34, json = 0, quiet = 0, plot = 1;
   double light = 2.0 * kD, t_end = 1.5, mu = 0.01, cfl = 0.25, vtu_dt = 0.05;
   const char *out = "gravity_current_out";
   for (int i = 1; i < argc; ++i) {
     const char *s = argv[i];
     const int has = i + 1 < argc;
     if (!strcmp(s, "--json")) json = 1;
+    else if (!strcmp(s, "--no-plot")) plot = 0;
     else if (!strcmp(s, "--quiet")) quiet = 1;
     else if (!strcmp(s, "--help")) {
       usage(stdout);
@@ -138,7 +142,8 @@ int main(int argc, char **argv) {
     fprintf(pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
   }
   const double out_dt = 0.005;
-  fc_progress_t prog = {quiet || json, -1, 0.0, t_end};
+  ex_progress_t prog;
+  ex_progress_init(&prog, quiet || json, 0.0, t_end);
   double t = 0.0, next_vtu = 0.0, sx = 0, sy = 0, sxx = 0, sxy = 0;
   int64_t steps = 0;
   int nvtu = 0, nfit = 0;
@@ -149,8 +154,9 @@ int main(int argc, char **argv) {
     if (io > 0) {
       int64_t ns = 0;
       run = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, fmin(t_end, io * out_dt), cfl, 0.0,
-                                   fc_progress, &prog, &ns);
+                                   ex_progress, &prog, &ns);
       steps += ns;
+      ex_progress_steps(&prog, ns);
       if (run != MFREE_SUCCESS) break;
     }
     double xh = 1e300;
@@ -173,7 +179,7 @@ int main(int argc, char **argv) {
   }
   clock_gettime(CLOCK_MONOTONIC, &c1);
   const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
-  if (!prog.quiet) fprintf(stderr, "\n");
+  ex_progress_done(&prog, "mfree_gravity_current", t);
   fclose(csv);
   if (pvd) {
     fprintf(pvd, "</Collection>\n</VTKFile>\n");
@@ -186,6 +192,26 @@ int main(int argc, char **argv) {
   double mass1 = 0.0;
   for (int q = 0; q < n; ++q) mass1 += m[q];
   const double merr = fabs(mass1 - mass0) / mass0;
+  /* plot: the distance the head travelled against time, with the Rottman & Simpson speed
+   * drawn through the middle of the fitted window */
+  char gp_path[4096], png_path[4096], csv_path[4096];
+  ex_join(gp_path, sizeof gp_path, out, "head.gp");
+  ex_join(png_path, sizeof png_path, out, "head.png");
+  ex_join(csv_path, sizeof csv_path, out, "head.csv");
+  FILE *gp = plot && ex_plot_path_ok(png_path) ? fopen(gp_path, "w") : NULL;
+  if (gp) {
+    fprintf(gp, "set terminal pngcairo size 800,560\nset output '%s'\nset datafile separator ','\n"
+                "set key top left\nset grid\nset xlabel 't (s)'\nset ylabel 'distance travelled by the head (m)'\n"
+                "set title 'Gravity current, %d particles: head against Rottman and Simpson (1983)'\n"
+                "plot '%s' every ::1 using 1:3 with linespoints pt 7 ps 0.5 title 'mfree (Galerkin SPH)'",
+            png_path, n, csv_path);
+    if (nfit >= 3)
+      fprintf(gp, ", %.6f + %.6f * (x - %.6f) with lines lw 2 dt 2 title 'v_h = 0.4 (g D drho/rho_0)^{1/2} = %.3f m/s'",
+              xlock - sy / nfit, ref, sx / nfit, ref);
+    fprintf(gp, "\n");
+    fclose(gp);
+    ex_plot(gp_path, png_path, csv_path, json ? stderr : stdout);
+  }
   if (json) {
     char sp[32] = "null", dv[32] = "null"; /* JSON has no NaN: null without a fit */
     if (nfit >= 3) {

@@ -8,13 +8,15 @@
  * ln ||e||_1 against ln Delta over N = 10, 20, 30, 50, 100, 250, 500; the paper does
  * not state its N, spec 001 section 8.2) with the revised super Gauss at a = 1.6.
  *
- * Usage: mfree_kernels [--json]
+ * Usage: mfree_kernels [--json] [--out DIR] [--no-plot]; DIR/kernels.png plots Table 6's
+ * convergence (gnuplot on PATH).
  */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "papers.h"
+#include "util.h"
 
 #define NK 9 /* linear, quadratic, cubic, quartic, revised Gauss, RSG a = 1, 1.2, 1.4, 1.6 */
 static const mfree_kernel_t kKernel[NK] = {
@@ -62,6 +64,72 @@ static const int kRateCol[6] = {0, 1, 2, 3, 4, 8};
 static const double kPaperRate[NH][6] = {{1.9902, 2.0006, 2.0140, 2.0096, 1.9993, 2.0189},
                                          {1.9882, 1.9926, 1.9993, 1.9956, 1.9927, 2.0064}};
 
+typedef struct {
+  const char *out_dir;
+  int plot;
+} options_t;
+
+static int parse_extra(int argc, char **argv, int *i, void *user) {
+  options_t *o = user;
+  if (strcmp(argv[*i], "--out") == 0 && *i + 1 < argc) {
+    o->out_dir = argv[++*i];
+    return 1;
+  }
+  if (strcmp(argv[*i], "--no-plot") == 0) {
+    o->plot = 0;
+    return 1;
+  }
+  return 0;
+}
+
+/* Table 6's convergence as DIR/kernels_table6.dat (N, Delta, then ||e||_1 of the six
+ * kernels at h = 1.2 Delta and at 1.4 Delta) and a log-log plot of it. Returns 0, or 1
+ * when a file cannot be written. */
+static int plot_table6(const options_t *o, double e1[NH][6][NN], FILE *msg) {
+  char dat[4200], gp[4200], png[4200];
+  ex_join(dat, sizeof dat, o->out_dir, "kernels_table6.dat");
+  ex_join(gp, sizeof gp, o->out_dir, "kernels.gp");
+  ex_join(png, sizeof png, o->out_dir, "kernels.png");
+  if (!ex_plot_path_ok(dat)) {
+    fprintf(stderr, "error: --out directory must not contain quotes\n");
+    return 1;
+  }
+  FILE *f = fopen(dat, "w");
+  FILE *g = f ? fopen(gp, "w") : NULL;
+  if (!f || !g) {
+    fprintf(stderr, "error: cannot write %s\n", f ? gp : dat);
+    if (f) fclose(f);
+    return 1;
+  }
+  fprintf(f, "# paper 001 Table 6: SSPH, f = exp(-x^2), ||e||_1 per N; columns N Delta, then the kernels");
+  for (int h = 0; h < NH; ++h)
+    for (int c = 0; c < 6; ++c) fprintf(f, " | %s h=%.1f", kName[kRateCol[c]], kH[h]);
+  fprintf(f, "\n");
+  for (int n = 0; n < NN; ++n) {
+    fprintf(f, "%d %.6e", kN[n], 1.0 / kN[n]);
+    for (int h = 0; h < NH; ++h)
+      for (int c = 0; c < 6; ++c) fprintf(f, " %.6e", e1[h][c][n]);
+    fprintf(f, "\n");
+  }
+  fclose(f);
+  fprintf(g, "# gnuplot script written by mfree_kernels (paper 001 Table 6)\n"
+             "set terminal pngcairo size 1400,560\nset output '%s'\nset multiplot layout 1,2 "
+             "title 'SSPH with six kernels, f = exp(-x^2): H^1 error against Delta (Zhang and Batra 2009, Table 6)'\n"
+             "set logscale xy\nset format y '10^{%%L}'\nset xlabel 'Delta'\nset ylabel '||e||_1'\n"
+             "set key top left\nset grid\n", png);
+  for (int h = 0; h < NH; ++h) {
+    fprintf(g, "set title 'h = %.1f Delta'\nplot", kH[h]);
+    for (int c = 0; c < 6; ++c)
+      fprintf(g, "%s '%s' using 2:%d with linespoints title '%s, rate %.3f'", c ? "," : "", dat, 3 + 6 * h + c,
+              kName[kRateCol[c]], papers_rate(NN, kN, e1[h][c]));
+    fprintf(g, "\n");
+  }
+  fprintf(g, "unset multiplot\n");
+  fclose(g);
+  if (o->plot) ex_plot(gp, png, dat, msg);
+  return 0;
+}
+
 /* 1-based rank of v[i] among v[0..n-1] (1 = smallest). */
 static int rank_of(const double *v, int n, int i) {
   int r = 1;
@@ -72,17 +140,19 @@ static int rank_of(const double *v, int n, int i) {
 
 int main(int argc, char **argv) {
   static const char usage[] =
-      "usage: mfree_kernels [--json]\n"
-      "Paper 001 Tables 3-6 (SSPH with six kernels, f = exp(-x^2)) next to the paper.\n";
+      "usage: mfree_kernels [--json] [--out DIR] [--no-plot]\n"
+      "Paper 001 Tables 3-6 (SSPH with six kernels, f = exp(-x^2)) next to the paper;\n"
+      "writes DIR/kernels_table6.dat (+ .gp, and kernels.png when gnuplot is on PATH).\n";
   int json = 0;
-  if (papers_parse(argc, argv, usage, &json, NULL, NULL)) return 2;
+  options_t opt = {".", 1};
+  if (papers_parse(argc, argv, usage, &json, parse_extra, &opt)) return 2;
   mfree_context_t *ctx = NULL;
   if (mfree_context_create(&ctx) != MFREE_SUCCESS) {
     fprintf(stderr, "error: cannot create an mfree context\n");
     return 1;
   }
   double e[NH][NK][2];  /* N = 20 */
-  double rate[NH][6];
+  double rate[NH][6], e1all[NH][6][NN];
   for (int h = 0; h < NH; ++h) {
     for (int k = 0; k < NK; ++k) {
       const mfree_status_t st = papers_norms_1d(ctx, MFREE_METHOD_SSPH, 2, kKernel[k], kParam[k],
@@ -105,12 +175,13 @@ int main(int argc, char **argv) {
           mfree_context_destroy(&ctx);
           return 1;
         }
-        e1[n] = nv[1];
+        e1[n] = e1all[h][c][n] = nv[1];
       }
       rate[h][c] = papers_rate(NN, kN, e1);
     }
   }
   mfree_context_destroy(&ctx);
+  if (plot_table6(&opt, e1all, json ? stderr : stdout)) return 1;
 
   /* ranks within each printed table */
   int rank[2][NH][2][6];

@@ -17,18 +17,20 @@
  * Output: a table with rates (default) or one JSON object (--json)
  *   {"h":[...],"fem":{"L2":[...],"H1":[...]},"mpfem":{"L2":[...],"H1":[...]},
  *    "rates":{"fem":{"L2":[...],"H1":[...]},"mpfem":{"L2":[...],"H1":[...]}}}
- * (rates between successive spacings; the PNG's path goes to stderr). DIR/mpfem_1d_du.dat holds u' of FEM, MPFEM
- * (eq 22 and eq 21) and the exact solution at h = 0.02 (Fig. 5b), DIR/mpfem_1d.gp plots
- * it to DIR/mpfem_1d.png when gnuplot is on PATH.
+ * (rates between successive spacings; the PNG's path goes to stderr). DIR/mpfem_1d_du.dat
+ * holds u' of FEM, MPFEM (eq 22 and eq 21) and the exact solution at h = 0.02 (Fig. 5b),
+ * DIR/mpfem_1d_rates.dat the errors per h; DIR/mpfem_1d.gp plots both to DIR/mpfem_1d.png
+ * when gnuplot is on PATH (not --no-plot).
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <mfree.h>
 #include <mfree_suitesparse.h>
+
+#include "util.h"
 
 #define NH 6
 static const double kH[NH] = {0.1, 0.05, 0.02, 0.01, 0.005, 0.002};
@@ -230,21 +232,6 @@ static void mpfem(int32_t n, int ng, double *l2, double *h1, int32_t npl, const 
   free(x), free(f), free(u), free(conn), free(qx), free(qw), free(xe), free(we), free(v), free(g);
 }
 
-static int on_path(const char *name) {
-  const char *path = getenv("PATH");
-  char full[4200];
-  while (path && *path) {
-    const size_t len = strcspn(path, ":");
-    if (len > 0 && len < 4000) {
-      snprintf(full, sizeof full, "%.*s/%s", (int)len, path, name);
-      if (access(full, X_OK) == 0) return 1;
-    }
-    path += len;
-    if (*path == ':') ++path;
-  }
-  return 0;
-}
-
 static double rate(double e0, double e1, double h0, double h1) { return log(e0 / e1) / log(h0 / h1); }
 
 static void json_array(const double *v, int n) {
@@ -271,7 +258,7 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  if (strchr(out, '\'') || strchr(out, '"')) {
+  if (!ex_plot_path_ok(out)) {
     fprintf(stderr, "error: --out directory must not contain quotes\n");
     return 1;
   }
@@ -294,7 +281,17 @@ int main(int argc, char **argv) {
     rmh[i] = rate(mh1[i], mh1[i + 1], kH[i], kH[i + 1]);
   }
   /* u' at h = 0.02 and the gnuplot script */
-  char dat[4200], gp[4200], png[4200];
+  char dat[4200], gp[4200], png[4200], rdat[4200];
+  snprintf(rdat, sizeof rdat, "%s/mpfem_1d_rates.dat", out);
+  FILE *r = fopen(rdat, "w");
+  if (!r) {
+    fprintf(stderr, "error: cannot write %s\n", rdat);
+    mfree_context_destroy(&ctx);
+    return 1;
+  }
+  fprintf(r, "# paper 004 Example B, %d Gauss points: h  FEM_L2  FEM_H1  MPFEM_L2  MPFEM_H1(eq 22)\n", ng);
+  for (int i = 0; i < NH; ++i) fprintf(r, "%g %.10g %.10g %.10g %.10g\n", kH[i], fl2[i], fh1[i], ml2[i], mh1[i]);
+  fclose(r);
   snprintf(dat, sizeof dat, "%s/mpfem_1d_du.dat", out);
   snprintf(gp, sizeof gp, "%s/mpfem_1d.gp", out);
   snprintf(png, sizeof png, "%s/mpfem_1d.png", out);
@@ -311,21 +308,19 @@ int main(int argc, char **argv) {
   for (int p = 0; p < NPL; ++p) fprintf(f, "%.6f %.10g %.10g %.10g %.10g\n", xpl[p], du_exact(xpl[p]), dfe[p], d22[p], d21[p]);
   fclose(f);
   fprintf(g, "# gnuplot script written by mfree_mpfem_1d (paper 004 Fig. 5b)\n"
-             "set terminal pngcairo size 900,600\nset output '%s'\n"
-             "set title \"Example B (004): u' at h = %g, FEM vs MPFEM\"\nset xlabel 'x'\nset ylabel \"u'\"\n"
+             "set terminal pngcairo size 1500,600\nset output '%s'\nset multiplot layout 1,2\n"
+             "set title \"Example B (Hao et al. 2004): u' at h = %g, FEM vs MPFEM\"\nset xlabel 'x'\nset ylabel \"u'\"\n"
              "set xrange [0.35:0.65]\nset key top left\n"
              "plot '%s' u 1:2 w l lw 2 t 'exact', '' u 1:3 w l t 'FEM (piecewise constant)', "
-             "'' u 1:4 w l t 'MPFEM, eq 22', '' u 1:5 w l dt 2 t 'MPFEM, eq 21'\n",
-          png, kH[PLOT_LEVEL], dat);
+             "'' u 1:4 w l t 'MPFEM, eq 22', '' u 1:5 w l dt 2 t 'MPFEM, eq 21'\n"
+             "set title 'Convergence: errors against h'\nset xlabel 'h'\nset ylabel 'error'\n"
+             "set autoscale x\nset logscale xy\nset format y '10^{%%L}'\n"
+             "plot '%s' u 1:2 w lp t 'FEM L2', '' u 1:3 w lp t 'FEM H1', '' u 1:4 w lp lw 2 t 'MPFEM L2', "
+             "'' u 1:5 w lp lw 2 t 'MPFEM H1 (eq 22)'\nunset multiplot\n",
+          png, kH[PLOT_LEVEL], dat, rdat);
   fclose(g);
-  int have_png = 0;
-  if (plot && on_path("gnuplot")) {
-    char cmd[9000];
-    snprintf(cmd, sizeof cmd, "gnuplot '%s' 1>&2", gp);
-    have_png = system(cmd) == 0;
-  }
+  if (plot) ex_plot(gp, png, rdat, json ? stderr : stdout);
   if (json) {
-    if (have_png) fprintf(stderr, "plot: %s\n", png);
     printf("{\"h\":");
     json_array(kH, NH);
     printf(",\"fem\":{\"L2\":");
@@ -358,7 +353,7 @@ int main(int argc, char **argv) {
       if (i) printf("%6.2f %6.2f\n", rml[i - 1], rmh[i - 1]);
       else printf("%6s %6s\n", "-", "-");
     }
-    printf("\nu' at h = %g: %s\n", kH[PLOT_LEVEL], have_png ? png : dat);
+    printf("\nu' at h = %g: %s; errors: %s\n", kH[PLOT_LEVEL], dat, rdat);
   }
   mfree_context_destroy(&ctx);
   return 0;

@@ -13,7 +13,8 @@
  *    Gauss points (004 Sect. 2.2).
  * Errors: L2 and the H1 semi-norm (MPFEM gradient by eq 21 and by eq 22), 5 x 5 Gauss.
  *
- * Usage: mfree_mpfem_2d [--json]
+ * Usage: mfree_mpfem_2d [--json] [--out DIR] [--no-plot]; DIR/mpfem_2d.dat holds the errors
+ * and DIR/mpfem_2d.png plots them (gnuplot on PATH).
  * Output: a table with rates, or one JSON object
  *   {"n":[...],"quad4":{"fem":{"L2":[...],"H1":[...]},"mpfem":{"L2":[...],"H1":[...],
  *    "H1_22":[...]}},"tri3":{...}}
@@ -25,6 +26,8 @@
 
 #include <mfree.h>
 #include <mfree_suitesparse.h>
+
+#include "util.h"
 
 #define NL 3
 static const int32_t kN[NL] = {8, 16, 32};
@@ -171,12 +174,57 @@ static void json_array(const err_t *e, int which) {
 
 static double rate(double a, double b) { return log(a / b) / log(2.0); }
 
+/* The errors per mesh as DIR/mpfem_2d.dat (n, 1/n, then per element type FEM L2, H1 and
+ * MPFEM L2, H1 (eq 21), H1 (eq 22)) and a log-log plot of them. Returns 0, or 1 when a
+ * file cannot be written. */
+static int plot_rates(const char *out, int plot, err_t fe[2][NL], err_t mp[2][NL], FILE *msg) {
+  char dat[4200], gp[4200], png[4200];
+  ex_join(dat, sizeof dat, out, "mpfem_2d.dat");
+  ex_join(gp, sizeof gp, out, "mpfem_2d.gp");
+  ex_join(png, sizeof png, out, "mpfem_2d.png");
+  FILE *f = ex_plot_path_ok(dat) ? fopen(dat, "w") : NULL;
+  FILE *g = f ? fopen(gp, "w") : NULL;
+  if (!f || !g) {
+    fprintf(stderr, "error: cannot write %s\n", f ? gp : dat);
+    if (f) fclose(f);
+    return 1;
+  }
+  fprintf(f, "# MPFEM 2D Poisson: n 1/n, then QUAD4 and TRI3: FEM_L2 FEM_H1 MPFEM_L2 MPFEM_H1(21) MPFEM_H1(22)\n");
+  for (int i = 0; i < NL; ++i) {
+    fprintf(f, "%d %.6e", kN[i], 1.0 / kN[i]);
+    for (int t = 0; t < 2; ++t)
+      fprintf(f, " %.6e %.6e %.6e %.6e %.6e", fe[t][i].L2, fe[t][i].H1, mp[t][i].L2, mp[t][i].H1, mp[t][i].H1_22);
+    fprintf(f, "\n");
+  }
+  fclose(f);
+  fprintf(g, "# gnuplot script written by mfree_mpfem_2d\n"
+             "set terminal pngcairo size 1400,560\nset output '%s'\nset multiplot layout 1,2 "
+             "title 'MPFEM (Hao, Liu and Belytschko 2004) and FEM on -lap u = f: errors against 1/n'\n"
+             "set logscale xy\nset format y '10^{%%L}'\nset xlabel '1/n'\nset ylabel 'error'\n"
+             "set key bottom right\nset grid\n", png);
+  static const char *const mesh[2] = {"QUAD4", "TRI3"};
+  for (int t = 0; t < 2; ++t) {
+    const int c = 3 + 5 * t;
+    fprintf(g, "set title '%s'\nplot '%s' u 2:%d w lp t 'FEM L2', '' u 2:%d w lp t 'FEM H1', "
+               "'' u 2:%d w lp lw 2 t 'MPFEM L2', '' u 2:%d w lp lw 2 t 'MPFEM H1 (eq 21)', "
+               "'' u 2:%d w lp dt 2 t 'MPFEM H1 (eq 22)'\n",
+            mesh[t], dat, c, c + 1, c + 2, c + 3, c + 4);
+  }
+  fprintf(g, "unset multiplot\n");
+  fclose(g);
+  if (plot) ex_plot(gp, png, dat, msg);
+  return 0;
+}
+
 int main(int argc, char **argv) {
-  int json = 0;
+  int json = 0, plot = 1;
+  const char *out = ".";
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--json") == 0) json = 1;
+    else if (strcmp(argv[i], "--no-plot") == 0) plot = 0;
+    else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) out = argv[++i];
     else {
-      fprintf(stderr, "usage: mfree_mpfem_2d [--json]\n");
+      fprintf(stderr, "usage: mfree_mpfem_2d [--json] [--out DIR] [--no-plot]\n");
       return 2;
     }
   }
@@ -189,6 +237,7 @@ int main(int argc, char **argv) {
       solve(kN[i], t, hk[t], &mp[t][i]);
     }
   const char *name[2] = {"quad4", "tri3"};
+  if (plot_rates(out, plot, fe, mp, json ? stderr : stdout)) return 1;
   if (json) {
     printf("{\"n\":[%d,%d,%d]", kN[0], kN[1], kN[2]);
     for (int t = 0; t < 2; ++t) {

@@ -51,7 +51,7 @@
  *
  * Output: a table (default) or one JSON object (--json) on stdout; with --out DIR the
  * profiles along the x_2 axis (the paper's Figs. 12, 14, 15) go to
- * DIR/plate_collocation.dat.
+ * DIR/plate_collocation.dat, plotted to DIR/plate_collocation.png (gnuplot on PATH).
  */
 #include <math.h>
 #include <stdio.h>
@@ -59,6 +59,7 @@
 #include <string.h>
 
 #include "plate.h"
+#include "util.h"
 
 #define NRES_MAX 8
 #define NM 2
@@ -192,11 +193,9 @@ static void json_run(const plate_result_t *r) {
   printf("}}");
 }
 
-static int write_profiles(const options_t *o, int nres, plate_result_t res[][NM]) {
+static int write_profiles(const options_t *o, int nres, plate_result_t res[][NM], FILE *msg) {
   char path[4200];
-  const size_t len = strlen(o->out);
-  snprintf(path, sizeof path, "%s%splate_collocation.dat", o->out,
-           (len && o->out[len - 1] == '/') ? "" : "/");
+  ex_join(path, sizeof path, o->out, "plate_collocation.dat");
   FILE *f = fopen(path, "w");
   if (!f) {
     fprintf(stderr, "error: cannot write %s\n", path);
@@ -217,6 +216,24 @@ static int write_profiles(const options_t *o, int nres, plate_result_t res[][NM]
     return 1;
   }
   fprintf(stderr, "wrote %s\n", path);
+  /* plot: the finest resolution's profiles against the exact solution */
+  char gp[4200], png[4200];
+  ex_join(gp, sizeof gp, o->out, "plate_collocation.gp");
+  ex_join(png, sizeof png, o->out, "plate_collocation.png");
+  FILE *g = ex_plot_path_ok(path) ? fopen(gp, "w") : NULL;
+  if (!g) return 0;
+  fprintf(g, "# gnuplot script written by mfree_plate_collocation (paper 001 Sect. 6.3)\n"
+             "set terminal pngcairo size 1400,560\nset output '%s'\nset multiplot layout 1,2 "
+             "title 'Plate with a hole, %d particles: SSPH and MSPH collocation against Kirsch'\n"
+             "set xlabel 'x_2'\nset key top right\nset grid\n"
+             "set title 'u_2 along x_1 = 0'\nplot '%s' index %d u 1:2 w l lw 2 t 'exact', "
+             "'' index %d u 1:3 w lp pt 7 ps 0.5 t 'SSPH', '' index %d u 1:4 w lp pt 6 ps 0.5 t 'MSPH'\n"
+             "set title 'sigma_{11} along x_1 = 0'\nplot '%s' index %d u 1:5 w l lw 2 t 'exact', "
+             "'' index %d u 1:6 w lp pt 7 ps 0.5 t 'SSPH', '' index %d u 1:7 w lp pt 6 ps 0.5 t 'MSPH'\n"
+             "unset multiplot\n",
+          png, res[nres - 1][0].n, path, nres - 1, nres - 1, nres - 1, path, nres - 1, nres - 1, nres - 1);
+  fclose(g);
+  ex_plot(gp, png, path, msg);
   return 0;
 }
 
@@ -282,7 +299,7 @@ int main(int argc, char **argv) {
     }
   }
   mfree_context_destroy(&ctx);
-  if (!status && opt.out) status = write_profiles(&opt, opt.nres, res);
+  if (!status && opt.out) status = write_profiles(&opt, opt.nres, res, json ? stderr : stdout);
 
   if (!status && json) {
     printf("{\"problem\":{\"a\":%.6g,\"b\":%.6g,\"E\":%.6g,\"nu\":%.6g,\"sigma0\":%.6g,"

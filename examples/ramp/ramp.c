@@ -31,6 +31,7 @@
 #include <unistd.h>
 
 #include "fluid_common.h"
+#include "util.h"
 
 static const double kG = 9.81, kRho0 = 1000.0, kGamma = 7.0, kH = 0.1, kSlope = 0.5, kDrop = 0.3,
                     kEnd = 1.0;
@@ -129,7 +130,8 @@ int main(int argc, char **argv) {
     if (!pvd) return 1;
     fprintf(pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
   }
-  fc_progress_t prog = {quiet || json, -1, 0.0, t_end};
+  ex_progress_t prog;
+  ex_progress_init(&prog, quiet || json, 0.0, t_end);
   double t = 0.0;
   int64_t steps = 0;
   int nvtu = 0;
@@ -140,13 +142,14 @@ int main(int argc, char **argv) {
   while (t < t_end && run == MFREE_SUCCESS) {
     const double target = vtu_dt > 0 ? fmin(t_end, (nvtu)*vtu_dt) : t_end;
     int64_t ns = 0;
-    run = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, target, cfl, 0.0, fc_progress, &prog, &ns);
+    run = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, target, cfl, 0.0, ex_progress, &prog, &ns);
     steps += ns;
+    ex_progress_steps(&prog, ns);
     if (pvd && fc_snapshot(sys, out, "ramp", nvtu++, t, n, y, NULL, pvd)) return 1;
   }
   clock_gettime(CLOCK_MONOTONIC, &c1);
   const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
-  if (!prog.quiet) fprintf(stderr, "\n");
+  ex_progress_done(&prog, "mfree_ramp", t);
   if (pvd) {
     fprintf(pvd, "</Collection>\n</VTKFile>\n");
     fclose(pvd);

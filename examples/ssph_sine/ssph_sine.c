@@ -25,9 +25,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "papers.h"
+#include "util.h"
 
 #define NN 7
 #define NM 3
@@ -74,38 +74,13 @@ static int parse_extra(int argc, char **argv, int *i, void *user) {
 
 static const char *edge_name(int e) { return e > 0 ? "include" : (e < 0 ? "exclude" : "as-is"); }
 
-/* Is an executable called name on PATH? */
-static int on_path(const char *name) {
-  const char *path = getenv("PATH");
-  if (!path) return 0;
-  char dir[4096];
-  while (*path) {
-    size_t len = strcspn(path, ":");
-    if (len > 0 && len < sizeof dir - 64) {
-      memcpy(dir, path, len);
-      dir[len] = '\0';
-      char full[4200];
-      snprintf(full, sizeof full, "%s/%s", dir, name);
-      if (access(full, X_OK) == 0) return 1;
-    }
-    path += len;
-    if (*path == ':') ++path;
-  }
-  return 0;
-}
-
-static void join(char *dst, size_t size, const char *dir, const char *file) {
-  const size_t n = strlen(dir);
-  snprintf(dst, size, "%s%s%s", dir, (n && dir[n - 1] == '/') ? "" : "/", file);
-}
-
 /* Writes the data file and the gnuplot script; returns 0 or 1 (message on stderr). */
 static int write_files(const options_t *o, double e[NM][NN][3], char *dat, char *gp,
                        char *png, size_t size) {
-  join(dat, size, o->out_dir, "ssph_sine.dat");
-  join(gp, size, o->out_dir, "ssph_sine.gp");
-  join(png, size, o->out_dir, "ssph_sine.png");
-  if (strchr(o->out_dir, '\'') || strchr(o->out_dir, '"')) {
+  ex_join(dat, size, o->out_dir, "ssph_sine.dat");
+  ex_join(gp, size, o->out_dir, "ssph_sine.gp");
+  ex_join(png, size, o->out_dir, "ssph_sine.png");
+  if (!ex_plot_path_ok(o->out_dir)) {
     fprintf(stderr, "error: --out directory must not contain quotes\n");
     return 1;
   }
@@ -154,15 +129,6 @@ static int write_files(const options_t *o, double e[NM][NN][3], char *dat, char 
   return 0;
 }
 
-/* Runs gnuplot on the script (its output goes to stderr); returns 1 if a PNG was made. */
-static int run_gnuplot(const char *gp) {
-  char cmd[4400];
-  snprintf(cmd, sizeof cmd, "gnuplot '%s' 1>&2", gp);
-  FILE *p = popen(cmd, "r");
-  if (!p) return 0;
-  return pclose(p) == 0;
-}
-
 static void json_triple(const double v[3]) {
   printf("{\"e0\":%.10e,\"e1\":%.10e,\"e2\":%.10e}", v[0], v[1], v[2]);
 }
@@ -205,14 +171,8 @@ int main(int argc, char **argv) {
 
   char dat[4200], gp[4200], png[4200];
   if (write_files(&opt, e, dat, gp, png, sizeof dat)) return 1;
-  int have_png = 0;
-  const int have_gnuplot = on_path("gnuplot");
-  if (opt.plot && have_gnuplot) {
-    have_png = run_gnuplot(gp);
-    if (!have_png) fprintf(stderr, "warning: gnuplot failed on %s; no plot made\n", gp);
-  }
-
   if (json) {
+    const int have_png = opt.plot && ex_plot(gp, png, dat, stderr);
     printf("{\"edge\":\"%s\",\"N\":[", edge_name(opt.edge));
     for (int k = 0; k < NN; ++k) printf("%s%d", k ? "," : "", kN[k]);
     printf("],\"table1\":{");
@@ -283,8 +243,7 @@ int main(int argc, char **argv) {
          "neighbours at exactly 2h (i +- 3) count (try --edge include / exclude); the paper's\n"
          "MSPH/RKPM numbers match neither convention to the printed digits.\n\n");
   printf("data: %s\nscript: %s\n", dat, gp);
-  if (have_png) printf("plot: %s\n", png);
-  else if (!opt.plot) printf("plot: not made (--no-plot); run gnuplot %s\n", gp);
-  else if (!have_gnuplot) printf("plot: gnuplot is not on PATH; data are in %s\n", dat);
+  if (opt.plot) ex_plot(gp, png, dat, stdout);
+  else printf("plot: not made (--no-plot); run gnuplot %s\n", gp);
   return 0;
 }

@@ -1,11 +1,13 @@
 # examples/gravity_current --json (paper 003 Sect. 7.3: lock exchange of fluids of 1000
 # and 1500 kg/m3 in a tank of depth D = 0.06 m): the run ends without a failure, the mass
 # is exact, and the head speed lies within 15 % of Rottman & Simpson's 0.4 (g D drho /
-# rho0)^(1/2) = 0.217 m/s (003 eq 126; the paper reports about 0.2 m/s).
+# rho0)^(1/2) = 0.217 m/s (003 eq 126; the paper reports about 0.2 m/s); the plot of the
+# head's travel is written when gnuplot is installed.
 # Usage: cmake -DEXE=<mfree_gravity_current> -DOUT=<dir> -DNZ=<n> -P check_gravity_current.cmake
 cmake_minimum_required(VERSION 3.20)
 include(${CMAKE_CURRENT_LIST_DIR}/../examples/json_checks.cmake)
 file(MAKE_DIRECTORY ${OUT})
+file(REMOVE ${OUT}/head.png)
 run_json(j --json --quiet --nz ${NZ} --vtu-every 0.1 --out ${OUT})
 string(JSON status GET "${j}" status)
 string(JSON speed GET "${j}" head_speed)
@@ -19,4 +21,5 @@ expect_range(${dev} -0.15 0.15 "paper 003 Sect. 7.3, eq 126: head speed within 1
 if(NOT EXISTS ${OUT}/head.csv OR NOT EXISTS ${OUT}/gravity_current.pvd)
   message(SEND_ERROR "examples/gravity_current did not write head.csv and its VTU series")
 endif()
+expect_plot(${OUT}/head.png)
 message(STATUS "gravity current (nz = ${NZ}): head speed ${speed} m/s, ${dev} from 0.217 m/s")

@@ -4,7 +4,10 @@
 # Usage: cmake -DEXE=<mfree_kernels> -DOUT=<dir> -P check_kernels.cmake
 cmake_minimum_required(VERSION 3.20)
 include(${CMAKE_CURRENT_LIST_DIR}/json_checks.cmake)
-run_json(j --json)
+file(MAKE_DIRECTORY ${OUT})
+file(REMOVE ${OUT}/kernels.png)
+run_json(j --json --out ${OUT})
+expect_plot(${OUT}/kernels.png)
 string(JSON nt LENGTH "${j}" tables)
 expect_equal(${nt} 4 "001 Tables 3, 4, 5 (two smoothing lengths)")
 math(EXPR last "${nt} - 1")

@@ -1,0 +1,96 @@
+/* Plots and progress for the examples (util.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "util.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static int on_path(const char *name) {
+  const char *path = getenv("PATH");
+  if (!path) return 0;
+  char buf[4096];
+  for (const char *p = path; *p;) {
+    const char *e = strchr(p, ':');
+    const size_t len = e ? (size_t)(e - p) : strlen(p);
+    if (len > 0 && len + strlen(name) + 2 < sizeof buf) {
+      memcpy(buf, p, len);
+      buf[len] = '/';
+      strcpy(buf + len + 1, name);
+      if (access(buf, X_OK) == 0) return 1;
+    }
+    if (!e) break;
+    p = e + 1;
+  }
+  return 0;
+}
+
+int ex_plot_available(void) {
+  const char *off = getenv("MFREE_NO_PLOT");
+  if (off && *off && strcmp(off, "0") != 0) return 0;
+  return on_path("gnuplot");
+}
+
+int ex_plot_path_ok(const char *path) { return !strchr(path, '\'') && !strchr(path, '"'); }
+
+void ex_join(char *dst, size_t size, const char *dir, const char *file) {
+  const size_t n = strlen(dir);
+  snprintf(dst, size, "%s%s%s", dir, (n && dir[n - 1] == '/') ? "" : "/", file);
+}
+
+int ex_plot(const char *script, const char *png, const char *data, FILE *msg) {
+  if (!ex_plot_available()) {
+    fprintf(msg, "no plot: gnuplot is not installed (scripts/deps.sh installs gnuplot-nox); "
+                 "data in %s, script in %s\n", data, script);
+    return 0;
+  }
+  if (!ex_plot_path_ok(script)) {
+    fprintf(msg, "no plot: the path %s contains a quote\n", script);
+    return 0;
+  }
+  char cmd[4200];
+  snprintf(cmd, sizeof cmd, "gnuplot '%s' > /dev/null 2>&1", script);
+  fflush(NULL);
+  const int rc = system(cmd);
+  if (rc != 0 || access(png, R_OK) != 0) {
+    fprintf(msg, "no plot: gnuplot failed on %s; data in %s\n", script, data);
+    return 0;
+  }
+  fprintf(msg, "plot: %s\n", png);
+  return 1;
+}
+
+void ex_progress_init(ex_progress_t *p, int quiet, double t0, double t1) {
+  p->quiet = quiet;
+  p->tty = isatty(fileno(stderr));
+  p->last = -1;
+  p->t0 = t0;
+  p->t1 = t1;
+  p->base = 0;
+}
+
+int32_t ex_progress(void *user, int64_t step, double t, double dt) {
+  ex_progress_t *p = user;
+  (void)dt;
+  if (p->quiet || !p->tty) return 0;
+  int pct = p->t1 > p->t0 ? (int)(100.0 * (t - p->t0) / (p->t1 - p->t0)) : 100;
+  if (pct > 100) pct = 100;
+  if (pct != p->last) {
+    p->last = pct;
+    const int w = 40, fill = pct * w / 100;
+    fprintf(stderr, "\r[%.*s%*s] %3d%%  t = %.4g s  step %lld", fill,
+            "########################################", w - fill, "", pct, t,
+            (long long)(p->base + step));
+    fflush(stderr);
+  }
+  return 0;
+}
+
+void ex_progress_steps(ex_progress_t *p, int64_t steps) { p->base += steps; }
+
+void ex_progress_done(ex_progress_t *p, const char *what, double t) {
+  if (p->quiet) return;
+  if (p->tty && p->last >= 0) fprintf(stderr, "\n");
+  else fprintf(stderr, "%s: integrated to t = %.4g s in %lld steps\n", what, t, (long long)p->base);
+}

@@ -1,0 +1,48 @@
+/* Helpers shared by the examples: plots and progress.
+ *
+ * Plots. An example writes its data (CSV or .dat) and a gnuplot script next to it, then
+ * calls ex_plot, which runs gnuplot when it is on PATH and says where the PNG is, or says
+ * that there is no plot and where the data are. Plotting is optional: without gnuplot (or
+ * with MFREE_NO_PLOT=1 in the environment) the example still succeeds.
+ *
+ * Progress. ex_progress is an mfree_progress_fn that draws a bar on stderr when stderr is
+ * a terminal; otherwise (a log, a pipe, a test) it stays silent and ex_progress_done
+ * prints one summary line. */
+#ifndef MFREE_EXAMPLES_UTIL_H
+#define MFREE_EXAMPLES_UTIL_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+/* 1 when gnuplot is on PATH and MFREE_NO_PLOT is not set to a nonzero value. */
+int ex_plot_available(void);
+
+/* Run gnuplot on the script, which writes png. Reports on msg (stdout, or stderr when
+ * stdout carries JSON): "plot: <png>" on success; else why there is no plot and that the
+ * data are in data. Returns 1 when the PNG was written, 0 otherwise (never fatal). */
+int ex_plot(const char *script, const char *png, const char *data, FILE *msg);
+
+/* dir/file into dst (size bytes), with one slash between them. */
+void ex_join(char *dst, size_t size, const char *dir, const char *file);
+
+/* 1 when the path can be quoted in a gnuplot script (no quote characters). */
+int ex_plot_path_ok(const char *path);
+
+typedef struct {
+  int quiet;     /* nothing at all */
+  int tty;       /* stderr is a terminal: draw the bar */
+  int last;      /* last percentage drawn */
+  double t0, t1; /* the time span of the whole run */
+  int64_t base;  /* steps of earlier mfree_system_integrate calls */
+} ex_progress_t;
+
+/* Start a run over [t0, t1]. */
+void ex_progress_init(ex_progress_t *p, int quiet, double t0, double t1);
+/* mfree_progress_fn; user = ex_progress_t *. Never stops the integration. */
+int32_t ex_progress(void *user, int64_t step, double t, double dt);
+/* After each mfree_system_integrate call: add the steps it took. */
+void ex_progress_steps(ex_progress_t *p, int64_t steps);
+/* End of the run: ends the bar's line on a terminal, else prints one summary line. */
+void ex_progress_done(ex_progress_t *p, const char *what, double t);
+
+#endif
