@@ -7,6 +7,7 @@
  * order 2 0.65 s; targets 10x faster. The like-for-like rows (2D) build the gradient
  * table only, as Compadre's figure does. Also the bytes per particle held by the set-up
  * approximant, counted through the context's allocator hook.
+ * MFREE_BENCH_ALL_METHODS=1 adds every method's one-thread setup relative to SPH.
  * Usage: bench_shape [n ...]  (default 100000). */
 #include "bench_util.h"
 
@@ -25,6 +26,27 @@ static const method_t kMethods[] = {
     {"KB Method 1", MFREE_METHOD_KB_METHOD1, 0, 0.0},
     {"MLS order 1", MFREE_METHOD_MLS, 1, 0.33},
     {"MLS order 2", MFREE_METHOD_MLS, 2, 0.65},
+    {"SSPH order 2", MFREE_METHOD_SSPH, 2, 0.0},
+};
+
+/* Every method at its default order (and the orders the guide's table names), for the
+ * cost of each relative to plain SPH in the same run: MFREE_BENCH_ALL_METHODS=1. */
+static const method_t kEvery[] = {
+    {"SPH", MFREE_METHOD_SPH, 0, 0.0},
+    {"SPH symmetrised", MFREE_METHOD_SPH_SYMMETRIC, 0, 0.0},
+    {"Shepard", MFREE_METHOD_SHEPARD, 0, 0.0},
+    {"Randles-Libersky", MFREE_METHOD_RANDLES_LIBERSKY, 0, 0.0},
+    {"Johnson-Beissel", MFREE_METHOD_JOHNSON_BEISSEL, 0, 0.0},
+    {"KB Method 1", MFREE_METHOD_KB_METHOD1, 0, 0.0},
+    {"KB Method 2", MFREE_METHOD_KB_METHOD2, 1, 0.0},
+    {"KB Method 3", MFREE_METHOD_KB_METHOD3, 0, 0.0},
+    {"MLS order 1", MFREE_METHOD_MLS, 1, 0.0},
+    {"MLS order 2", MFREE_METHOD_MLS, 2, 0.0},
+    {"RKPM order 1", MFREE_METHOD_RKPM, 1, 0.0},
+    {"RKPM order 2", MFREE_METHOD_RKPM, 2, 0.0},
+    {"MSPH order 1", MFREE_METHOD_MSPH, 1, 0.0},
+    {"MSPH order 2", MFREE_METHOD_MSPH, 2, 0.0},
+    {"SSPH order 1", MFREE_METHOD_SSPH, 1, 0.0},
     {"SSPH order 2", MFREE_METHOD_SSPH, 2, 0.0},
 };
 
@@ -129,6 +151,18 @@ static void run(int dim, double n_target) {
   }
   printf("setup MLS order 1 / Randles-Libersky %.2f, / KB Method 1 %.2f (paper 000 Table IV: >= 2.4)\n",
          t_mls1 / t_cheap[0], t_mls1 / t_cheap[1]);
+  const char *every = getenv("MFREE_BENCH_ALL_METHODS");
+  if (every && atoi(every)) {
+    printf("every method, one thread, value + gradient setup relative to SPH in this run\n");
+    printf("%-18s %10s %10s %9s\n", "method", "setup s", "update s", "x SPH");
+    double t_sph = 0;
+    for (size_t k = 0; k < sizeof kEvery / sizeof kEvery[0]; ++k) {
+      double tsv[2], tuv[2], bytes;
+      time_method(dim, n, x, h, &kEvery[k], vg, 1, tsv, tuv, &bytes);
+      if (k == 0) t_sph = tsv[0];
+      printf("%-18s %10.4f %10.4f %9.2f\n", kEvery[k].name, tsv[0], tuv[0], tsv[0] / t_sph);
+    }
+  }
   if (dim == 2) {
     /* Like for like with Compadre's figure: GMLS gradient weights only (no value table)
      * at points whose neighbour lists are given (the search is not timed, here as there):

@@ -3,10 +3,11 @@
 # are missing (apt-get update runs only then). Works as root or through sudo.
 # Later capabilities add their packages here (gfortran, libsuitesparse-dev,
 # libsundials-dev, ...). abigail-tools: the abidiff check against abi/*.abi (ABI.md);
-# clang: the libFuzzer harness (fuzz/); valgrind: the memory-check label.
+# clang: the libFuzzer harness (fuzz/); valgrind: the memory-check label; doxygen: the
+# API reference and guide (docs target, test t908); gnuplot-nox: the examples' plots.
 set -euo pipefail
 
-MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev abigail-tools clang valgrind libnanoflann-dev"
+MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev abigail-tools clang valgrind libnanoflann-dev doxygen gnuplot-nox"
 
 if ! command -v dpkg-query >/dev/null 2>&1; then
   echo "deps.sh: dpkg-query not found: this script is for Debian/Ubuntu." >&2

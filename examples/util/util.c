@@ -26,11 +26,12 @@ static int on_path(const char *name) {
   return 0;
 }
 
-int ex_plot_available(void) {
+static int plot_off(void) {
   const char *off = getenv("MFREE_NO_PLOT");
-  if (off && *off && strcmp(off, "0") != 0) return 0;
-  return on_path("gnuplot");
+  return off && *off && strcmp(off, "0") != 0;
 }
+
+int ex_plot_available(void) { return !plot_off() && on_path("gnuplot"); }
 
 int ex_plot_path_ok(const char *path) { return !strchr(path, '\'') && !strchr(path, '"'); }
 
@@ -40,6 +41,10 @@ void ex_join(char *dst, size_t size, const char *dir, const char *file) {
 }
 
 int ex_plot(const char *script, const char *png, const char *data, FILE *msg) {
+  if (plot_off()) {
+    fprintf(msg, "no plot (MFREE_NO_PLOT is set); data in %s, script in %s\n", data, script);
+    return 0;
+  }
   if (!ex_plot_available()) {
     fprintf(msg, "no plot: gnuplot is not installed (scripts/deps.sh installs gnuplot-nox); "
                  "data in %s, script in %s\n", data, script);
