@@ -36,16 +36,10 @@ static double pulse(void *user, double t) {
   return t <= kT0 ? 1.0 : 0.0;
 }
 
-static int fail(mfree_context_t *ctx, mfree_status_t st, const char *what) {
-  char msg[1024] = "";
-  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
-  fprintf(stderr, "mfree_bar: %s failed (%s): %s\n", what, mfree_status_string(st), msg);
-  return 1;
-}
-#define CHECK(call)                                          \
-  do {                                                       \
-    const mfree_status_t st_ = (call);                       \
-    if (st_ != MFREE_SUCCESS) return fail(ctx, st_, #call);  \
+#define CHECK(call)                                                         \
+  do {                                                                      \
+    const mfree_status_t st_ = (call);                                      \
+    if (st_ != MFREE_SUCCESS) return ex_fail(ctx, "mfree_bar", st_, #call); \
   } while (0)
 
 static int run(mfree_context_t *ctx, int n, const char *out, int plot, int json) {

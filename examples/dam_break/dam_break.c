@@ -151,16 +151,10 @@ static int write_vtu(const char *path, int n, const double *y, const double *vha
   return fclose(f) != 0;
 }
 
-static int fail(mfree_context_t *ctx, mfree_status_t st, const char *what) {
-  char msg[1024] = "";
-  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
-  fprintf(stderr, "mfree_dam_break: %s failed (%s): %s\n", what, mfree_status_string(st), msg);
-  return 1;
-}
-#define CHECK(call)                                  \
-  do {                                               \
-    const mfree_status_t st_ = (call);               \
-    if (st_ != MFREE_SUCCESS) return fail(ctx, st_, #call); \
+#define CHECK(call)                                                               \
+  do {                                                                            \
+    const mfree_status_t st_ = (call);                                            \
+    if (st_ != MFREE_SUCCESS) return ex_fail(ctx, "mfree_dam_break", st_, #call); \
   } while (0)
 
 int main(int argc, char **argv) {

@@ -85,10 +85,3 @@ int fc_snapshot(mfree_system_t *sys, const char *dir, const char *prefix, int in
   free(p);
   return rc;
 }
-
-int fc_fail(mfree_context_t *ctx, const char *prog, mfree_status_t st, const char *what) {
-  char msg[1024] = "";
-  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
-  fprintf(stderr, "%s: %s failed (%s): %s\n", prog, what, mfree_status_string(st), msg);
-  return 1;
-}

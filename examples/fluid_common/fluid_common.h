@@ -30,7 +30,4 @@ int fc_write_vtu(const char *path, int n, const double *y, const double *vhat, c
 int fc_snapshot(mfree_system_t *sys, const char *dir, const char *prefix, int index, double t, int n,
                 const double *y, const int *tag, FILE *pvd);
 
-/* Print the context's last error for a failed call; returns 1. */
-int fc_fail(mfree_context_t *ctx, const char *prog, mfree_status_t st, const char *what);
-
 #endif

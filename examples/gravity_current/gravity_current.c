@@ -116,7 +116,7 @@ int main(int argc, char **argv) {
   mfree_system_t *sys = NULL;
   mfree_status_t st;
 #define CHECK(call) \
-  if ((st = (call)) != MFREE_SUCCESS) return fc_fail(ctx, "mfree_gravity_current", st, #call)
+  if ((st = (call)) != MFREE_SUCCESS) return ex_fail(ctx, "mfree_gravity_current", st, #call)
   CHECK(mfree_system_create_fluid(ctx, 2, n, &sys));
   CHECK(mfree_system_set_fluid(sys, rho0, 1, kappa, kGamma, mu));
   CHECK(mfree_system_set_masses(sys, m, 1));

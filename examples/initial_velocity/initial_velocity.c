@@ -24,14 +24,10 @@
 #include <mfree.h>
 #include <mfree_suitesparse.h>
 
-static int fail(mfree_context_t *ctx, mfree_status_t st, const char *what) {
-  char msg[1024] = "";
-  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
-  fprintf(stderr, "mfree_initial_velocity: %s failed (%s): %s\n", what, mfree_status_string(st), msg);
-  return 1;
-}
+#include "util.h"
+
 #define CHECK(call) \
-  if ((st = (call)) != MFREE_SUCCESS) return fail(ctx, st, #call)
+  if ((st = (call)) != MFREE_SUCCESS) return ex_fail(ctx, "mfree_initial_velocity", st, #call)
 
 /* max_k |v_hat(x_k) - u(x_k)| over both components */
 static double mismatch(const double *vhat, const double *u, int n) {

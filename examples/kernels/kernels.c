@@ -71,15 +71,7 @@ typedef struct {
 
 static int parse_extra(int argc, char **argv, int *i, void *user) {
   options_t *o = user;
-  if (strcmp(argv[*i], "--out") == 0 && *i + 1 < argc) {
-    o->out_dir = argv[++*i];
-    return 1;
-  }
-  if (strcmp(argv[*i], "--no-plot") == 0) {
-    o->plot = 0;
-    return 1;
-  }
-  return 0;
+  return ex_plot_option(argc, argv, i, &o->out_dir, &o->plot);
 }
 
 /* Table 6's convergence as DIR/kernels_table6.dat (N, Delta, then ||e||_1 of the six

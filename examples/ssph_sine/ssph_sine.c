@@ -53,14 +53,7 @@ typedef struct {
 
 static int parse_extra(int argc, char **argv, int *i, void *user) {
   options_t *o = user;
-  if (strcmp(argv[*i], "--out") == 0 && *i + 1 < argc) {
-    o->out_dir = argv[++*i];
-    return 1;
-  }
-  if (strcmp(argv[*i], "--no-plot") == 0) {
-    o->plot = 0;
-    return 1;
-  }
+  if (ex_plot_option(argc, argv, i, &o->out_dir, &o->plot)) return 1;
   if (strcmp(argv[*i], "--edge") == 0 && *i + 1 < argc) {
     const char *v = argv[++*i];
     if (strcmp(v, "as-is") == 0) o->edge = 0;

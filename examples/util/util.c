@@ -1,4 +1,4 @@
-/* Plots and progress for the examples (util.h). */
+/* Plots, failures and progress for the examples (util.h). */
 #define _POSIX_C_SOURCE 200809L
 #include "util.h"
 
@@ -64,6 +64,25 @@ int ex_plot(const char *script, const char *png, const char *data, FILE *msg) {
   }
   fprintf(msg, "plot: %s\n", png);
   return 1;
+}
+
+int ex_fail(mfree_context_t *ctx, const char *prog, mfree_status_t st, const char *what) {
+  char msg[1024] = "";
+  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  fprintf(stderr, "%s: %s failed (%s): %s\n", prog, what, mfree_status_string(st), msg);
+  return 1;
+}
+
+int ex_plot_option(int argc, char **argv, int *i, const char **out, int *plot) {
+  if (strcmp(argv[*i], "--out") == 0 && *i + 1 < argc) {
+    *out = argv[++*i];
+    return 1;
+  }
+  if (strcmp(argv[*i], "--no-plot") == 0) {
+    *plot = 0;
+    return 1;
+  }
+  return 0;
 }
 
 void ex_progress_init(ex_progress_t *p, int quiet, double t0, double t1) {

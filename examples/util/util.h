@@ -5,6 +5,8 @@
  * that there is no plot and where the data are. Plotting is optional: without gnuplot (or
  * with MFREE_NO_PLOT=1 in the environment) the example still succeeds.
  *
+ * Failures. ex_fail prints the context's message of a failed call.
+ *
  * Progress. ex_progress is an mfree_progress_fn that draws a bar on stderr when stderr is
  * a terminal; otherwise (a log, a pipe, a test) it stays silent and ex_progress_done
  * prints one summary line. */
@@ -13,6 +15,8 @@
 
 #include <stdint.h>
 #include <stdio.h>
+
+#include <mfree.h>
 
 /* 1 when gnuplot is on PATH and MFREE_NO_PLOT is not set to a nonzero value. */
 int ex_plot_available(void);
@@ -27,6 +31,13 @@ void ex_join(char *dst, size_t size, const char *dir, const char *file);
 
 /* 1 when the path can be quoted in a gnuplot script (no quote characters). */
 int ex_plot_path_ok(const char *path);
+
+/* Print ctx's last error for a failed call `what` of program prog; returns 1. */
+int ex_fail(mfree_context_t *ctx, const char *prog, mfree_status_t st, const char *what);
+
+/* The plot options every plotting example takes: --out DIR (sets *out) and --no-plot
+ * (clears *plot). Returns 1 when argv[*i] was one of them (advancing *i past a value). */
+int ex_plot_option(int argc, char **argv, int *i, const char **out, int *plot);
 
 typedef struct {
   int quiet;     /* nothing at all */
