@@ -82,6 +82,8 @@ typedef MFREE_ENUM(mfree_status) {
   MFREE_ERR_UNSUPPORTED = -6, /**< a valid request this method/kernel does not provide */
   MFREE_ERR_INPUT = -7,       /**< invalid values in an input array (NaN/Inf, zero or
                                    negative volume or support, malformed CSR) */
+  MFREE_ERR_HALO = -8,        /**< an owned particle's support reaches past the halo
+                                   width the host declared: its row would miss ghosts */
   MFREE_ERR_INTERNAL = -99,   /**< a bug in mfree; please report it */
 
   /* Positive: data-dependent failure. The call completed what it could and reports
@@ -603,6 +605,44 @@ MFREE_API mfree_status_t mfree_particles_set_neighbors(mfree_particles_t *ps,
                                                        mfree_mem_t mem);
 
 /**
+ * Global ids (optional), one per particle, owned and ghost (a ghost carries the id of the
+ * particle it copies). With ids every neighbour row (searched or the host's), table row
+ * and sum over a row (setup, update, apply) runs in ascending global-id order, so an
+ * owned particle's results depend only on its neighbourhood, never on the local
+ * numbering: split over ranks, it gets the bits of the one-rank run (docs/mpi.md). Rows
+ * of mfree_particles_get_neighbors and mfree_approximant_assemble_csr are then in id
+ * order (columns stay local indices). Without ids (the default) rows are sorted by index.
+ * @param[in] ps   the set
+ * @param[in] ids  n values, >= 0 and unique in the set, or NULL to remove the ids;
+ *                 copied or borrowed (borrowed ids are re-checked at every setup)
+ * @param[in] mem  MFREE_COPY or MFREE_BORROW (else MFREE_ERR_ARG)
+ * @return MFREE_ERR_INPUT for a negative or repeated id (the message names both
+ *         particles; at setup for borrowed ids), nothing changed
+ */
+MFREE_API mfree_status_t mfree_particles_set_global_ids(mfree_particles_t *ps,
+                                                        const int64_t *ids, mfree_mem_t mem);
+
+/** Copy the global ids.
+ * @param[in]  ps   the set
+ * @param[out] ids  n values
+ * @return MFREE_ERR_STATE when the set has no global ids */
+MFREE_API mfree_status_t mfree_particles_get_global_ids(const mfree_particles_t *ps,
+                                                        int64_t *ids);
+
+/**
+ * Declare the halo width: the host promises that every particle within distance w of an
+ * owned particle is in the set (owned or ghost). Particle setup then checks the search
+ * radius kappa h_i of every valid owned particle (with the symmetric conventions, kappa
+ * times the largest support present), approximant setup the kernel support R h, against
+ * w, instead of building rows that silently miss ghosts. The ghosts each method needs:
+ * docs/mpi.md (one support radius for rows at owned particles).
+ * @param[in] ps  the set
+ * @param[in] w   finite and >= 0 (else MFREE_ERR_ARG); 0, the default, checks nothing
+ * @return MFREE_SUCCESS; setups then return MFREE_ERR_HALO naming the particle
+ */
+MFREE_API mfree_status_t mfree_particles_set_halo_width(mfree_particles_t *ps, double w);
+
+/**
  * Validate the particle data and build the neighbour lists (cell-list search, or the
  * host's lists). A particle whose borrowed data are non-finite or out of range is
  * isolated (empty row, listed by no other row) and named by
@@ -644,7 +684,8 @@ MFREE_API mfree_status_t mfree_particles_get_neighbor_nnz(const mfree_particles_
 
 /**
  * Copy the neighbour lists: 0-based CSR, one row per owned particle, each row sorted
- * ascending; searched rows include the particle itself.
+ * ascending (by ascending global id when the set has ids); searched rows include the
+ * particle itself.
  * @param[in]  ps      the set
  * @param[out] rowptr  n_owned + 1 offsets
  * @param[out] cols    nnz column indices (size from mfree_particles_get_neighbor_nnz)

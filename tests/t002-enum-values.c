@@ -11,6 +11,7 @@ static void test_status_values(void **s) {
   assert_int_equal(MFREE_ERR_MISMATCH, -5);
   assert_int_equal(MFREE_ERR_UNSUPPORTED, -6);
   assert_int_equal(MFREE_ERR_INPUT, -7);
+  assert_int_equal(MFREE_ERR_HALO, -8);
   assert_int_equal(MFREE_ERR_INTERNAL, -99);
   assert_int_equal(MFREE_FAIL_NONFINITE, 1);
   assert_int_equal(MFREE_FAIL_INVALID_DATA, 2);

@@ -44,6 +44,7 @@ module mfree
   integer(c_int), parameter, public :: MFREE_ERR_MISMATCH = -5
   integer(c_int), parameter, public :: MFREE_ERR_UNSUPPORTED = -6
   integer(c_int), parameter, public :: MFREE_ERR_INPUT = -7
+  integer(c_int), parameter, public :: MFREE_ERR_HALO = -8
   integer(c_int), parameter, public :: MFREE_ERR_INTERNAL = -99
   integer(c_int), parameter, public :: MFREE_FAIL_NONFINITE = 1
   integer(c_int), parameter, public :: MFREE_FAIL_INVALID_DATA = 2
@@ -429,6 +430,28 @@ module mfree
       integer(c_int32_t), value :: index_base
       integer(c_int), value :: mem
     end function mfree_particles_set_neighbors_c
+
+    integer(c_int) function mfree_particles_set_global_ids_c(ps, ids, mem) &
+        bind(C, name="mfree_particles_set_global_ids")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int64_t), intent(in), target :: ids(*)
+      integer(c_int), value :: mem
+    end function mfree_particles_set_global_ids_c
+
+    integer(c_int) function mfree_particles_get_global_ids_c(ps, ids) &
+        bind(C, name="mfree_particles_get_global_ids")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int64_t), intent(out) :: ids(*)
+    end function mfree_particles_get_global_ids_c
+
+    integer(c_int) function mfree_particles_set_halo_width_c(ps, w) &
+        bind(C, name="mfree_particles_set_halo_width")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), value :: w
+    end function mfree_particles_set_halo_width_c
 
     integer(c_int) function mfree_particles_setup_c(ps) &
         bind(C, name="mfree_particles_setup")
@@ -1256,6 +1279,8 @@ module mfree
   public :: mfree_particles_set_densities_c, mfree_particles_set_support_c
   public :: mfree_particles_set_search_c, mfree_particles_set_periodic_c
   public :: mfree_particles_set_neighbors_c, mfree_particles_setup_c
+  public :: mfree_particles_set_global_ids_c, mfree_particles_get_global_ids_c
+  public :: mfree_particles_set_halo_width_c
   public :: mfree_particles_update_c, mfree_particles_get_dimension_c
   public :: mfree_particles_get_size_c, mfree_particles_get_neighbor_nnz_c
   public :: mfree_particles_get_neighbors_c, mfree_particles_get_volumes_c
@@ -1339,6 +1364,8 @@ module mfree
   public :: mfree_particles_set_masses, mfree_particles_set_densities
   public :: mfree_particles_set_support, mfree_particles_set_search
   public :: mfree_particles_set_periodic, mfree_particles_set_neighbors
+  public :: mfree_particles_set_global_ids, mfree_particles_get_global_ids
+  public :: mfree_particles_set_halo_width
   public :: mfree_particles_setup, mfree_particles_update, mfree_particles_get_dimension
   public :: mfree_particles_get_size, mfree_particles_get_neighbor_nnz
   public :: mfree_particles_get_neighbors, mfree_particles_get_volumes
@@ -1782,6 +1809,27 @@ contains
     integer(c_int), intent(in) :: mem
     st = mfree_particles_set_neighbors_c(ps%ptr, rowptr, cols, index_base, mem)
   end function mfree_particles_set_neighbors
+
+  !> Global ids, one per particle (owned and ghost); borrowed ids need a target that
+  !> outlives the set's setups.
+  integer(c_int) function mfree_particles_set_global_ids(ps, ids, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(in), target :: ids(*)
+    integer(c_int), intent(in) :: mem
+    st = mfree_particles_set_global_ids_c(ps%ptr, ids, mem)
+  end function mfree_particles_set_global_ids
+
+  integer(c_int) function mfree_particles_get_global_ids(ps, ids) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(out) :: ids(*)
+    st = mfree_particles_get_global_ids_c(ps%ptr, ids)
+  end function mfree_particles_get_global_ids
+
+  integer(c_int) function mfree_particles_set_halo_width(ps, w) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in) :: w
+    st = mfree_particles_set_halo_width_c(ps%ptr, w)
+  end function mfree_particles_set_halo_width
 
   integer(c_int) function mfree_particles_setup(ps) result(st)
     type(mfree_particles), intent(in) :: ps

@@ -126,6 +126,30 @@ mfree_status_t mfree_particles_update(mfree_particles_t *ps) {
   });
 }
 
+mfree_status_t mfree_particles_set_global_ids(mfree_particles_t *ps, const int64_t *ids,
+                                              mfree_mem_t mem) {
+  return mfree::with_handle(ps, "mfree_particles_set_global_ids", [&](mfree::ParticleSet &s) {
+    s.set_global_ids(ids, mem);
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_particles_get_global_ids(const mfree_particles_t *ps, int64_t *ids) {
+  return mfree::with_handle(ps, "mfree_particles_get_global_ids", [&](const mfree::ParticleSet &s) {
+    MFREE_REQUIRE(ids || s.size() == 0, MFREE_ERR_NULL, "output pointer is NULL");
+    MFREE_REQUIRE(s.has_global_ids(), MFREE_ERR_STATE, "the particle set has no global ids");
+    std::copy(s.global_ids(), s.global_ids() + s.size(), ids);
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_particles_set_halo_width(mfree_particles_t *ps, double w) {
+  return mfree::with_handle(ps, "mfree_particles_set_halo_width", [&](mfree::ParticleSet &s) {
+    s.set_halo_width(w);
+    return MFREE_SUCCESS;
+  });
+}
+
 mfree_status_t mfree_particles_get_dimension(const mfree_particles_t *ps, int32_t *dim) {
   return mfree::with_handle(ps, "mfree_particles_get_dimension", [&](const mfree::ParticleSet &s) {
     MFREE_REQUIRE(dim, MFREE_ERR_NULL, "output pointer is NULL");

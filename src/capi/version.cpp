@@ -21,6 +21,7 @@ const char *mfree_status_string(mfree_status_t s) {
     case MFREE_ERR_MISMATCH: return "objects or sizes do not match";
     case MFREE_ERR_UNSUPPORTED: return "not supported by this method or kernel";
     case MFREE_ERR_INPUT: return "invalid values in an input array";
+    case MFREE_ERR_HALO: return "a support reaches past the declared halo width";
     case MFREE_ERR_INTERNAL: return "internal error";
     case MFREE_FAIL_NONFINITE: return "non-finite value in data or result";
     case MFREE_FAIL_INVALID_DATA: return "data value out of range";

@@ -354,6 +354,7 @@ void Approximant::build_pattern() {
   int32_t *cl = cols_.data();
   int32_t *self = self_.data();
   int64_t *rp = rowptr_.data();
+  const int64_t *gid = ps_->global_ids();
   const int nt = num_threads(src->nnz());
   parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
     for (int64_t s = b; s < e; ++s) {
@@ -417,6 +418,9 @@ void Approximant::build_pattern() {
       if (me >= 0 && at_self < 0) {  // host lists may omit the particle itself
         at_self = k;
         cl[k++] = me;
+        if (gid)  // in its place by global id
+          for (; at_self > base && gid[cl[at_self - 1]] > gid[me]; --at_self)
+            std::swap(cl[at_self - 1], cl[at_self]);
       }
       self[s] = at_self < 0 ? -1 : static_cast<int32_t>(at_self - base);
       rp[s + 1] = k - base;
@@ -443,6 +447,7 @@ bool Approximant::share_rows(const Csr &src) {
   const int32_t *scl = src.cols.data();
   int32_t *cl = cols_.data(), *self = self_.data();
   int64_t *rp = rowptr_.data();
+  const int64_t *gid = ps_->global_ids();
   // static blocks of sites, each copying its rows and finding the site in them (rows
   // are sorted: a binary search)
   const int nt = num_threads(nnz);
@@ -461,13 +466,22 @@ bool Approximant::share_rows(const Csr &src) {
       const int n = static_cast<int>(srp[s + 1] - srp[s]);
       const int32_t me = static_cast<int32_t>(s);
       int at = 0;
+      if (gid) {  // rows in global-id order
+        const int64_t gme = gid[me];
+        for (int q = 0; q < n; ++q) {
+          const int32_t v = r0[q];
+          out[q] = v;
+          at += gid[v] < gme;
+        }
+      } else {
 #ifdef _OPENMP
 #pragma omp simd reduction(+ : at)
 #endif
-      for (int q = 0; q < n; ++q) {
-        const int32_t v = r0[q];
-        out[q] = v;
-        at += v < me;
+        for (int q = 0; q < n; ++q) {
+          const int32_t v = r0[q];
+          out[q] = v;
+          at += v < me;
+        }
       }
       const bool found = at < n && r0[at] == me;
       self[s] = found ? at : -1;
@@ -669,6 +683,17 @@ Report Approximant::setup() {
     return rep;
   }
   validate_config();
+  if (!points_) {
+    const double R = kernel_->radius();
+    const int conv = ps_->search_convention();
+    double hmax = 0.0;
+    if (conv != MFREE_SEARCH_GATHER && ps_->halo_width() > 0.0)
+      for (int32_t j = 0; j < ps_->size(); ++j)
+        if (ps_->site_status()[j] == 0) hmax = std::max(hmax, ps_->h(j));
+    ps_->check_halo(
+        [&](int32_t i) { return R * (conv == MFREE_SEARCH_GATHER ? ps_->h(i) : std::max(ps_->h(i), hmax)); },
+        "kernel support");
+  }
   pack();
   build_pattern();
   Report rep = compute("setup");

@@ -1656,6 +1656,7 @@ void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &sta
     for (int32_t s = 0; s < npts; ++s) sc.order[start[cell[s]]++] = s;
   }
   run_queries(sc, rule, npts, false, site, out);
+  ps.order_rows_by_id(out);
 }
 
 }  // namespace mfree

@@ -193,6 +193,75 @@ void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int3
   setup_done_ = false;
 }
 
+void ParticleSet::check_global_ids(const int64_t *ids) {
+  // sorted copy (reserved once: a repeated setup with borrowed ids allocates nothing)
+  gid_check_.resize(static_cast<size_t>(n_));
+  for (int32_t i = 0; i < n_; ++i) {
+    if (ids[i] < 0)
+      throw Error(MFREE_ERR_INPUT, "global id of particle " + std::to_string(i) + " is " +
+                                       std::to_string(ids[i]) + " (must be >= 0)");
+    gid_check_[i] = ids[i];
+  }
+  std::sort(gid_check_.begin(), gid_check_.end());
+  const auto dup = std::adjacent_find(gid_check_.begin(), gid_check_.end());
+  if (dup == gid_check_.end()) return;
+  const int64_t v = *dup;
+  int32_t a = -1, b = -1;
+  for (int32_t i = 0; i < n_ && b < 0; ++i)
+    if (ids[i] == v) (a < 0 ? a : b) = i;
+  throw Error(MFREE_ERR_INPUT, "global id " + std::to_string(v) + " is given to particles " +
+                                   std::to_string(a) + " and " + std::to_string(b) +
+                                   " (ids must be unique in the set)");
+}
+
+void ParticleSet::set_global_ids(const int64_t *ids, int mem) {
+  check_mem(mem);
+  if (!ids) {
+    gid_ = nullptr;
+    gid_own_.clear();
+    setup_done_ = false;
+    return;
+  }
+  check_global_ids(ids);
+  if (mem == MFREE_COPY) {
+    std::vector<int64_t> own(ids, ids + n_);
+    if (own.empty()) own.push_back(0);  // keep data() non-NULL: the set has ids
+    gid_own_.swap(own);
+    gid_ = gid_own_.data();
+  } else {
+    gid_own_.clear();
+    gid_ = ids;
+  }
+  setup_done_ = false;
+}
+
+void ParticleSet::set_halo_width(double w) {
+  if (!std::isfinite(w) || w < 0.0)
+    throw Error(MFREE_ERR_ARG, "halo width must be finite and >= 0, got " + std::to_string(w));
+  halo_ = w;
+  setup_done_ = false;
+}
+
+void ParticleSet::order_rows_by_id(Csr &rows) const {
+  if (!gid_) return;
+  const int64_t *g = gid_;
+  const int64_t nrows = static_cast<int64_t>(rows.rowptr.size()) - 1;
+  const int64_t *rp = rows.rowptr.data();
+  int32_t *cl = rows.cols.data();
+  // rows are short and nearly in order already (local numbering often follows the
+  // ids): insertion sort, no allocation, the same result on any thread count
+  parallel_blocks(nrows, num_threads(rows.nnz()), [&](int, int64_t b, int64_t e) {
+    for (int64_t r = b; r < e; ++r)
+      for (int64_t k = rp[r] + 1; k < rp[r + 1]; ++k) {
+        const int32_t v = cl[k];
+        const int64_t gv = g[v];
+        int64_t q = k;
+        for (; q > rp[r] && g[cl[q - 1]] > gv; --q) cl[q] = cl[q - 1];
+        cl[q] = v;
+      }
+  });
+}
+
 Report ParticleSet::validate() {
   Report rep;
   // (zeroed below by the threads, each its block: a serial assign was a pass of its own)
@@ -290,6 +359,17 @@ Report ParticleSet::setup() {
   Report rep = validate();
   Csr out{{}, {}};  // (empty: a search allocates nothing here; host lists fill it below)
   try {
+    // borrowed ids may have changed since they were set
+    if (gid_ && gid_own_.empty()) check_global_ids(gid_);
+    if (!host_neighbors()) {
+      const bool gather = convention_ == MFREE_SEARCH_GATHER;
+      double hmax = 0.0;
+      if (!gather && halo_ > 0.0)
+        for (int32_t j = 0; j < n_; ++j)
+          if (site_status_[j] == 0) hmax = std::max(hmax, h_(j));
+      check_halo([&](int32_t i) { return kappa_ * (gather ? h_(i) : std::max(h_(i), hmax)); },
+                 "search radius");
+    }
     if (host_neighbors()) {
       const int32_t rows = num_owned();
       out.rowptr.assign(static_cast<size_t>(rows) + 1, 0);
@@ -318,6 +398,7 @@ Report ParticleSet::setup() {
     throw;
   }
   if (host_neighbors()) nbr_ = std::move(out);
+  order_rows_by_id(nbr_);
   setup_done_ = true;
   return rep;
 }

@@ -65,6 +65,9 @@ class ParticleSet {
   void set_search(int convention, double kappa);
   void set_periodic(const double *lo, const double *hi, const int32_t *periodic);
   void set_neighbors(const int64_t *rowptr, const int32_t *cols, int32_t base, int mem);
+  // Global ids (NULL: none) and the host's halo width (0: none declared).
+  void set_global_ids(const int64_t *ids, int mem);
+  void set_halo_width(double w);
 
   // Validate (and for a search, rebuild the lists). Negative failures throw.
   Report setup();
@@ -93,6 +96,17 @@ class ParticleSet {
   double box_lo(int c) const { return lo_[c]; }
   double box_hi(int c) const { return hi_[c]; }
   bool host_neighbors() const { return host_rowptr_ != nullptr; }
+  bool has_global_ids() const { return gid_ != nullptr; }
+  const int64_t *global_ids() const { return gid_; }
+  double halo_width() const { return halo_; }
+  // With global ids, each row of rows (columns are particle indices) reordered by
+  // ascending global id, so that every sum over a row runs in one order whatever the
+  // local numbering; without ids rows are left as they are (sorted by index).
+  void order_rows_by_id(Csr &rows) const;
+  // Throws MFREE_ERR_HALO when a declared halo width is narrower than the radius r(s)
+  // that site s of the valid owned particles reaches (what: the radius' name).
+  template <class Radius>
+  void check_halo(Radius r, const char *what) const;
 
   // Displacement x_i - x_j with the nearest image along periodic axes.
   void displacement(int32_t i, int32_t j, double *d) const {
@@ -129,6 +143,13 @@ class ParticleSet {
   std::vector<int64_t> host_rowptr_own_;
   std::vector<int32_t> host_cols_own_;
 
+  // global ids: n values, borrowed or in gid_own_; gid_check_ is the duplicate check's
+  // sorted copy, kept so that a repeated setup with borrowed ids allocates nothing
+  const int64_t *gid_ = nullptr;
+  std::vector<int64_t> gid_own_, gid_check_;
+  void check_global_ids(const int64_t *ids);
+  double halo_ = 0.0;
+
   bool setup_done_ = false;
   Csr nbr_;
   std::vector<int32_t> site_status_;
@@ -139,6 +160,22 @@ class ParticleSet {
   // ones (same sizes: no allocation, no page faults).
   std::unique_ptr<NeighborScratch, NeighborScratchDeleter> scratch_;
 };
+
+template <class Radius>
+void ParticleSet::check_halo(Radius r, const char *what) const {
+  if (halo_ <= 0.0) return;
+  const int32_t no = num_owned();
+  for (int32_t i = 0; i < no; ++i) {
+    if (!site_status_.empty() && site_status_[i] != 0) continue;
+    const double ri = r(i);
+    if (ri > halo_)
+      throw Error(MFREE_ERR_HALO, "owned particle " + std::to_string(i) +
+                                      (gid_ ? " (global id " + std::to_string(gid_[i]) + ")" : std::string()) +
+                                      ": its " + what + " " + std::to_string(ri) +
+                                      " reaches past the declared halo width " + std::to_string(halo_) +
+                                      " (mfree_particles_set_halo_width): rows would miss ghosts");
+  }
+}
 
 // Cell-list search over the valid particles of ps (site_status[i] == 0); fills rows for
 // the owned particles, sorted. Throws Error on a periodic box too small for the supports;
