@@ -29,3 +29,5 @@ write "$build/adapters/suitesparse/libmfree_suitesparse.so" libmfree_suitesparse
       adapters/suitesparse/include include "$build/include"
 write "$build/adapters/sundials/libmfree_sundials.so" libmfree_sundials.abi \
       adapters/sundials/include include "$build/include"
+write "$build/adapters/mpi/libmfree_mpi.so" libmfree_mpi.abi \
+      adapters/mpi/include include "$build/include"

@@ -1,0 +1,127 @@
+/*
+ * mfree_mpi.h -- ghost layers and halo exchange over MPI for mfree particle sets
+ * (libmfree_mpi, pkg-config mfree-mpi, CMake mfree::mfree_mpi).
+ *
+ * For hosts without halo code of their own. Each rank gives its owned particles
+ * (positions, optional global ids) and a halo width; the plan finds the ghosts (every
+ * particle of another rank within the width of this rank's owned particles' bounding
+ * box, a superset of what the halo contract asks), numbers the owned particles globally
+ * when the host has no ids (offsets by an exclusive scan), and exchanges any per-particle
+ * field from owners to ghosts with one MPI neighbourhood collective
+ * (MPI_Neighbor_alltoallv over a graph of the ranks whose boxes are within the width).
+ * Memory per rank is O(owned + ghosts) plus one bounding box per rank.
+ *
+ * Arrays on a rank hold n_owned + n_ghost items: the owned particles first, in the host's
+ * order, then the ghosts in the plan's order (mfree_halo_get_global_ids names them).
+ * Give them to mfree_particles_* with mfree_particles_set_num_ghost(ps, n_ghost) and
+ * mfree_particles_set_global_ids: the owned particles' results are then bitwise those of
+ * a one-rank run.
+ *
+ * Collective calls (create, setup, exchange) must be called by every rank of the
+ * communicator. Their errors are agreed: when one rank fails (bad argument, duplicate
+ * global id anywhere, out of memory), every rank returns the same status and its context
+ * holds a message naming the failing rank and its reason; no rank is left waiting. Only
+ * a NULL handle or context is reported locally (MFREE_ERR_NULL), as it has no
+ * communicator. The core library never calls MPI; this one does.
+ */
+#ifndef MFREE_MPI_H
+#define MFREE_MPI_H
+
+#include <mpi.h>
+#include <stdint.h>
+
+#include "mfree.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32)
+#if defined(MFREE_MPI_BUILDING)
+#define MFREE_MPI_API __declspec(dllexport)
+#else
+#define MFREE_MPI_API
+#endif
+#elif defined(__GNUC__) && __GNUC__ >= 4
+#define MFREE_MPI_API __attribute__((visibility("default")))
+#else
+#define MFREE_MPI_API
+#endif
+
+typedef struct mfree_halo mfree_halo_t;
+
+/**
+ * Create a halo plan on comm (duplicated: the plan's messages never meet the host's).
+ * Collective over comm.
+ * @param[in]  ctx   context for errors (kept alive by the plan)
+ * @param[in]  comm  the ranks sharing the particles
+ * @param[in]  dim   1, 2 or 3
+ * @param[out] halo  the new plan (NULL on failure)
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_create(mfree_context_t *ctx, MPI_Comm comm, int32_t dim,
+                                               mfree_halo_t **halo);
+
+/** mfree_halo_create with a Fortran communicator handle (MPI_Comm_f2c). */
+MFREE_MPI_API mfree_status_t mfree_halo_create_f(mfree_context_t *ctx, int32_t fcomm, int32_t dim,
+                                                 mfree_halo_t **halo);
+
+/** Free a plan (not collective). @param[in,out] halo  may be NULL or point to NULL */
+MFREE_MPI_API mfree_status_t mfree_halo_destroy(mfree_halo_t **halo);
+
+/**
+ * Build (or rebuild, after particles moved) the ghost layer and the exchange plan.
+ * Collective. Buffers are reused from the previous setup when the sizes allow.
+ * @param[in] n_owned  owned particles on this rank (>= 0)
+ * @param[in] x        positions, AoS: particle i, component c at x[i*ld + c] (finite)
+ * @param[in] ld       leading dimension (>= dim)
+ * @param[in] ids      n_owned global ids (>= 0, unique over all ranks), or NULL: the
+ *                     owned particles are numbered offset + i, offset the exclusive
+ *                     scan of n_owned (mfree_halo_get_global_offset). Copied.
+ * @param[in] width    halo width (finite, > 0): at least the largest distance at which
+ *                     a particle of another rank can be a neighbour (kappa times the
+ *                     largest support) plus, for plans kept while particles move, twice
+ *                     the largest displacement before the next setup
+ * @return MFREE_ERR_ARG, MFREE_ERR_INPUT (non-finite position, negative or repeated id:
+ *         the message names the id), MFREE_ERR_ALLOC, MFREE_ERR_INTERNAL (an MPI
+ *         failure); on every rank alike. On failure the previous plan is gone and
+ *         exchange returns MFREE_ERR_STATE until a setup succeeds.
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_setup(mfree_halo_t *halo, int32_t n_owned,
+                                              const double *x, int64_t ld, const int64_t *ids,
+                                              double width);
+
+/** Owned and ghost counts of this rank (after setup); either pointer may be NULL. */
+MFREE_MPI_API mfree_status_t mfree_halo_get_size(const mfree_halo_t *halo, int32_t *n_owned,
+                                                 int32_t *n_ghost);
+
+/** Global ids of the n_owned + n_ghost particles of this rank (after setup).
+ * @param[out] ids  n_owned + n_ghost values */
+MFREE_MPI_API mfree_status_t mfree_halo_get_global_ids(const mfree_halo_t *halo, int64_t *ids);
+
+/** The exclusive scan of the owned counts (this rank's first number when the plan
+ * numbered the particles) and their sum over all ranks; either pointer may be NULL. */
+MFREE_MPI_API mfree_status_t mfree_halo_get_global_offset(const mfree_halo_t *halo,
+                                                          int64_t *offset, int64_t *total);
+
+/** The plan: neighbour ranks, particle copies sent and received per exchange (so one
+ * exchange of ncomp doubles moves 8 ncomp n_send bytes out of this rank); any NULL. */
+MFREE_MPI_API mfree_status_t mfree_halo_get_plan(const mfree_halo_t *halo, int32_t *n_neighbors,
+                                                 int64_t *n_send, int64_t *n_recv);
+
+/**
+ * Forward exchange: the owners' values of a per-particle field written into the ghost
+ * items. Collective; one MPI_Neighbor_alltoallv.
+ * @param[in]     ncomp  components per particle (>= 1)
+ * @param[in,out] field  AoS, n_owned + n_ghost items of ld doubles; items [0, n_owned)
+ *                       are read, items [n_owned, n_owned + n_ghost) written (components
+ *                       [0, ncomp) only)
+ * @param[in]     ld     leading dimension (>= ncomp)
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_exchange(mfree_halo_t *halo, int32_t ncomp, double *field,
+                                                 int64_t ld);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MFREE_MPI_H */

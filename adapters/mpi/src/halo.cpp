@@ -1,0 +1,412 @@
+// libmfree_mpi: ghost layers and forward halo exchange over MPI neighbourhood
+// collectives. Collective calls agree on their status (one MPI_Allreduce of the worst
+// status and its rank, then that rank's message broadcast) before any step that would
+// make the others wait, so that a failure on one rank never leaves another blocked.
+#include "mfree_mpi.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <new>
+#include <string>
+#include <vector>
+
+struct mfree_halo {
+  mfree_context_t *ctx = nullptr;
+  mfree_matrix_t *ctx_ref = nullptr;  // a 0 x 0 matrix: holds a reference on ctx
+  MPI_Comm comm = MPI_COMM_NULL;      // the host's communicator, duplicated
+  MPI_Comm graph = MPI_COMM_NULL;     // neighbour graph of the current plan
+  int rank = 0, size = 1, dim = 0;
+  bool ready = false;
+  int32_t n_owned = 0, n_ghost = 0;
+  int64_t offset = 0, total = 0;
+  std::vector<int> nbrs;                          // neighbour ranks, ascending
+  std::vector<int> scount, sdispl, rcount, rdispl;  // particles per neighbour
+  std::vector<int> sc, sd, rc, rd;                // the same times ncomp (per exchange)
+  std::vector<int32_t> send_idx;                  // owned particles sent, by neighbour
+  std::vector<int64_t> ids;                       // owned then ghost global ids
+  std::vector<double> sbuf, rbuf, boxes;
+};
+
+namespace {
+
+mfree_status_t record(mfree_context_t *ctx, mfree_status_t st, const char *fn,
+                      const std::string &msg) noexcept {
+  try {
+    const std::string text = std::string(fn) + ": " + msg;
+    mfree_context_set_error(ctx, st, text.c_str());
+  } catch (...) {  // no memory for the message: keep at least the code and the function
+    mfree_context_set_error(ctx, st, fn);
+  }
+  return st;
+}
+
+// A local step's outcome: status and message, not yet shared with the other ranks.
+struct Local {
+  mfree_status_t st = MFREE_SUCCESS;
+  std::string msg;
+  void fail(mfree_status_t s, std::string m) {
+    if (st == MFREE_SUCCESS) {
+      st = s;
+      msg = std::move(m);
+    }
+  }
+};
+
+template <class Body>
+Local run_local(Body &&body) noexcept {
+  Local l;
+  try {
+    body(l);
+  } catch (const std::bad_alloc &) {
+    l.st = MFREE_ERR_ALLOC;
+    l.msg = "out of memory";
+  } catch (const std::exception &e) {
+    l.st = MFREE_ERR_INTERNAL;
+    try {
+      l.msg = std::string("internal error: ") + e.what();
+    } catch (...) {
+    }
+  } catch (...) {
+    l.st = MFREE_ERR_INTERNAL;
+  }
+  return l;
+}
+
+// Every rank learns the lowest status of the ranks (the first rank holding it breaks
+// ties) and that rank's message; all return the same status. MPI failures of the
+// agreement itself are internal errors.
+mfree_status_t agree(mfree_halo_t *h, const char *fn, const Local &l) noexcept {
+  struct {
+    int v, r;
+  } in{static_cast<int>(l.st < 0 ? l.st : MFREE_SUCCESS), h->rank}, out{0, 0};
+  if (MPI_Allreduce(&in, &out, 1, MPI_2INT, MPI_MINLOC, h->comm) != MPI_SUCCESS)
+    return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Allreduce failed");
+  if (out.v == MFREE_SUCCESS) return MFREE_SUCCESS;
+  char buf[512] = {0};
+  if (h->rank == out.r) std::snprintf(buf, sizeof buf, "%s", l.msg.c_str());
+  if (MPI_Bcast(buf, static_cast<int>(sizeof buf), MPI_CHAR, out.r, h->comm) != MPI_SUCCESS)
+    return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Bcast failed");
+  buf[sizeof buf - 1] = 0;
+  const mfree_status_t st = static_cast<mfree_status_t>(out.v);
+  try {
+    return record(h->ctx, st, fn, "rank " + std::to_string(out.r) + ": " + buf);
+  } catch (...) {
+    return record(h->ctx, st, fn, "");
+  }
+}
+
+// An MPI call inside a local step: its failure becomes MFREE_ERR_INTERNAL.
+void mpi_ok(Local &l, int rc, const char *what) {
+  if (rc != MPI_SUCCESS) l.fail(MFREE_ERR_INTERNAL, std::string(what) + " failed");
+}
+
+// The rank that checks global id g for duplicates (ids spread by a 64-bit mix).
+int id_owner(int64_t g, int size) {
+  uint64_t z = static_cast<uint64_t>(g) + 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return static_cast<int>(z % static_cast<uint64_t>(size));
+}
+
+bool overlaps(const double *a, const double *b, int dim, double w) {
+  for (int c = 0; c < dim; ++c)
+    if (a[c] - w > b[dim + c] || b[c] > a[dim + c] + w) return false;
+  return true;
+}
+
+void free_graph(mfree_halo_t *h) {
+  if (h->graph != MPI_COMM_NULL) MPI_Comm_free(&h->graph);
+  h->graph = MPI_COMM_NULL;
+}
+
+}  // namespace
+
+extern "C" {
+
+mfree_status_t mfree_halo_create(mfree_context_t *ctx, MPI_Comm comm, int32_t dim, mfree_halo_t **halo) {
+  const char *fn = "mfree_halo_create";
+  if (!ctx) return MFREE_ERR_NULL;
+  if (!halo) return record(ctx, MFREE_ERR_NULL, fn, "output pointer is NULL");
+  *halo = nullptr;
+  if (comm == MPI_COMM_NULL) return record(ctx, MFREE_ERR_ARG, fn, "communicator is MPI_COMM_NULL");
+  mfree_halo_t *h = new (std::nothrow) mfree_halo_t;
+  if (!h) return record(ctx, MFREE_ERR_ALLOC, fn, "out of memory");
+  h->ctx = ctx;
+  h->dim = dim;
+  if (MPI_Comm_dup(comm, &h->comm) != MPI_SUCCESS) {
+    delete h;
+    return record(ctx, MFREE_ERR_INTERNAL, fn, "MPI_Comm_dup failed");
+  }
+  MPI_Comm_set_errhandler(h->comm, MPI_ERRORS_RETURN);
+  MPI_Comm_rank(h->comm, &h->rank);
+  MPI_Comm_size(h->comm, &h->size);
+  Local l = run_local([&](Local &r) {
+    if (dim < 1 || dim > 3) r.fail(MFREE_ERR_ARG, "dimension " + std::to_string(dim) + " is not 1, 2 or 3");
+  });
+  if (l.st == MFREE_SUCCESS) {
+    // The ABI has no context retain: an empty matrix on ctx keeps it alive for us.
+    int64_t zero = 0;
+    const mfree_status_t st = mfree_matrix_create_csr(ctx, 0, 0, &zero, nullptr, nullptr, &h->ctx_ref);
+    if (st != MFREE_SUCCESS) l.fail(st, "cannot hold the context");
+  }
+  const mfree_status_t st = agree(h, fn, l);
+  if (st != MFREE_SUCCESS) {
+    mfree_halo_destroy(&h);
+    return st;
+  }
+  *halo = h;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_create_f(mfree_context_t *ctx, int32_t fcomm, int32_t dim, mfree_halo_t **halo) {
+  return mfree_halo_create(ctx, MPI_Comm_f2c(static_cast<MPI_Fint>(fcomm)), dim, halo);
+}
+
+mfree_status_t mfree_halo_destroy(mfree_halo_t **halo) {
+  if (!halo || !*halo) return MFREE_SUCCESS;
+  mfree_halo_t *h = *halo;
+  free_graph(h);
+  if (h->comm != MPI_COMM_NULL) MPI_Comm_free(&h->comm);
+  mfree_matrix_t *ref = h->ctx_ref;
+  delete h;
+  mfree_matrix_destroy(&ref);
+  *halo = nullptr;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *x, int64_t ld,
+                                const int64_t *ids, double width) {
+  const char *fn = "mfree_halo_setup";
+  if (!h) return MFREE_ERR_NULL;
+  h->ready = false;
+  const int dim = h->dim;
+  // 1. arguments and this rank's bounding box (empty: lo = +inf, hi = -inf)
+  std::vector<double> box(2 * static_cast<size_t>(dim), 0.0);
+  Local l = run_local([&](Local &r) {
+    if (n_owned < 0) return r.fail(MFREE_ERR_ARG, "n_owned " + std::to_string(n_owned) + " is negative");
+    if (ld < dim) return r.fail(MFREE_ERR_ARG, "leading dimension " + std::to_string(ld) + " is below dim");
+    if (!std::isfinite(width) || width <= 0.0)
+      return r.fail(MFREE_ERR_ARG, "halo width must be finite and > 0, got " + std::to_string(width));
+    if (n_owned > 0 && !x) return r.fail(MFREE_ERR_NULL, "positions pointer is NULL");
+    for (int c = 0; c < dim; ++c) {
+      box[c] = std::numeric_limits<double>::infinity();
+      box[dim + c] = -std::numeric_limits<double>::infinity();
+    }
+    for (int32_t i = 0; i < n_owned; ++i)
+      for (int c = 0; c < dim; ++c) {
+        const double v = x[i * ld + c];
+        if (!std::isfinite(v))
+          return r.fail(MFREE_ERR_INPUT, "position of particle " + std::to_string(i) + ", component " +
+                                             std::to_string(c) + " is not finite");
+        box[c] = std::min(box[c], v);
+        box[dim + c] = std::max(box[dim + c], v);
+      }
+    if (ids)
+      for (int32_t i = 0; i < n_owned; ++i)
+        if (ids[i] < 0)
+          return r.fail(MFREE_ERR_INPUT, "global id of particle " + std::to_string(i) + " is " +
+                                             std::to_string(ids[i]) + " (must be >= 0)");
+  });
+  mfree_status_t st = agree(h, fn, l);
+  if (st != MFREE_SUCCESS) return st;
+
+  // 2. global numbering, every rank's box, and the duplicate-id check: each id is sent to
+  // the rank id_owner(id), which finds repeats among what it receives
+  l = run_local([&](Local &r) {
+    int64_t n = n_owned, off = 0, tot = 0;
+    mpi_ok(r, MPI_Exscan(&n, &off, 1, MPI_INT64_T, MPI_SUM, h->comm), "MPI_Exscan");
+    if (h->rank == 0) off = 0;  // (undefined on rank 0)
+    mpi_ok(r, MPI_Allreduce(&n, &tot, 1, MPI_INT64_T, MPI_SUM, h->comm), "MPI_Allreduce");
+    h->offset = off;
+    h->total = tot;
+    h->boxes.resize(2 * static_cast<size_t>(dim) * h->size);
+    mpi_ok(r, MPI_Allgather(box.data(), 2 * dim, MPI_DOUBLE, h->boxes.data(), 2 * dim, MPI_DOUBLE, h->comm),
+           "MPI_Allgather");
+    h->ids.resize(static_cast<size_t>(n_owned));
+    for (int32_t i = 0; i < n_owned; ++i) h->ids[i] = ids ? ids[i] : off + i;
+    if (!ids) return;  // numbered here: unique by construction
+    std::vector<int> cnt(h->size, 0), rcnt(h->size, 0), sdis(h->size, 0), rdis(h->size, 0);
+    for (int32_t i = 0; i < n_owned; ++i) ++cnt[id_owner(ids[i], h->size)];
+    mpi_ok(r, MPI_Alltoall(cnt.data(), 1, MPI_INT, rcnt.data(), 1, MPI_INT, h->comm), "MPI_Alltoall");
+    for (int p = 1; p < h->size; ++p) {
+      sdis[p] = sdis[p - 1] + cnt[p - 1];
+      rdis[p] = rdis[p - 1] + rcnt[p - 1];
+    }
+    const size_t nr = static_cast<size_t>(rdis[h->size - 1]) + rcnt[h->size - 1];
+    std::vector<int64_t> out(static_cast<size_t>(n_owned)), in(nr);
+    std::vector<int> pos(sdis);
+    for (int32_t i = 0; i < n_owned; ++i) out[pos[id_owner(ids[i], h->size)]++] = ids[i];
+    mpi_ok(r, MPI_Alltoallv(out.data(), cnt.data(), sdis.data(), MPI_INT64_T, in.data(), rcnt.data(),
+                            rdis.data(), MPI_INT64_T, h->comm),
+           "MPI_Alltoallv");
+    if (r.st) return;
+    // (id, sending rank) pairs sorted: a repeat is two neighbours with one id
+    std::vector<std::pair<int64_t, int>> all(nr);
+    for (int p = 0; p < h->size; ++p)
+      for (int k = 0; k < rcnt[p]; ++k) all[rdis[p] + k] = {in[rdis[p] + k], p};
+    std::sort(all.begin(), all.end());
+    for (size_t k = 1; k < nr; ++k)
+      if (all[k].first == all[k - 1].first)
+        return r.fail(MFREE_ERR_INPUT, "global id " + std::to_string(all[k].first) +
+                                           " is given to particles of ranks " + std::to_string(all[k - 1].second) +
+                                           " and " + std::to_string(all[k].second) +
+                                           " (ids must be unique over all ranks)");
+  });
+  st = agree(h, fn, l);
+  if (st != MFREE_SUCCESS) return st;
+
+  // 3. neighbours (ranks whose boxes lie within the width: a symmetric relation, so both
+  // sides list each other) and what to send them: the owned particles within the width
+  // of their box
+  l = run_local([&](Local &r) {
+    free_graph(h);
+    h->nbrs.clear();
+    const double *me = box.data();
+    for (int p = 0; p < h->size; ++p)
+      if (p != h->rank && overlaps(me, &h->boxes[2 * static_cast<size_t>(dim) * p], dim, width))
+        h->nbrs.push_back(p);
+    const int k = static_cast<int>(h->nbrs.size());
+    h->scount.assign(k, 0);
+    h->sdispl.assign(k, 0);
+    h->rcount.assign(k, 0);
+    h->rdispl.assign(k, 0);
+    h->send_idx.clear();
+    for (int q = 0; q < k; ++q) {
+      const double *b = &h->boxes[2 * static_cast<size_t>(dim) * h->nbrs[q]];
+      h->sdispl[q] = static_cast<int>(h->send_idx.size());
+      for (int32_t i = 0; i < n_owned; ++i) {
+        bool in = true;
+        for (int c = 0; c < dim && in; ++c) {
+          const double v = x[i * ld + c];
+          in = v >= b[c] - width && v <= b[dim + c] + width;
+        }
+        if (in) h->send_idx.push_back(i);
+      }
+      if (h->send_idx.size() > static_cast<size_t>(std::numeric_limits<int>::max()))
+        return r.fail(MFREE_ERR_ARG, "more than 2^31 particle copies to send");
+      h->scount[q] = static_cast<int>(h->send_idx.size()) - h->sdispl[q];
+    }
+    const int *nb = k ? h->nbrs.data() : MPI_UNWEIGHTED;  // (any non-NULL pointer when k = 0)
+    mpi_ok(r, MPI_Dist_graph_create_adjacent(h->comm, k, nb, MPI_UNWEIGHTED, k, nb, MPI_UNWEIGHTED,
+                                             MPI_INFO_NULL, 0, &h->graph),
+           "MPI_Dist_graph_create_adjacent");
+  });
+  st = agree(h, fn, l);
+  if (st != MFREE_SUCCESS) return st;
+
+  // 4. counts and the ghosts' ids through the graph
+  l = run_local([&](Local &r) {
+    MPI_Comm_set_errhandler(h->graph, MPI_ERRORS_RETURN);
+    const int k = static_cast<int>(h->nbrs.size());
+    mpi_ok(r, MPI_Neighbor_alltoall(h->scount.data(), 1, MPI_INT, h->rcount.data(), 1, MPI_INT, h->graph),
+           "MPI_Neighbor_alltoall");
+    if (r.st) return;
+    int64_t ng = 0;
+    for (int q = 0; q < k; ++q) {
+      h->rdispl[q] = static_cast<int>(ng);
+      ng += h->rcount[q];
+    }
+    if (static_cast<int64_t>(n_owned) + ng > std::numeric_limits<int32_t>::max())
+      return r.fail(MFREE_ERR_ARG, "owned plus ghost particles exceed 2^31 - 1");
+    h->n_owned = n_owned;
+    h->n_ghost = static_cast<int32_t>(ng);
+    std::vector<int64_t> sid(h->send_idx.size());
+    for (size_t s = 0; s < sid.size(); ++s) sid[s] = h->ids[h->send_idx[s]];
+    h->ids.resize(static_cast<size_t>(n_owned) + static_cast<size_t>(ng));
+    mpi_ok(r, MPI_Neighbor_alltoallv(sid.data(), h->scount.data(), h->sdispl.data(), MPI_INT64_T,
+                                     h->ids.data() + n_owned, h->rcount.data(), h->rdispl.data(),
+                                     MPI_INT64_T, h->graph),
+           "MPI_Neighbor_alltoallv");
+  });
+  st = agree(h, fn, l);
+  if (st != MFREE_SUCCESS) return st;
+  h->ready = true;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_get_size(const mfree_halo_t *h, int32_t *n_owned, int32_t *n_ghost) {
+  if (!h) return MFREE_ERR_NULL;
+  if (!h->ready) return record(h->ctx, MFREE_ERR_STATE, "mfree_halo_get_size", "the plan is not set up");
+  if (n_owned) *n_owned = h->n_owned;
+  if (n_ghost) *n_ghost = h->n_ghost;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_get_global_ids(const mfree_halo_t *h, int64_t *ids) {
+  const char *fn = "mfree_halo_get_global_ids";
+  if (!h) return MFREE_ERR_NULL;
+  if (!h->ready) return record(h->ctx, MFREE_ERR_STATE, fn, "the plan is not set up");
+  if (!ids && !h->ids.empty()) return record(h->ctx, MFREE_ERR_NULL, fn, "output pointer is NULL");
+  std::copy(h->ids.begin(), h->ids.end(), ids);
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_get_global_offset(const mfree_halo_t *h, int64_t *offset, int64_t *total) {
+  if (!h) return MFREE_ERR_NULL;
+  if (!h->ready) return record(h->ctx, MFREE_ERR_STATE, "mfree_halo_get_global_offset", "the plan is not set up");
+  if (offset) *offset = h->offset;
+  if (total) *total = h->total;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_get_plan(const mfree_halo_t *h, int32_t *n_neighbors, int64_t *n_send,
+                                   int64_t *n_recv) {
+  if (!h) return MFREE_ERR_NULL;
+  if (!h->ready) return record(h->ctx, MFREE_ERR_STATE, "mfree_halo_get_plan", "the plan is not set up");
+  if (n_neighbors) *n_neighbors = static_cast<int32_t>(h->nbrs.size());
+  if (n_send) *n_send = static_cast<int64_t>(h->send_idx.size());
+  if (n_recv) *n_recv = h->n_ghost;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_exchange(mfree_halo_t *h, int32_t ncomp, double *field, int64_t ld) {
+  const char *fn = "mfree_halo_exchange";
+  if (!h) return MFREE_ERR_NULL;
+  // Argument checks are local (no agreement round: one neighbourhood collective per
+  // exchange); every rank must pass the same ncomp.
+  if (!h->ready) return record(h->ctx, MFREE_ERR_STATE, fn, "the plan is not set up");
+  if (ncomp < 1) return record(h->ctx, MFREE_ERR_ARG, fn, "ncomp must be >= 1");
+  if (ld < ncomp) return record(h->ctx, MFREE_ERR_ARG, fn, "leading dimension is below ncomp");
+  if (!field && h->n_owned + h->n_ghost > 0) return record(h->ctx, MFREE_ERR_NULL, fn, "field is NULL");
+  try {
+    const size_t k = h->nbrs.size();
+    const int64_t biggest = std::max<int64_t>(static_cast<int64_t>(h->send_idx.size()), h->n_ghost) * ncomp;
+    if (biggest > std::numeric_limits<int>::max())
+      return record(h->ctx, MFREE_ERR_ARG, fn, "more than 2^31 doubles in one exchange");
+    h->sc.resize(k);
+    h->sd.resize(k);
+    h->rc.resize(k);
+    h->rd.resize(k);
+    for (size_t q = 0; q < k; ++q) {
+      h->sc[q] = h->scount[q] * ncomp;
+      h->sd[q] = h->sdispl[q] * ncomp;
+      h->rc[q] = h->rcount[q] * ncomp;
+      h->rd[q] = h->rdispl[q] * ncomp;
+    }
+    const size_t ns = h->send_idx.size();
+    h->sbuf.resize(ns * ncomp);
+    for (size_t s = 0; s < ns; ++s)
+      std::memcpy(&h->sbuf[s * ncomp], field + h->send_idx[s] * ld, sizeof(double) * ncomp);
+    // contiguous ghost items are received in place
+    const bool direct = ld == ncomp;
+    double *dst = field ? field + static_cast<int64_t>(h->n_owned) * ld : nullptr;
+    if (!direct) h->rbuf.resize(static_cast<size_t>(h->n_ghost) * ncomp);
+    double *recv = direct ? dst : h->rbuf.data();
+    if (MPI_Neighbor_alltoallv(h->sbuf.data(), h->sc.data(), h->sd.data(), MPI_DOUBLE, recv, h->rc.data(),
+                               h->rd.data(), MPI_DOUBLE, h->graph) != MPI_SUCCESS)
+      return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Neighbor_alltoallv failed");
+    if (!direct)
+      for (int32_t g = 0; g < h->n_ghost; ++g)
+        std::memcpy(dst + g * ld, &h->rbuf[static_cast<size_t>(g) * ncomp], sizeof(double) * ncomp);
+  } catch (const std::bad_alloc &) {
+    return record(h->ctx, MFREE_ERR_ALLOC, fn, "out of memory");
+  }
+  return MFREE_SUCCESS;
+}
+
+}  // extern "C"

@@ -1,0 +1,49 @@
+/* Helpers of the MPI tests (label mpi): a cloud every rank builds alike, its
+ * decompositions, and checks that end every rank with the same verdict. */
+#ifndef MFREE_MPITEST_H
+#define MFREE_MPITEST_H
+
+#include <mpi.h>
+#include <stdint.h>
+
+#include "mfree.h"
+#include "mfree_mpi.h"
+
+#define KAPPA 2.0
+
+/* One failed check on this rank: prints it and counts it; mpitest_finish agrees. */
+extern int mpitest_failures;
+#define CHECK(cond, ...)                                             \
+  do {                                                               \
+    if (!(cond)) {                                                   \
+      int r_;                                                        \
+      MPI_Comm_rank(MPI_COMM_WORLD, &r_);                            \
+      fprintf(stderr, "rank %d, %s:%d: check failed: %s: ", r_, __FILE__, __LINE__, #cond); \
+      fprintf(stderr, __VA_ARGS__);                                  \
+      fprintf(stderr, "\n");                                         \
+      ++mpitest_failures;                                            \
+    }                                                                \
+  } while (0)
+
+/* 0 when no rank failed a check (printed by rank 0), else 1: main's exit code. */
+int mpitest_finish(const char *name);
+
+/* A jittered lattice of m^dim particles on [0,1]^dim, supports varying by +-10 %, volumes
+ * dx^dim +-10 %, global ids 5 + 2 i (not contiguous), the same on every rank. */
+typedef struct {
+  int dim, n;
+  double *x, *h, *v;
+  int64_t *id;
+} cloud_t;
+void cloud_make(cloud_t *c, int dim, int m, uint64_t seed);
+void cloud_free(cloud_t *c);
+double cloud_max_support(const cloud_t *c);
+
+/* part[i] = the rank owning particle i: slab (along x), random (hash of the id), or
+ * Zoltan RCB (collective; returns -1 when Zoltan is not built in). */
+enum { DECOMP_SLAB = 0, DECOMP_RANDOM = 1, DECOMP_RCB = 2 };
+int decompose(const cloud_t *c, int how, MPI_Comm comm, int *part);
+
+uint64_t mpitest_hash(uint64_t z);
+
+#endif

@@ -1,0 +1,261 @@
+/* Corrected gradients on 1-4 ranks bitwise equal to one rank (label mpi).
+ * Every rank builds the same cloud and computes the one-rank reference itself; then the
+ * particles are split (slab along x, random by id, Zoltan RCB), each rank's owned share
+ * in a random order of its own, the ghost layer built by libmfree_mpi (positions,
+ * supports and volumes exchanged as one record), and for SPH, RL, KB Method 1, MLS 1,
+ * MLS 2 and SSPH 2 every owned particle's gradient-table row (columns by global id) and
+ * its apply(GRADIENT) of two exchanged fields must equal the reference bit for bit,
+ * 2D and 3D. The ghosts' data must be their owners' (by id), the global numbering an
+ * exclusive scan, and after the particles move and the plan is rebuilt the RL rows again
+ * equal a one-rank run of the moved cloud. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpitest.h"
+
+typedef struct {
+  int method, order;
+  const char *name;
+} method_t;
+static const method_t kMethods[] = {
+    {MFREE_METHOD_SPH, 0, "SPH"},        {MFREE_METHOD_RANDLES_LIBERSKY, 0, "RL"},
+    {MFREE_METHOD_KB_METHOD1, 0, "KB1"}, {MFREE_METHOD_MLS, 1, "MLS1"},
+    {MFREE_METHOD_MLS, 2, "MLS2"},       {MFREE_METHOD_SSPH, 2, "SSPH2"},
+};
+#define NMETHODS 6
+
+/* One approximant's gradient rows and apply(GRADIENT) of two fields, columns as ids. */
+typedef struct {
+  int nsites, dim;
+  int64_t *rp, *cid;
+  double *g, *ap; /* g: nnz x dim; ap: nsites x 2 dim */
+} rows_t;
+
+static void field_at(int64_t id, double *u) {
+  u[0] = sin(0.01 * (double)id + 0.3);
+  u[1] = cos(0.013 * (double)id) * (double)(1 + id % 7);
+}
+
+static void compute_rows(mfree_context_t *ctx, mfree_particles_t *ps, const int64_t *ids, int n,
+                         const method_t *m, rows_t *r) {
+  mfree_approximant_t *a = NULL;
+  int dim = 0;
+  mfree_particles_get_dimension(ps, &dim);
+  CHECK(mfree_approximant_create(ctx, ps, m->method, &a) == MFREE_SUCCESS, "create %s", m->name);
+  if (m->order) mfree_approximant_set_order(a, m->order);
+  mfree_approximant_set_derivatives(a, MFREE_DERIV_GRADIENT);
+  const mfree_status_t st = mfree_approximant_setup(a);
+  CHECK(st == MFREE_SUCCESS, "%s setup status %d", m->name, (int)st);
+  int32_t ns = 0;
+  int64_t nnz = 0;
+  mfree_approximant_get_num_sites(a, &ns);
+  mfree_approximant_get_nnz(a, &nnz);
+  r->nsites = ns;
+  r->dim = dim;
+  r->rp = malloc(sizeof(int64_t) * (size_t)(ns + 1));
+  r->cid = malloc(sizeof(int64_t) * (size_t)(nnz + 1));
+  r->g = malloc(sizeof(double) * (size_t)(nnz * dim + 1));
+  int32_t *cols = malloc(sizeof(int32_t) * (size_t)(nnz + 1));
+  double *tmp = malloc(sizeof(double) * (size_t)(nnz + 1));
+  for (int c = 0; c < dim; ++c) {
+    mfree_approximant_assemble_csr(a, MFREE_DERIV_GRADIENT, c, r->rp, cols, tmp);
+    for (int64_t k = 0; k < nnz; ++k) r->g[k * dim + c] = tmp[k];
+  }
+  for (int64_t k = 0; k < nnz; ++k) r->cid[k] = ids[cols[k]];
+  double *u = malloc(sizeof(double) * (size_t)(2 * n + 1));
+  for (int j = 0; j < n; ++j) field_at(ids[j], u + 2 * j);
+  r->ap = malloc(sizeof(double) * (size_t)(2 * dim * ns + 1));
+  CHECK(mfree_approximant_apply(a, MFREE_OP_GRADIENT, 2, u, MFREE_LAYOUT_AOS, 2, r->ap, MFREE_LAYOUT_AOS,
+                                2 * dim) == MFREE_SUCCESS,
+        "%s apply", m->name);
+  free(u);
+  free(cols);
+  free(tmp);
+  mfree_approximant_destroy(&a);
+}
+
+static void free_rows(rows_t *r) {
+  free(r->rp);
+  free(r->cid);
+  free(r->g);
+  free(r->ap);
+}
+
+static mfree_particles_t *reference_set(mfree_context_t *ctx, const cloud_t *c) {
+  mfree_particles_t *ps = NULL;
+  mfree_particles_create(ctx, c->dim, c->n, &ps);
+  mfree_particles_set_positions(ps, c->x, MFREE_LAYOUT_AOS, c->dim, MFREE_BORROW);
+  mfree_particles_set_support(ps, c->h, 1, MFREE_BORROW);
+  mfree_particles_set_volumes(ps, c->v, 1, MFREE_BORROW);
+  mfree_particles_set_global_ids(ps, c->id, MFREE_BORROW);
+  CHECK(mfree_particles_setup(ps) == MFREE_SUCCESS, "reference setup");
+  return ps;
+}
+
+/* Owned row k (global id ids[k]) of d against the reference row of the same id. */
+static void compare_rows(const rows_t *ref, const rows_t *d, const int64_t *ids, int n_owned, const char *what) {
+  const int dim = ref->dim;
+  int bad = 0;
+  for (int k = 0; k < n_owned && bad < 3; ++k) {
+    const int s = (int)((ids[k] - 5) / 2);
+    const int64_t a0 = ref->rp[s], a1 = ref->rp[s + 1], b0 = d->rp[k], b1 = d->rp[k + 1];
+    int ok = a1 - a0 == b1 - b0;
+    for (int64_t q = 0; ok && q < a1 - a0; ++q)
+      ok = ref->cid[a0 + q] == d->cid[b0 + q] &&
+           !memcmp(ref->g + (a0 + q) * dim, d->g + (b0 + q) * dim, sizeof(double) * dim);
+    ok = ok && !memcmp(ref->ap + (size_t)s * 2 * dim, d->ap + (size_t)k * 2 * dim, sizeof(double) * 2 * dim);
+    CHECK(ok, "%s: particle id %lld differs from one rank (row %lld / %lld entries)", what,
+          (long long)ids[k], (long long)(a1 - a0), (long long)(b1 - b0));
+    bad += !ok;
+  }
+}
+
+/* The distributed run of one decomposition, compared with ref (one per method). */
+static void run(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, const int *part, rows_t *ref,
+                const method_t *methods, int nmethods, const char *label) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const int dim = c->dim, R = dim + 2;
+  int no = 0;
+  int *own = malloc(sizeof(int) * (size_t)c->n);
+  for (int i = 0; i < c->n; ++i)
+    if (part[i] == rank) own[no++] = i;
+  uint64_t s = 1234 + (uint64_t)rank;
+  for (int i = no - 1; i > 0; --i) { /* this rank's own order */
+    s = mpitest_hash(s);
+    const int j = (int)(s % (uint64_t)(i + 1)), t = own[i];
+    own[i] = own[j];
+    own[j] = t;
+  }
+  double *xo = malloc(sizeof(double) * (size_t)(no * dim + 1));
+  int64_t *io = malloc(sizeof(int64_t) * (size_t)(no + 1));
+  for (int k = 0; k < no; ++k) {
+    memcpy(xo + k * dim, c->x + (size_t)own[k] * dim, sizeof(double) * dim);
+    io[k] = c->id[own[k]];
+  }
+  const double width = KAPPA * cloud_max_support(c) * (1 + 1e-12);
+  mfree_status_t st = mfree_halo_setup(halo, no, xo, dim, io, width);
+  CHECK(st == MFREE_SUCCESS, "%s: halo setup %d", label, (int)st);
+  int32_t n_owned = 0, n_ghost = 0;
+  mfree_halo_get_size(halo, &n_owned, &n_ghost);
+  CHECK(n_owned == no, "%s: n_owned", label);
+  const int n = n_owned + n_ghost;
+  int64_t *ids = malloc(sizeof(int64_t) * (size_t)(n + 1)), off = -1, total = -1;
+  mfree_halo_get_global_ids(halo, ids);
+  mfree_halo_get_global_offset(halo, &off, &total);
+  int64_t scan = 0, nn = no;
+  MPI_Exscan(&nn, &scan, 1, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+  CHECK(total == c->n && off == (rank ? scan : 0), "%s: offset %lld total %lld", label, (long long)off,
+        (long long)total);
+  /* one record per particle: x, h, V (owned filled, ghosts exchanged) */
+  double *rec = malloc(sizeof(double) * (size_t)(n * R + 1));
+  for (int k = 0; k < n; ++k)
+    for (int q = 0; q < R; ++q) rec[k * R + q] = k < no ? NAN : -1.0;
+  for (int k = 0; k < no; ++k) {
+    memcpy(rec + k * R, xo + k * dim, sizeof(double) * dim);
+    rec[k * R + dim] = c->h[own[k]];
+    rec[k * R + dim + 1] = c->v[own[k]];
+  }
+  CHECK(mfree_halo_exchange(halo, R, rec, R) == MFREE_SUCCESS, "%s: exchange", label);
+  for (int g = no; g < n; ++g) {
+    const int i = (int)((ids[g] - 5) / 2);
+    CHECK(ids[g] >= 5 && i < c->n && part[i] != rank, "%s: ghost id %lld", label, (long long)ids[g]);
+    if (ids[g] < 5 || i >= c->n) continue;
+    CHECK(!memcmp(rec + g * R, c->x + (size_t)i * dim, sizeof(double) * dim) && rec[g * R + dim] == c->h[i] &&
+              rec[g * R + dim + 1] == c->v[i],
+          "%s: ghost id %lld holds other data than its owner", label, (long long)ids[g]);
+  }
+  /* a strided field (ld > ncomp): the exchange writes components [0, ncomp) only */
+  double *u = malloc(sizeof(double) * (size_t)(3 * n + 1));
+  for (int k = 0; k < n; ++k) {
+    if (k < no) field_at(ids[k], u + 3 * k);
+    else u[3 * k] = u[3 * k + 1] = 0.0;
+    u[3 * k + 2] = 42.0;
+  }
+  CHECK(mfree_halo_exchange(halo, 2, u, 3) == MFREE_SUCCESS, "%s: strided exchange", label);
+  for (int g = no; g < n; ++g) {
+    double w[2];
+    field_at(ids[g], w);
+    CHECK(u[3 * g] == w[0] && u[3 * g + 1] == w[1] && u[3 * g + 2] == 42.0, "%s: strided exchange at %d", label,
+          g);
+  }
+  /* the particle set on this rank, borrowing the records */
+  mfree_particles_t *ps = NULL;
+  mfree_particles_create(ctx, dim, n, &ps);
+  mfree_particles_set_num_ghost(ps, n_ghost);
+  mfree_particles_set_positions(ps, rec, MFREE_LAYOUT_AOS, R, MFREE_BORROW);
+  mfree_particles_set_support(ps, rec + dim, R, MFREE_BORROW);
+  mfree_particles_set_volumes(ps, rec + dim + 1, R, MFREE_BORROW);
+  mfree_particles_set_global_ids(ps, ids, MFREE_BORROW);
+  mfree_particles_set_halo_width(ps, width);
+  st = mfree_particles_setup(ps);
+  CHECK(st == MFREE_SUCCESS, "%s: particle setup %d", label, (int)st);
+  for (int m = 0; m < nmethods; ++m) {
+    rows_t d;
+    char what[128];
+    snprintf(what, sizeof what, "%s %s", label, methods[m].name);
+    compute_rows(ctx, ps, ids, n, &methods[m], &d);
+    compare_rows(&ref[m], &d, ids, no, what);
+    free_rows(&d);
+  }
+  mfree_particles_destroy(&ps);
+  free(u);
+  free(rec);
+  free(ids);
+  free(xo);
+  free(io);
+  free(own);
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  mfree_context_t *ctx = NULL;
+  mfree_context_create(&ctx);
+  for (int dim = 2; dim <= 3; ++dim) {
+    mfree_halo_t *halo = NULL;
+    CHECK(mfree_halo_create(ctx, MPI_COMM_WORLD, dim, &halo) == MFREE_SUCCESS, "halo create");
+    cloud_t c;
+    cloud_make(&c, dim, dim == 2 ? 22 : 9, 77 + dim);
+    mfree_particles_t *ps = reference_set(ctx, &c);
+    rows_t ref[NMETHODS];
+    for (int m = 0; m < NMETHODS; ++m) compute_rows(ctx, ps, c.id, c.n, &kMethods[m], &ref[m]);
+    int *part = malloc(sizeof(int) * (size_t)c.n);
+    const char *names[3] = {"slab", "random", "Zoltan RCB"};
+    for (int how = 0; how < 3; ++how) {
+      if (decompose(&c, how, MPI_COMM_WORLD, part) != 0) {
+        if (rank == 0) printf("%dD %s: skipped (no Zoltan)\n", dim, names[how]);
+        continue;
+      }
+      char label[64];
+      snprintf(label, sizeof label, "%dD %s on %d ranks", dim, names[how], size);
+      run(ctx, halo, &c, part, ref, kMethods, NMETHODS, label);
+      if (rank == 0) printf("%s: done\n", label);
+    }
+    /* the particles move: every rank moves the same cloud, the plan is rebuilt */
+    for (int i = 0; i < c.n; ++i)
+      for (int d = 0; d < dim; ++d)
+        c.x[i * dim + d] += 0.02 * sin(3.0 * c.x[i * dim + (d + 1) % dim] + d);
+    rows_t moved;
+    CHECK(mfree_particles_setup(ps) == MFREE_SUCCESS, "moved reference setup");
+    compute_rows(ctx, ps, c.id, c.n, &kMethods[1], &moved);
+    decompose(&c, DECOMP_SLAB, MPI_COMM_WORLD, part);
+    char label[64];
+    snprintf(label, sizeof label, "%dD moved, slab on %d ranks", dim, size);
+    run(ctx, halo, &c, part, &moved, &kMethods[1], 1, label);
+    free_rows(&moved);
+    for (int m = 0; m < NMETHODS; ++m) free_rows(&ref[m]);
+    free(part);
+    mfree_particles_destroy(&ps);
+    cloud_free(&c);
+    mfree_halo_destroy(&halo);
+  }
+  mfree_context_destroy(&ctx);
+  const int rc = mpitest_finish("t160-mpi-gradients");
+  MPI_Finalize();
+  return rc;
+}

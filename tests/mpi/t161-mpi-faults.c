@@ -1,0 +1,134 @@
+/* Faults on 1-4 ranks (label mpi): every rank returns the documented status and a
+ * message, and no rank waits for ever (the CTest timeout bounds it):
+ *  - one rank asks for a 4D plan: MFREE_ERR_ARG on every rank, naming that rank;
+ *  - one rank's setup fails (a NaN position: MFREE_ERR_INPUT; a negative width:
+ *    MFREE_ERR_ARG): every rank returns that status with "rank R: <its reason>", the
+ *    plan is not set up (get/exchange: MFREE_ERR_STATE) and a correct setup recovers;
+ *  - a global id given to particles of two ranks (of one rank on one rank):
+ *    MFREE_ERR_INPUT everywhere, the message names the id;
+ *  - a halo too narrow for the supports: the particle set that declares the plan's width
+ *    returns MFREE_ERR_HALO at setup on every rank, instead of rows that miss ghosts. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpitest.h"
+
+static int rank = 0, size = 1;
+
+static void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle,
+                   const char *what) {
+  char msg[600] = "";
+  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  CHECK(got == want, "%s: status %d, expected %d (%s)", what, (int)got, (int)want, msg);
+  CHECK(!needle || strstr(msg, needle), "%s: message '%s' lacks '%s'", what, msg, needle);
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const int last = size - 1;
+  char who[32];
+  snprintf(who, sizeof who, "rank %d:", last);
+  mfree_context_t *ctx = NULL;
+  mfree_context_create(&ctx);
+
+  /* a bad argument on one rank at create */
+  mfree_halo_t *halo = NULL;
+  expect(ctx, mfree_halo_create(ctx, MPI_COMM_WORLD, rank == last ? 4 : 2, &halo), MFREE_ERR_ARG, who,
+         "create, dim 4 on the last rank");
+  CHECK(halo == NULL, "no plan after a failed create");
+  CHECK(mfree_halo_create(ctx, MPI_COMM_WORLD, 2, &halo) == MFREE_SUCCESS, "create");
+
+  cloud_t c;
+  cloud_make(&c, 2, 16, 3);
+  int *part = malloc(sizeof(int) * (size_t)c.n);
+  decompose(&c, DECOMP_SLAB, MPI_COMM_WORLD, part);
+  int no = 0;
+  double *xo = malloc(sizeof(double) * (size_t)c.n * 2);
+  int64_t *io = malloc(sizeof(int64_t) * (size_t)c.n);
+  double *ho = malloc(sizeof(double) * (size_t)c.n);
+  for (int i = 0; i < c.n; ++i)
+    if (part[i] == rank) {
+      xo[2 * no] = c.x[2 * i];
+      xo[2 * no + 1] = c.x[2 * i + 1];
+      io[no] = c.id[i];
+      ho[no++] = c.h[i];
+    }
+  const double width = KAPPA * cloud_max_support(&c);
+
+  /* one rank's setup fails: a NaN position, then a negative width */
+  const double keep = xo[1];
+  if (rank == last) xo[1] = NAN;
+  expect(ctx, mfree_halo_setup(halo, no, xo, 2, io, width), MFREE_ERR_INPUT, "position of particle 0",
+         "NaN position on the last rank");
+  xo[1] = keep;
+  char msg[600] = "";
+  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  CHECK(strstr(msg, who) != NULL, "the message names the failing rank: %s", msg);
+  int32_t n_owned = 0, n_ghost = 0;
+  expect(ctx, mfree_halo_get_size(halo, &n_owned, &n_ghost), MFREE_ERR_STATE, "not set up", "size after failure");
+  double u[4] = {0, 0, 0, 0};
+  expect(ctx, mfree_halo_exchange(halo, 1, u, 1), MFREE_ERR_STATE, "not set up", "exchange after failure");
+  expect(ctx, mfree_halo_setup(halo, no, xo, 2, io, rank == last ? -1.0 : width), MFREE_ERR_ARG, who,
+         "negative width on the last rank");
+  expect(ctx, mfree_halo_setup(halo, rank == 0 ? -5 : no, xo, 2, io, width), MFREE_ERR_ARG, "rank 0:",
+         "negative count on rank 0");
+  CHECK(mfree_halo_setup(halo, no, xo, 2, io, width) == MFREE_SUCCESS, "recovery");
+
+  /* the same global id on two ranks (on one rank: twice on it) */
+  const int64_t dup = c.id[0]; /* owned by rank 0 in the slab split */
+  const int64_t keep_id = no > 1 ? io[1] : 0;
+  if (rank == last && no > 1) io[1] = dup;
+  char needle[64];
+  snprintf(needle, sizeof needle, "global id %lld", (long long)dup);
+  expect(ctx, mfree_halo_setup(halo, no, xo, 2, io, width), MFREE_ERR_INPUT, needle, "duplicate id");
+  if (rank == last && no > 1) io[1] = keep_id;
+  io[0] = -7;
+  expect(ctx, mfree_halo_setup(halo, no, xo, 2, io, width), MFREE_ERR_INPUT, "must be >= 0", "negative id");
+  for (int i = 0, k = 0; i < c.n; ++i)
+    if (part[i] == rank) io[k++] = c.id[i];
+  CHECK(mfree_halo_setup(halo, no, xo, 2, io, width) == MFREE_SUCCESS, "recovery after ids");
+
+  /* a halo too narrow: the plan holds the ghosts within half the supports' reach; the
+   * set that declares that width refuses to build rows */
+  const double narrow = 0.5 * width;
+  CHECK(mfree_halo_setup(halo, no, xo, 2, io, narrow) == MFREE_SUCCESS, "narrow plan");
+  mfree_halo_get_size(halo, &n_owned, &n_ghost);
+  const int n = n_owned + n_ghost;
+  double *x = malloc(sizeof(double) * (size_t)(2 * n + 2)), *h = malloc(sizeof(double) * (size_t)(n + 1));
+  int64_t *ids = malloc(sizeof(int64_t) * (size_t)(n + 1));
+  memcpy(x, xo, sizeof(double) * 2 * (size_t)no);
+  memcpy(h, ho, sizeof(double) * (size_t)no);
+  mfree_halo_exchange(halo, 2, x, 2);
+  mfree_halo_exchange(halo, 1, h, 1);
+  mfree_halo_get_global_ids(halo, ids);
+  mfree_particles_t *ps = NULL;
+  mfree_particles_create(ctx, 2, n, &ps);
+  mfree_particles_set_num_ghost(ps, n_ghost);
+  mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, 2, MFREE_BORROW);
+  mfree_particles_set_support(ps, h, 1, MFREE_BORROW);
+  mfree_particles_set_global_ids(ps, ids, MFREE_BORROW);
+  mfree_particles_set_halo_width(ps, narrow);
+  expect(ctx, mfree_particles_setup(ps), MFREE_ERR_HALO, "reaches past the declared halo width",
+         "particle setup on a narrow halo");
+  mfree_particles_set_halo_width(ps, width);  /* an honest width passes the set's check */
+  CHECK(mfree_halo_setup(halo, no, xo, 2, io, width) == MFREE_SUCCESS, "wide plan");
+  mfree_particles_destroy(&ps);
+  free(x);
+  free(h);
+  free(ids);
+
+  free(xo);
+  free(io);
+  free(ho);
+  free(part);
+  cloud_free(&c);
+  mfree_halo_destroy(&halo);
+  mfree_context_destroy(&ctx);
+  const int rc = mpitest_finish("t161-mpi-faults");
+  MPI_Finalize();
+  return rc;
+}
