@@ -1,6 +1,7 @@
-/*
- * mfree_mpi.h -- ghost layers and halo exchange over MPI for mfree particle sets
- * (libmfree_mpi, pkg-config mfree-mpi, CMake mfree::mfree_mpi).
+/**
+ * @file mfree_mpi.h
+ * @brief Ghost layers and halo exchange over MPI for mfree particle sets (libmfree_mpi,
+ * pkg-config mfree-mpi, CMake mfree::mfree_mpi).
  *
  * For hosts without halo code of their own. Each rank gives its owned particles
  * (positions, optional global ids) and a halo width; the plan finds the ghosts (every
@@ -22,7 +23,8 @@
  * global id anywhere, out of memory), every rank returns the same status and its context
  * holds a message naming the failing rank and its reason; no rank is left waiting. Only
  * a NULL handle or context is reported locally (MFREE_ERR_NULL), as it has no
- * communicator. The core library never calls MPI; this one does.
+ * communicator. The core library never calls MPI; this one does. docs/mpi.md shows how
+ * a host runs on ranks and which ghosts each method needs.
  */
 #ifndef MFREE_MPI_H
 #define MFREE_MPI_H
@@ -48,74 +50,120 @@ extern "C" {
 #define MFREE_MPI_API
 #endif
 
+/** A halo plan: the ghost layer of one rank and its exchange pattern. */
 typedef struct mfree_halo mfree_halo_t;
 
 /**
- * Create a halo plan on comm (duplicated: the plan's messages never meet the host's).
- * Collective over comm.
+ * Create a halo plan on comm (duplicated, so that the plan's messages never meet the
+ * host's). Collective over comm.
  * @param[in]  ctx   context for errors (kept alive by the plan)
  * @param[in]  comm  the ranks sharing the particles
- * @param[in]  dim   1, 2 or 3
- * @param[out] halo  the new plan (NULL on failure)
+ * @param[in]  dim   1, 2 or 3 (else MFREE_ERR_ARG on every rank)
+ * @param[out] halo  the new plan; NULL on failure
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (local) for a NULL ctx or halo; MFREE_ERR_ARG,
+ *         MFREE_ERR_ALLOC or MFREE_ERR_INTERNAL on every rank when one rank fails
  */
 MFREE_MPI_API mfree_status_t mfree_halo_create(mfree_context_t *ctx, MPI_Comm comm, int32_t dim,
                                                mfree_halo_t **halo);
 
-/** mfree_halo_create with a Fortran communicator handle (MPI_Comm_f2c). */
+/**
+ * mfree_halo_create with a Fortran communicator handle (converted by MPI_Comm_f2c), for
+ * hosts that hold communicators as Fortran integers.
+ * @param[in]  ctx    context for errors
+ * @param[in]  fcomm  the Fortran handle (e.g. MPI_COMM_WORLD of `use mpi`)
+ * @param[in]  dim    1, 2 or 3
+ * @param[out] halo   the new plan
+ * @return as mfree_halo_create
+ */
 MFREE_MPI_API mfree_status_t mfree_halo_create_f(mfree_context_t *ctx, int32_t fcomm, int32_t dim,
                                                  mfree_halo_t **halo);
 
-/** Free a plan (not collective). @param[in,out] halo  may be NULL or point to NULL */
+/**
+ * Free a plan (not collective).
+ * @param[in,out] halo  may be NULL or point to NULL; set to NULL
+ * @return MFREE_SUCCESS
+ */
 MFREE_MPI_API mfree_status_t mfree_halo_destroy(mfree_halo_t **halo);
 
 /**
  * Build (or rebuild, after particles moved) the ghost layer and the exchange plan.
- * Collective. Buffers are reused from the previous setup when the sizes allow.
+ * Collective. On failure the previous plan is gone: the getters and exchange return
+ * MFREE_ERR_STATE until a setup succeeds.
+ * @param[in] halo     the plan
  * @param[in] n_owned  owned particles on this rank (>= 0)
- * @param[in] x        positions, AoS: particle i, component c at x[i*ld + c] (finite)
+ * @param[in] x        positions, AoS: particle i, component c at x[i*ld + c], finite;
+ *                     read during the call only
  * @param[in] ld       leading dimension (>= dim)
- * @param[in] ids      n_owned global ids (>= 0, unique over all ranks), or NULL: the
- *                     owned particles are numbered offset + i, offset the exclusive
- *                     scan of n_owned (mfree_halo_get_global_offset). Copied.
- * @param[in] width    halo width (finite, > 0): at least the largest distance at which
- *                     a particle of another rank can be a neighbour (kappa times the
- *                     largest support) plus, for plans kept while particles move, twice
- *                     the largest displacement before the next setup
- * @return MFREE_ERR_ARG, MFREE_ERR_INPUT (non-finite position, negative or repeated id:
- *         the message names the id), MFREE_ERR_ALLOC, MFREE_ERR_INTERNAL (an MPI
- *         failure); on every rank alike. On failure the previous plan is gone and
- *         exchange returns MFREE_ERR_STATE until a setup succeeds.
+ * @param[in] ids      n_owned global ids (>= 0, unique over all ranks; copied), or NULL:
+ *                     the owned particles are numbered offset + i, offset the exclusive
+ *                     scan of n_owned (mfree_halo_get_global_offset)
+ * @param[in] width    halo width (finite, > 0): at least the largest distance at which a
+ *                     particle of another rank can be a neighbour (kappa times the
+ *                     largest support), plus twice the largest displacement before the
+ *                     next setup for plans kept while particles move
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG, MFREE_ERR_NULL,
+ *         MFREE_ERR_INPUT (non-finite position, negative id, an id repeated anywhere:
+ *         the message names it and the ranks), MFREE_ERR_ALLOC, MFREE_ERR_INTERNAL (an
+ *         MPI failure); the message starts with the failing rank
  */
 MFREE_MPI_API mfree_status_t mfree_halo_setup(mfree_halo_t *halo, int32_t n_owned,
                                               const double *x, int64_t ld, const int64_t *ids,
                                               double width);
 
-/** Owned and ghost counts of this rank (after setup); either pointer may be NULL. */
+/**
+ * Owned and ghost counts of this rank.
+ * @param[in]  halo     a set-up plan
+ * @param[out] n_owned  owned particles (may be NULL)
+ * @param[out] n_ghost  ghosts (may be NULL)
+ * @return MFREE_SUCCESS; MFREE_ERR_STATE before a successful setup
+ */
 MFREE_MPI_API mfree_status_t mfree_halo_get_size(const mfree_halo_t *halo, int32_t *n_owned,
                                                  int32_t *n_ghost);
 
-/** Global ids of the n_owned + n_ghost particles of this rank (after setup).
- * @param[out] ids  n_owned + n_ghost values */
+/**
+ * Global ids of this rank's particles: the owned ones in the host's order, then the
+ * ghosts in the plan's order.
+ * @param[in]  halo  a set-up plan
+ * @param[out] ids   n_owned + n_ghost values
+ * @return MFREE_SUCCESS; MFREE_ERR_STATE before a successful setup; MFREE_ERR_NULL
+ */
 MFREE_MPI_API mfree_status_t mfree_halo_get_global_ids(const mfree_halo_t *halo, int64_t *ids);
 
-/** The exclusive scan of the owned counts (this rank's first number when the plan
- * numbered the particles) and their sum over all ranks; either pointer may be NULL. */
+/**
+ * The exclusive scan of the owned counts (this rank's first number when the plan
+ * numbered the particles) and their sum over all ranks.
+ * @param[in]  halo    a set-up plan
+ * @param[out] offset  the owned particles of the lower ranks (may be NULL)
+ * @param[out] total   all owned particles (may be NULL)
+ * @return MFREE_SUCCESS; MFREE_ERR_STATE before a successful setup
+ */
 MFREE_MPI_API mfree_status_t mfree_halo_get_global_offset(const mfree_halo_t *halo,
                                                           int64_t *offset, int64_t *total);
 
-/** The plan: neighbour ranks, particle copies sent and received per exchange (so one
- * exchange of ncomp doubles moves 8 ncomp n_send bytes out of this rank); any NULL. */
+/**
+ * The plan's size: one exchange of ncomp doubles sends 8 ncomp n_send bytes from this
+ * rank to its neighbours and receives 8 ncomp n_recv.
+ * @param[in]  halo         a set-up plan
+ * @param[out] n_neighbors  ranks this one exchanges with (may be NULL)
+ * @param[out] n_send       particle copies sent per exchange (may be NULL)
+ * @param[out] n_recv       particle copies received (the ghosts; may be NULL)
+ * @return MFREE_SUCCESS; MFREE_ERR_STATE before a successful setup
+ */
 MFREE_MPI_API mfree_status_t mfree_halo_get_plan(const mfree_halo_t *halo, int32_t *n_neighbors,
                                                  int64_t *n_send, int64_t *n_recv);
 
 /**
  * Forward exchange: the owners' values of a per-particle field written into the ghost
- * items. Collective; one MPI_Neighbor_alltoallv.
+ * items. Collective: one MPI_Neighbor_alltoallv; no allocation once the buffers have
+ * grown to the largest ncomp used. Its arguments are checked on the calling rank only
+ * (no agreement round): every rank must pass the same ncomp.
+ * @param[in]     halo   a set-up plan
  * @param[in]     ncomp  components per particle (>= 1)
- * @param[in,out] field  AoS, n_owned + n_ghost items of ld doubles; items [0, n_owned)
- *                       are read, items [n_owned, n_owned + n_ghost) written (components
- *                       [0, ncomp) only)
+ * @param[in,out] field  AoS, n_owned + n_ghost items of ld doubles: items [0, n_owned)
+ *                       are read, components [0, ncomp) of the ghost items written
  * @param[in]     ld     leading dimension (>= ncomp)
+ * @return MFREE_SUCCESS; MFREE_ERR_STATE before a successful setup; MFREE_ERR_ARG,
+ *         MFREE_ERR_NULL; MFREE_ERR_ALLOC; MFREE_ERR_INTERNAL for an MPI failure
  */
 MFREE_MPI_API mfree_status_t mfree_halo_exchange(mfree_halo_t *halo, int32_t ncomp, double *field,
                                                  int64_t ld);
