@@ -1,7 +1,9 @@
-# Layering of the shared libraries (run with cmake -P):
-#   -DCORE=<libmfree.so> -DADAPTER=<libmfree_suitesparse.so> [-DREADELF=<readelf>]
-# libmfree needs no SuiteSparse library; libmfree_suitesparse needs libmfree and the
-# three solvers.
+# Layering of an adapter's shared library (run with cmake -P):
+#   -DCORE=<libmfree.so> -DADAPTER=<libmfree_X.so> -DNAME=<what X wraps>
+#   "-DFORBIDDEN=<;-list of regexes>" "-DREQUIRED=<;-list of library names>"
+#   [-DREADELF=<readelf>]
+# libmfree needs no library that matches a FORBIDDEN regex (applied to "[libNAME.so"),
+# the adapter needs libmfree and each REQUIRED library (libNAME.so).
 cmake_minimum_required(VERSION 3.25)
 if(NOT DEFINED READELF OR READELF STREQUAL "")
   set(READELF readelf)
@@ -17,15 +19,15 @@ function(needed lib out)
 endfunction()
 
 needed("${CORE}" core)
-foreach(ss cholmod umfpack klu amd camd colamd ccolamd btf suitesparseconfig)
-  if(core MATCHES "\\[lib${ss}\\.so")
-    message(FATAL_ERROR "${CORE} depends on lib${ss}: the core must not need SuiteSparse\n${core}")
+foreach(re IN LISTS FORBIDDEN)
+  if(core MATCHES "\\[lib${re}")
+    message(FATAL_ERROR "${CORE} depends on ${NAME} (lib${re}): the core must not\n${core}")
   endif()
 endforeach()
 needed("${ADAPTER}" adapter)
-foreach(lib mfree cholmod umfpack klu)
+foreach(lib mfree ${REQUIRED})
   if(NOT adapter MATCHES "\\[lib${lib}\\.so")
     message(FATAL_ERROR "${ADAPTER} does not depend on lib${lib}:\n${adapter}")
   endif()
 endforeach()
-message(STATUS "layering ok: core needs no SuiteSparse; the adapter needs libmfree and SuiteSparse")
+message(STATUS "layering ok: core needs no ${NAME}; the adapter needs libmfree and ${NAME}")
