@@ -4,7 +4,9 @@
 #    repository, and its #anchor, if any, to a heading of the target document (GitHub's
 #    heading ids: lower case, punctuation dropped, spaces to hyphens, -1, -2 for repeats);
 #  - no document, source, script or build file refers to a path outside the repository
-#    (the project's shared folder beside it, or the absolute path of a checkout).
+#    (the project's shared folder beside it, or the absolute path of a checkout);
+#  - the public headers name no test ids and cite papers by their docs/references.md key
+#    (t909 is the documents check as a whole: links, paths, headers).
 # Links inside code blocks and code spans are not links and are skipped, as are URLs.
 cmake_minimum_required(VERSION 3.25)
 if(NOT DEFINED ROOT)
@@ -135,6 +137,18 @@ foreach(f IN LISTS sources)
     file(RELATIVE_PATH rel "${ROOT}" "${f}")
     list(GET hits 0 first)
     string(APPEND errors "  ${rel}: refers to a path outside the repository: ${first}\n")
+  endif()
+endforeach()
+
+# The public headers are self-contained: papers cited by their key of docs/references.md,
+# not by the project's seed numbers, and no test named as evidence.
+file(GLOB headers ${ROOT}/include/*.h ${ROOT}/adapters/*/include/*.h)
+foreach(h IN LISTS headers)
+  file(STRINGS "${h}" hits REGEX "(^|[^A-Za-z0-9_])t[0-9][0-9][0-9]([^0-9]|$)|(paper|spec) 00[0-9]|00[0-9] (eq|eqs|Sect|Table)")
+  if(hits)
+    file(RELATIVE_PATH rel "${ROOT}" "${h}")
+    list(GET hits 0 first)
+    string(APPEND errors "  ${rel}: a test id or a seed-number citation (cite docs/references.md keys): ${first}\n")
   endif()
 endforeach()
 
