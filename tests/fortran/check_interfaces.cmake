@@ -1,5 +1,7 @@
 # Check a Fortran binding module against its C header (run with cmake -P):
 #   -DHEADER=<C header> -DFORTRAN=<module source> [-DHEADER_TYPES=<header with typedefs>]
+#   [-DC_ONLY=<;-list of functions>]  (C-only by design, e.g. taking an MPI_Comm, which has
+#   no portable Fortran type: not looked for in the module)
 # Fails when
 #  - a public C function (MFREE_API / MFREE_SUITESPARSE_API) has no raw interface
 #    bound with bind(C, name="<function>"), or the Fortran binds a name the header
@@ -85,6 +87,9 @@ foreach(d IN LISTS decls)
   set(name "${CMAKE_MATCH_2}")
   string(STRIP "${CMAKE_MATCH_1}" ret)
   string(STRIP "${CMAKE_MATCH_3}" params)
+  if(name IN_LIST C_ONLY)
+    continue()
+  endif()
   list(APPEND c_funcs "${name}")
   if(ret STREQUAL "mfree_status_t")
     set(c_ret_${name} "status")

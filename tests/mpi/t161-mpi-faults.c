@@ -4,6 +4,7 @@
  *  - one rank's setup fails (a NaN position: MFREE_ERR_INPUT; a negative width:
  *    MFREE_ERR_ARG): every rank returns that status with "rank R: <its reason>", the
  *    plan is not set up (get/exchange: MFREE_ERR_STATE) and a correct setup recovers;
+ *  - global ids from some ranks only: MFREE_ERR_ARG everywhere;
  *  - a global id given to particles of two ranks (of one rank on one rank):
  *    MFREE_ERR_INPUT everywhere, the message names the id;
  *  - a halo too narrow for the supports: the particle set that declares the plan's width
@@ -77,6 +78,10 @@ int main(int argc, char **argv) {
   expect(ctx, mfree_halo_setup(halo, rank == 0 ? -5 : no, xo, 2, io, width), MFREE_ERR_ARG, "rank 0:",
          "negative count on rank 0");
   CHECK(mfree_halo_setup(halo, no, xo, 2, io, width) == MFREE_SUCCESS, "recovery");
+  /* ids on some ranks only (the last gives none): MFREE_ERR_ARG everywhere */
+  if (size > 1)
+    expect(ctx, mfree_halo_setup(halo, no, xo, 2, rank == last ? NULL : io, width), MFREE_ERR_ARG,
+           "all ranks or none", "ids on some ranks only");
 
   /* the same global id on two ranks (on one rank: twice on it) */
   const int64_t dup = c.id[0]; /* owned by rank 0 in the slab split */

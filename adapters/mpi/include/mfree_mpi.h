@@ -96,7 +96,8 @@ MFREE_MPI_API mfree_status_t mfree_halo_destroy(mfree_halo_t **halo);
  * @param[in] ld       leading dimension (>= dim)
  * @param[in] ids      n_owned global ids (>= 0, unique over all ranks; copied), or NULL:
  *                     the owned particles are numbered offset + i, offset the exclusive
- *                     scan of n_owned (mfree_halo_get_global_offset)
+ *                     scan of n_owned (mfree_halo_get_global_offset); every rank with
+ *                     particles gives ids, or none does (else MFREE_ERR_ARG)
  * @param[in] width    halo width (finite, > 0): at least the largest distance at which a
  *                     particle of another rank can be a neighbour (kappa times the
  *                     largest support), plus twice the largest displacement before the

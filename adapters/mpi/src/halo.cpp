@@ -214,6 +214,17 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
   });
   mfree_status_t st = agree(h, fn, l);
   if (st != MFREE_SUCCESS) return st;
+  // ids from the host on every rank with particles, or on none: agreed, because the
+  // duplicate check below is collective (a rank without particles may pass NULL)
+  int flag[2] = {n_owned > 0 ? (ids ? 1 : 0) : -1, n_owned > 0 ? (ids ? -1 : 0) : -1}, any[2] = {0, 0};
+  l = run_local([&](Local &r) {
+    mpi_ok(r, MPI_Allreduce(flag, any, 2, MPI_INT, MPI_MAX, h->comm), "MPI_Allreduce");
+    if (!r.st && any[0] == 1 && any[1] == 0 && n_owned > 0 && !ids)
+      r.fail(MFREE_ERR_ARG, "no global ids here while other ranks give theirs (all ranks or none)");
+  });
+  st = agree(h, fn, l);
+  if (st != MFREE_SUCCESS) return st;
+  const bool host_ids = any[0] == 1;
 
   // 2. global numbering, every rank's box, and the duplicate-id check: each id is sent to
   // the rank id_owner(id), which finds repeats among what it receives
@@ -228,10 +239,10 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
     mpi_ok(r, MPI_Allgather(box.data(), 2 * dim, MPI_DOUBLE, h->boxes.data(), 2 * dim, MPI_DOUBLE, h->comm),
            "MPI_Allgather");
     h->ids.resize(static_cast<size_t>(n_owned));
-    for (int32_t i = 0; i < n_owned; ++i) h->ids[i] = ids ? ids[i] : off + i;
-    if (!ids) return;  // numbered here: unique by construction
+    for (int32_t i = 0; i < n_owned; ++i) h->ids[i] = host_ids ? ids[i] : off + i;
+    if (!host_ids) return;  // numbered here: unique by construction
     std::vector<int> cnt(h->size, 0), rcnt(h->size, 0), sdis(h->size, 0), rdis(h->size, 0);
-    for (int32_t i = 0; i < n_owned; ++i) ++cnt[id_owner(ids[i], h->size)];
+    for (int32_t i = 0; i < n_owned; ++i) ++cnt[id_owner(ids[i], h->size)];  // (n_owned = 0 if ids is NULL)
     mpi_ok(r, MPI_Alltoall(cnt.data(), 1, MPI_INT, rcnt.data(), 1, MPI_INT, h->comm), "MPI_Alltoall");
     for (int p = 1; p < h->size; ++p) {
       sdis[p] = sdis[p - 1] + cnt[p - 1];

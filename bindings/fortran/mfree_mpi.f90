@@ -1,0 +1,172 @@
+!> module mfree_mpi: Fortran 2008 bindings of the MPI adapter
+!> (adapters/mpi/include/mfree_mpi.h, library libmfree_mpi). Built into
+!> libmfree_fortran_mpi only when the adapter is built; the core module mfree never
+!> depends on MPI.
+!>
+!> Same two layers as module mfree: raw bind(C) interfaces, the C name with _c, and typed
+!> wrappers with the C names. Communicators are the integer handles of `use mpi`
+!> (mfree_halo_create takes one and calls mfree_halo_create_f: the C function with an
+!> MPI_Comm has no portable Fortran interface). Arrays are AoS: x(ld, n), field(ld, n).
+!> Fortran hosts give global ids (the C API's numbering by the plan, ids = NULL, is C only).
+module mfree_mpi
+  use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_ptr, &
+    c_null_ptr
+  use mfree, only: mfree_context
+  implicit none
+  private
+
+  !> A halo plan (C: mfree_halo_t *).
+  type, public :: mfree_halo
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_halo
+
+  ! ---- raw bind(C) interfaces: one per public function of mfree_mpi.h (but the C-only
+  ! mfree_halo_create) ----
+  interface
+    integer(c_int) function mfree_halo_create_f_c(ctx, fcomm, dim, halo) &
+        bind(C, name="mfree_halo_create_f")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: fcomm
+      integer(c_int32_t), value :: dim
+      type(c_ptr), intent(out) :: halo
+    end function mfree_halo_create_f_c
+
+    integer(c_int) function mfree_halo_destroy_c(halo) bind(C, name="mfree_halo_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: halo
+    end function mfree_halo_destroy_c
+
+    integer(c_int) function mfree_halo_setup_c(halo, n_owned, x, ld, ids, width) &
+        bind(C, name="mfree_halo_setup")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int32_t), value :: n_owned
+      real(c_double), intent(in) :: x(*)
+      integer(c_int64_t), value :: ld
+      integer(c_int64_t), intent(in) :: ids(*)
+      real(c_double), value :: width
+    end function mfree_halo_setup_c
+
+    integer(c_int) function mfree_halo_get_size_c(halo, n_owned, n_ghost) &
+        bind(C, name="mfree_halo_get_size")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int32_t), intent(out) :: n_owned
+      integer(c_int32_t), intent(out) :: n_ghost
+    end function mfree_halo_get_size_c
+
+    integer(c_int) function mfree_halo_get_global_ids_c(halo, ids) &
+        bind(C, name="mfree_halo_get_global_ids")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int64_t), intent(out) :: ids(*)
+    end function mfree_halo_get_global_ids_c
+
+    integer(c_int) function mfree_halo_get_global_offset_c(halo, offset, total) &
+        bind(C, name="mfree_halo_get_global_offset")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int64_t), intent(out) :: offset
+      integer(c_int64_t), intent(out) :: total
+    end function mfree_halo_get_global_offset_c
+
+    integer(c_int) function mfree_halo_get_plan_c(halo, n_neighbors, n_send, n_recv) &
+        bind(C, name="mfree_halo_get_plan")
+      import :: c_int, c_int32_t, c_int64_t, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int32_t), intent(out) :: n_neighbors
+      integer(c_int64_t), intent(out) :: n_send
+      integer(c_int64_t), intent(out) :: n_recv
+    end function mfree_halo_get_plan_c
+
+    integer(c_int) function mfree_halo_exchange_c(halo, ncomp, field, ld) &
+        bind(C, name="mfree_halo_exchange")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int32_t), value :: ncomp
+      real(c_double), intent(inout) :: field(*)
+      integer(c_int64_t), value :: ld
+    end function mfree_halo_exchange_c
+  end interface
+
+  public :: mfree_halo_create_f_c, mfree_halo_destroy_c, mfree_halo_setup_c
+  public :: mfree_halo_get_size_c, mfree_halo_get_global_ids_c
+  public :: mfree_halo_get_global_offset_c, mfree_halo_get_plan_c, mfree_halo_exchange_c
+  public :: mfree_halo_create, mfree_halo_create_f, mfree_halo_destroy, mfree_halo_setup
+  public :: mfree_halo_get_size, mfree_halo_get_global_ids, mfree_halo_get_global_offset
+  public :: mfree_halo_get_plan, mfree_halo_exchange
+
+contains
+
+  !> A plan on the communicator comm (an integer handle of `use mpi`). Collective.
+  integer(c_int) function mfree_halo_create(ctx, comm, dim, halo) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer, intent(in) :: comm
+    integer(c_int32_t), intent(in) :: dim
+    type(mfree_halo), intent(out) :: halo
+    st = mfree_halo_create_f_c(ctx%ptr, int(comm, c_int32_t), dim, halo%ptr)
+  end function mfree_halo_create
+
+  !> The same with the communicator already as integer(c_int32_t).
+  integer(c_int) function mfree_halo_create_f(ctx, fcomm, dim, halo) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: fcomm, dim
+    type(mfree_halo), intent(out) :: halo
+    st = mfree_halo_create_f_c(ctx%ptr, fcomm, dim, halo%ptr)
+  end function mfree_halo_create_f
+
+  integer(c_int) function mfree_halo_destroy(halo) result(st)
+    type(mfree_halo), intent(inout) :: halo
+    st = mfree_halo_destroy_c(halo%ptr)
+  end function mfree_halo_destroy
+
+  !> Ghost layer and plan of n_owned particles x(ld, n_owned) with global ids(n_owned).
+  !> Collective.
+  integer(c_int) function mfree_halo_setup(halo, n_owned, x, ld, ids, width) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int32_t), intent(in) :: n_owned
+    real(c_double), intent(in) :: x(*)
+    integer(c_int64_t), intent(in) :: ld
+    integer(c_int64_t), intent(in) :: ids(*)
+    real(c_double), intent(in) :: width
+    st = mfree_halo_setup_c(halo%ptr, n_owned, x, ld, ids, width)
+  end function mfree_halo_setup
+
+  integer(c_int) function mfree_halo_get_size(halo, n_owned, n_ghost) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int32_t), intent(out) :: n_owned, n_ghost
+    st = mfree_halo_get_size_c(halo%ptr, n_owned, n_ghost)
+  end function mfree_halo_get_size
+
+  !> ids(n_owned + n_ghost): owned first, then the ghosts.
+  integer(c_int) function mfree_halo_get_global_ids(halo, ids) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int64_t), intent(out) :: ids(*)
+    st = mfree_halo_get_global_ids_c(halo%ptr, ids)
+  end function mfree_halo_get_global_ids
+
+  integer(c_int) function mfree_halo_get_global_offset(halo, offset, total) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int64_t), intent(out) :: offset, total
+    st = mfree_halo_get_global_offset_c(halo%ptr, offset, total)
+  end function mfree_halo_get_global_offset
+
+  integer(c_int) function mfree_halo_get_plan(halo, n_neighbors, n_send, n_recv) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int32_t), intent(out) :: n_neighbors
+    integer(c_int64_t), intent(out) :: n_send, n_recv
+    st = mfree_halo_get_plan_c(halo%ptr, n_neighbors, n_send, n_recv)
+  end function mfree_halo_get_plan
+
+  !> field(ld, n_owned + n_ghost): components 1..ncomp of the ghost columns from their
+  !> owners. Collective.
+  integer(c_int) function mfree_halo_exchange(halo, ncomp, field, ld) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(inout) :: field(*)
+    integer(c_int64_t), intent(in) :: ld
+    st = mfree_halo_exchange_c(halo%ptr, ncomp, field, ld)
+  end function mfree_halo_exchange
+
+end module mfree_mpi
