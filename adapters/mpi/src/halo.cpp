@@ -21,6 +21,7 @@ struct mfree_halo {
   MPI_Comm graph = MPI_COMM_NULL;     // neighbour graph of the current plan
   int rank = 0, size = 1, dim = 0;
   bool ready = false;
+  bool ids_checked = false;  // the owned ids in ids[0, n_owned) passed the global check
   int32_t n_owned = 0, n_ghost = 0;
   int64_t offset = 0, total = 0;
   std::vector<int> nbrs;                          // neighbour ranks, ascending
@@ -216,9 +217,16 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
   if (st != MFREE_SUCCESS) return st;
   // ids from the host on every rank with particles, or on none: agreed, because the
   // duplicate check below is collective (a rank without particles may pass NULL)
-  int flag[2] = {n_owned > 0 ? (ids ? 1 : 0) : -1, n_owned > 0 ? (ids ? -1 : 0) : -1}, any[2] = {0, 0};
+  // The duplicate check (an all-to-all of every id) is skipped when no rank's owned ids
+  // changed since the last one passed: a rebuild after motion without migration.
+  const bool same = h->ids_checked && ids && n_owned == h->n_owned &&
+                    static_cast<int64_t>(h->ids.size()) >= n_owned &&
+                    std::equal(ids, ids + n_owned, h->ids.begin());
+  h->ids_checked = false;
+  int flag[3] = {n_owned > 0 ? (ids ? 1 : 0) : -1, n_owned > 0 ? (ids ? -1 : 0) : -1, same ? 0 : 1};
+  int any[3] = {0, 0, 0};
   l = run_local([&](Local &r) {
-    mpi_ok(r, MPI_Allreduce(flag, any, 2, MPI_INT, MPI_MAX, h->comm), "MPI_Allreduce");
+    mpi_ok(r, MPI_Allreduce(flag, any, 3, MPI_INT, MPI_MAX, h->comm), "MPI_Allreduce");
     if (!r.st && any[0] == 1 && any[1] == 0 && n_owned > 0 && !ids)
       r.fail(MFREE_ERR_ARG, "no global ids here while other ranks give theirs (all ranks or none)");
   });
@@ -240,7 +248,7 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
            "MPI_Allgather");
     h->ids.resize(static_cast<size_t>(n_owned));
     for (int32_t i = 0; i < n_owned; ++i) h->ids[i] = host_ids ? ids[i] : off + i;
-    if (!host_ids) return;  // numbered here: unique by construction
+    if (!host_ids || any[2] == 0) return;  // numbered here, or unchanged since checked
     std::vector<int> cnt(h->size, 0), rcnt(h->size, 0), sdis(h->size, 0), rdis(h->size, 0);
     for (int32_t i = 0; i < n_owned; ++i) ++cnt[id_owner(ids[i], h->size)];  // (n_owned = 0 if ids is NULL)
     mpi_ok(r, MPI_Alltoall(cnt.data(), 1, MPI_INT, rcnt.data(), 1, MPI_INT, h->comm), "MPI_Alltoall");
@@ -337,6 +345,7 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
   st = agree(h, fn, l);
   if (st != MFREE_SUCCESS) return st;
   h->ready = true;
+  h->ids_checked = host_ids;
   return MFREE_SUCCESS;
 }
 
