@@ -29,7 +29,7 @@ if command -v gnuplot >/dev/null 2>&1; then
   gnuplot -e "set terminal dumb size 90,28; set datafile separator ','; set key top left; \
 set xlabel 'T = t sqrt(2g/a)'; set ylabel 'Z = z/a'; set xrange [0:3.5]; \
 plot '$out/front.csv' using 1:2 with lines title 'mfree front', \
-'$data' using 1:2 with points pt 7 title 'Martin & Moyce (1952)'" 2>/dev/null ||
+'$data' using 1:2 with points pt 'O' title 'Martin & Moyce (1952)'" 2>/dev/null ||
     echo "(gnuplot could not draw the terminal plot)"
 else
   echo "(gnuplot is not installed: no plot; scripts/deps.sh installs gnuplot-nox)"
