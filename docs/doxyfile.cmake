@@ -15,8 +15,8 @@ function(mfree_doxyfile out)
     list(FILTER top EXCLUDE REGEX "/README\\.md$")  # the repository's front page, not the site's
     file(GLOB readmes CONFIGURE_DEPENDS ${src}/data/README.md ${src}/tests/README.md
          ${src}/bench/README.md ${src}/adapters/*/README.md ${src}/bindings/*/README.md)
-    list(APPEND inputs ${src}/docs ${top} ${readmes} ${src}/bindings/fortran/mfree.f90
-         ${src}/bindings/fortran/mfree_suitesparse.f90)
+    file(GLOB modules CONFIGURE_DEPENDS ${src}/bindings/fortran/*.f90)
+    list(APPEND inputs ${src}/docs ${top} ${readmes} ${modules})
   endif()
   string(REPLACE ";" " " MFREE_DOCS_INPUT "${inputs}")
   set(MFREE_DOCS_OUTPUT ${D_OUTPUT})
