@@ -4,7 +4,8 @@
  *  - one rank's setup fails (a NaN position: MFREE_ERR_INPUT; a negative width:
  *    MFREE_ERR_ARG): every rank returns that status with "rank R: <its reason>", the
  *    plan is not set up (get/exchange: MFREE_ERR_STATE) and a correct setup recovers;
- *  - global ids from some ranks only: MFREE_ERR_ARG everywhere;
+ *  - a rank without particles takes part; global ids from some ranks only:
+ *    MFREE_ERR_ARG everywhere;
  *  - a global id given to particles of two ranks (of one rank on one rank):
  *    MFREE_ERR_INPUT everywhere, the message names the id;
  *  - a halo too narrow for the supports: the particle set that declares the plan's width
@@ -78,6 +79,12 @@ int main(int argc, char **argv) {
   expect(ctx, mfree_halo_setup(halo, rank == 0 ? -5 : no, xo, 2, io, width), MFREE_ERR_ARG, "rank 0:",
          "negative count on rank 0");
   CHECK(mfree_halo_setup(halo, no, xo, 2, io, width) == MFREE_SUCCESS, "recovery");
+  /* a rank without particles (NULL positions and ids) takes part and gets no ghosts */
+  CHECK(mfree_halo_setup(halo, rank == last ? 0 : no, rank == last ? NULL : xo, 2, rank == last ? NULL : io,
+                         width) == MFREE_SUCCESS,
+        "a rank without particles");
+  mfree_halo_get_size(halo, &n_owned, &n_ghost);
+  CHECK(rank != last || (n_owned == 0 && n_ghost == 0), "the empty rank holds nothing");
   /* ids on some ranks only (the last gives none): MFREE_ERR_ARG everywhere */
   if (size > 1)
     expect(ctx, mfree_halo_setup(halo, no, xo, 2, rank == last ? NULL : io, width), MFREE_ERR_ARG,
