@@ -7,7 +7,9 @@
  * its apply(GRADIENT) of two exchanged fields must equal the reference bit for bit,
  * 2D and 3D. The ghosts' data must be their owners' (by id), the global numbering an
  * exclusive scan, and after the particles move and the plan is rebuilt the RL rows again
- * equal a one-rank run of the moved cloud. */
+ * equal a one-rank run of the moved cloud. With a plan two support radii wide and the
+ * first layer of ghosts counted as owned, the first layer's rows (RL, KB 1, MLS 2, whose
+ * correction matrices and coefficients they hold) are their owners' bits too. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -113,8 +115,11 @@ static void compare_rows(const rows_t *ref, const rows_t *d, const int64_t *ids,
 }
 
 /* The distributed run of one decomposition, compared with ref (one per method). */
+/* layers = 2: the plan reaches two support radii and the ghosts within one radius of an
+ * owned particle (the first layer) count as owned in the set, so that their rows, and
+ * their correction data, are computed here too and must be their owners' bits. */
 static void run(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, const int *part, rows_t *ref,
-                const method_t *methods, int nmethods, const char *label) {
+                const method_t *methods, int nmethods, int layers, const char *label) {
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   const int dim = c->dim, R = dim + 2;
@@ -136,7 +141,7 @@ static void run(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, cons
     io[k] = c->id[own[k]];
   }
   const double width = KAPPA * cloud_max_support(c) * (1 + 1e-12);
-  mfree_status_t st = mfree_halo_setup(halo, no, xo, dim, io, width);
+  mfree_status_t st = mfree_halo_setup(halo, no, xo, dim, io, layers * width);
   CHECK(st == MFREE_SUCCESS, "%s: halo setup %d", label, (int)st);
   int32_t n_owned = 0, n_ghost = 0;
   mfree_halo_get_size(halo, &n_owned, &n_ghost);
@@ -181,10 +186,46 @@ static void run(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, cons
     CHECK(u[3 * g] == w[0] && u[3 * g + 1] == w[1] && u[3 * g + 2] == 42.0, "%s: strided exchange at %d", label,
           g);
   }
+  /* two layers: first-layer ghosts moved before the second layer and given rows */
+  int nrows = no, set_ghosts = n_ghost;
+  if (layers == 2) {
+    double *rec2 = malloc(sizeof(double) * (size_t)(n * R + 1));
+    int64_t *ids2 = malloc(sizeof(int64_t) * (size_t)(n + 1));
+    int *second = malloc(sizeof(int) * (size_t)(n + 1)), ns = 0;
+    memcpy(rec2, rec, sizeof(double) * (size_t)no * R);
+    memcpy(ids2, ids, sizeof(int64_t) * (size_t)no);
+    for (int g = no; g < n; ++g) {
+      int first = 0;
+      for (int k = 0; k < no && !first; ++k) {
+        double r2 = 0;
+        for (int d = 0; d < dim; ++d) r2 += pow(rec[g * R + d] - rec[k * R + d], 2);
+        first = r2 <= width * width;
+      }
+      if (first) {
+        memcpy(rec2 + (size_t)nrows * R, rec + (size_t)g * R, sizeof(double) * R);
+        ids2[nrows++] = ids[g];
+      } else {
+        second[ns++] = g;
+      }
+    }
+    for (int q = 0; q < ns; ++q) {
+      memcpy(rec2 + (size_t)(nrows + q) * R, rec + (size_t)second[q] * R, sizeof(double) * R);
+      ids2[nrows + q] = ids[second[q]];
+    }
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    CHECK(size == 1 || (nrows > no && ns > 0), "%s: %d first-layer and %d second-layer ghosts", label, nrows - no, ns);
+    set_ghosts = ns;
+    memcpy(rec, rec2, sizeof(double) * (size_t)n * R);
+    memcpy(ids, ids2, sizeof(int64_t) * (size_t)n);
+    free(rec2);
+    free(ids2);
+    free(second);
+  }
   /* the particle set on this rank, borrowing the records */
   mfree_particles_t *ps = NULL;
   mfree_particles_create(ctx, dim, n, &ps);
-  mfree_particles_set_num_ghost(ps, n_ghost);
+  mfree_particles_set_num_ghost(ps, set_ghosts);
   mfree_particles_set_positions(ps, rec, MFREE_LAYOUT_AOS, R, MFREE_BORROW);
   mfree_particles_set_support(ps, rec + dim, R, MFREE_BORROW);
   mfree_particles_set_volumes(ps, rec + dim + 1, R, MFREE_BORROW);
@@ -197,7 +238,7 @@ static void run(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, cons
     char what[128];
     snprintf(what, sizeof what, "%s %s", label, methods[m].name);
     compute_rows(ctx, ps, ids, n, &methods[m], &d);
-    compare_rows(&ref[m], &d, ids, no, what);
+    compare_rows(&ref[m], &d, ids, nrows, what);
     free_rows(&d);
   }
   mfree_particles_destroy(&ps);
@@ -233,7 +274,17 @@ int main(int argc, char **argv) {
       }
       char label[64];
       snprintf(label, sizeof label, "%dD %s on %d ranks", dim, names[how], size);
-      run(ctx, halo, &c, part, ref, kMethods, NMETHODS, label);
+      run(ctx, halo, &c, part, ref, kMethods, NMETHODS, 1, label);
+      if (rank == 0) printf("%s: done\n", label);
+    }
+    /* two layers: the first layer's rows (RL, KB 1, MLS 2: their correction data) too */
+    {
+      const method_t two[3] = {kMethods[1], kMethods[2], kMethods[4]};
+      rows_t ref2[3] = {ref[1], ref[2], ref[4]};
+      char label[64];
+      decompose(&c, DECOMP_SLAB, MPI_COMM_WORLD, part);
+      snprintf(label, sizeof label, "%dD slab, two layers, on %d ranks", dim, size);
+      run(ctx, halo, &c, part, ref2, two, 3, 2, label);
       if (rank == 0) printf("%s: done\n", label);
     }
     /* the particles move: every rank moves the same cloud, the plan is rebuilt */
@@ -246,7 +297,7 @@ int main(int argc, char **argv) {
     decompose(&c, DECOMP_SLAB, MPI_COMM_WORLD, part);
     char label[64];
     snprintf(label, sizeof label, "%dD moved, slab on %d ranks", dim, size);
-    run(ctx, halo, &c, part, &moved, &kMethods[1], 1, label);
+    run(ctx, halo, &c, part, &moved, &kMethods[1], 1, 1, label);
     free_rows(&moved);
     for (int m = 0; m < NMETHODS; ++m) free_rows(&ref[m]);
     free(part);
