@@ -1519,11 +1519,13 @@ contains
 
   ! ==== context ========================================================================
 
+  !> Typed wrapper of mfree_context_create (mfree.h).
   integer(c_int) function mfree_context_create(ctx) result(st)
     type(mfree_context), intent(out) :: ctx
     st = mfree_context_create_c(ctx%ptr)
   end function mfree_context_create
 
+  !> Typed wrapper of mfree_context_destroy (mfree.h).
   integer(c_int) function mfree_context_destroy(ctx) result(st)
     type(mfree_context), intent(inout) :: ctx
     st = mfree_context_destroy_c(ctx%ptr)
@@ -1609,12 +1611,14 @@ contains
     st = mfree_context_set_error_handler_c(ctx%ptr, fp, up)
   end function mfree_context_set_error_handler
 
+  !> Typed wrapper of mfree_context_set_num_threads (mfree.h).
   integer(c_int) function mfree_context_set_num_threads(ctx, nthreads) result(st)
     type(mfree_context), intent(in) :: ctx
     integer(c_int32_t), intent(in) :: nthreads
     st = mfree_context_set_num_threads_c(ctx%ptr, nthreads)
   end function mfree_context_set_num_threads
 
+  !> Typed wrapper of mfree_context_get_num_threads (mfree.h).
   integer(c_int) function mfree_context_get_num_threads(ctx, nthreads) result(st)
     type(mfree_context), intent(in) :: ctx
     integer(c_int32_t), intent(out) :: nthreads
@@ -1661,6 +1665,7 @@ contains
     st = mfree_kernel_eval_c(ctx%ptr, kernel, dim, param, h, n, r, pw, pd, pd2)
   end function mfree_kernel_eval
 
+  !> Typed wrapper of mfree_kernel_get_support_radius (mfree.h).
   integer(c_int) function mfree_kernel_get_support_radius(ctx, kernel, param, radius) &
       result(st)
     type(mfree_context), intent(in) :: ctx
@@ -1670,6 +1675,7 @@ contains
     st = mfree_kernel_get_support_radius_c(ctx%ptr, kernel, param, radius)
   end function mfree_kernel_get_support_radius
 
+  !> Typed wrapper of mfree_kernel_get_normalization (mfree.h).
   integer(c_int) function mfree_kernel_get_normalization(ctx, kernel, dim, param, c) &
       result(st)
     type(mfree_context), intent(in) :: ctx
@@ -1682,6 +1688,7 @@ contains
 
   ! ==== particle sets ==================================================================
 
+  !> Typed wrapper of mfree_particles_create (mfree.h).
   integer(c_int) function mfree_particles_create(ctx, dim, n, ps) result(st)
     type(mfree_context), intent(in) :: ctx
     integer(c_int32_t), intent(in) :: dim, n
@@ -1689,11 +1696,13 @@ contains
     st = mfree_particles_create_c(ctx%ptr, dim, n, ps%ptr)
   end function mfree_particles_create
 
+  !> Typed wrapper of mfree_particles_destroy (mfree.h).
   integer(c_int) function mfree_particles_destroy(ps) result(st)
     type(mfree_particles), intent(inout) :: ps
     st = mfree_particles_destroy_c(ps%ptr)
   end function mfree_particles_destroy
 
+  !> Typed wrapper of mfree_particles_set_num_ghost (mfree.h).
   integer(c_int) function mfree_particles_set_num_ghost(ps, n_ghost) result(st)
     type(mfree_particles), intent(in) :: ps
     integer(c_int32_t), intent(in) :: n_ghost
@@ -1710,6 +1719,7 @@ contains
     st = mfree_particles_set_positions_c(ps%ptr, x, layout, ld, mem)
   end function mfree_particles_set_positions
 
+  !> Typed wrapper of mfree_particles_set_volumes_array (mfree.h).
   integer(c_int) function mfree_particles_set_volumes_array(ps, v, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(in), target :: v(*)
@@ -1718,6 +1728,7 @@ contains
     st = mfree_particles_set_volumes_c(ps%ptr, v, stride, mem)
   end function mfree_particles_set_volumes_array
 
+  !> Typed wrapper of mfree_particles_set_volumes_scalar (mfree.h).
   integer(c_int) function mfree_particles_set_volumes_scalar(ps, v, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(in), target :: v
@@ -1728,6 +1739,7 @@ contains
     st = mfree_particles_set_volumes_c(ps%ptr, p, stride, mem)
   end function mfree_particles_set_volumes_scalar
 
+  !> Typed wrapper of mfree_particles_set_masses_array (mfree.h).
   integer(c_int) function mfree_particles_set_masses_array(ps, m, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(in), target :: m(*)
@@ -1736,6 +1748,7 @@ contains
     st = mfree_particles_set_masses_c(ps%ptr, m, stride, mem)
   end function mfree_particles_set_masses_array
 
+  !> Typed wrapper of mfree_particles_set_masses_scalar (mfree.h).
   integer(c_int) function mfree_particles_set_masses_scalar(ps, m, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(in), target :: m
@@ -1746,6 +1759,7 @@ contains
     st = mfree_particles_set_masses_c(ps%ptr, p, stride, mem)
   end function mfree_particles_set_masses_scalar
 
+  !> Typed wrapper of mfree_particles_set_densities_array (mfree.h).
   integer(c_int) function mfree_particles_set_densities_array(ps, rho, stride, mem) &
       result(st)
     type(mfree_particles), intent(in) :: ps
@@ -1755,6 +1769,7 @@ contains
     st = mfree_particles_set_densities_c(ps%ptr, rho, stride, mem)
   end function mfree_particles_set_densities_array
 
+  !> Typed wrapper of mfree_particles_set_densities_scalar (mfree.h).
   integer(c_int) function mfree_particles_set_densities_scalar(ps, rho, stride, mem) &
       result(st)
     type(mfree_particles), intent(in) :: ps
@@ -1766,6 +1781,7 @@ contains
     st = mfree_particles_set_densities_c(ps%ptr, p, stride, mem)
   end function mfree_particles_set_densities_scalar
 
+  !> Typed wrapper of mfree_particles_set_support_array (mfree.h).
   integer(c_int) function mfree_particles_set_support_array(ps, h, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(in), target :: h(*)
@@ -1774,6 +1790,7 @@ contains
     st = mfree_particles_set_support_c(ps%ptr, h, stride, mem)
   end function mfree_particles_set_support_array
 
+  !> Typed wrapper of mfree_particles_set_support_scalar (mfree.h).
   integer(c_int) function mfree_particles_set_support_scalar(ps, h, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(in), target :: h
@@ -1784,6 +1801,7 @@ contains
     st = mfree_particles_set_support_c(ps%ptr, p, stride, mem)
   end function mfree_particles_set_support_scalar
 
+  !> Typed wrapper of mfree_particles_set_search (mfree.h).
   integer(c_int) function mfree_particles_set_search(ps, convention, kappa) result(st)
     type(mfree_particles), intent(in) :: ps
     integer(c_int), intent(in) :: convention
@@ -1791,6 +1809,7 @@ contains
     st = mfree_particles_set_search_c(ps%ptr, convention, kappa)
   end function mfree_particles_set_search
 
+  !> Typed wrapper of mfree_particles_set_periodic (mfree.h).
   integer(c_int) function mfree_particles_set_periodic(ps, lo, hi, periodic) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(in) :: lo(*), hi(*)
@@ -1819,34 +1838,40 @@ contains
     st = mfree_particles_set_global_ids_c(ps%ptr, ids, mem)
   end function mfree_particles_set_global_ids
 
+  !> Typed wrapper of mfree_particles_get_global_ids (mfree.h).
   integer(c_int) function mfree_particles_get_global_ids(ps, ids) result(st)
     type(mfree_particles), intent(in) :: ps
     integer(c_int64_t), intent(out) :: ids(*)
     st = mfree_particles_get_global_ids_c(ps%ptr, ids)
   end function mfree_particles_get_global_ids
 
+  !> Typed wrapper of mfree_particles_set_halo_width (mfree.h).
   integer(c_int) function mfree_particles_set_halo_width(ps, w) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(in) :: w
     st = mfree_particles_set_halo_width_c(ps%ptr, w)
   end function mfree_particles_set_halo_width
 
+  !> Typed wrapper of mfree_particles_setup (mfree.h).
   integer(c_int) function mfree_particles_setup(ps) result(st)
     type(mfree_particles), intent(in) :: ps
     st = mfree_particles_setup_c(ps%ptr)
   end function mfree_particles_setup
 
+  !> Typed wrapper of mfree_particles_update (mfree.h).
   integer(c_int) function mfree_particles_update(ps) result(st)
     type(mfree_particles), intent(in) :: ps
     st = mfree_particles_update_c(ps%ptr)
   end function mfree_particles_update
 
+  !> Typed wrapper of mfree_particles_get_dimension (mfree.h).
   integer(c_int) function mfree_particles_get_dimension(ps, dim) result(st)
     type(mfree_particles), intent(in) :: ps
     integer(c_int32_t), intent(out) :: dim
     st = mfree_particles_get_dimension_c(ps%ptr, dim)
   end function mfree_particles_get_dimension
 
+  !> Typed wrapper of mfree_particles_get_size (mfree.h).
   integer(c_int) function mfree_particles_get_size(ps, n, n_ghost) result(st)
     type(mfree_particles), intent(in) :: ps
     integer(c_int32_t), intent(out), optional, target :: n, n_ghost
@@ -1858,6 +1883,7 @@ contains
     st = mfree_particles_get_size_c(ps%ptr, pn, pg)
   end function mfree_particles_get_size
 
+  !> Typed wrapper of mfree_particles_get_neighbor_nnz (mfree.h).
   integer(c_int) function mfree_particles_get_neighbor_nnz(ps, nnz) result(st)
     type(mfree_particles), intent(in) :: ps
     integer(c_int64_t), intent(out) :: nnz
@@ -1872,12 +1898,14 @@ contains
     st = mfree_particles_get_neighbors_c(ps%ptr, rowptr, cols)
   end function mfree_particles_get_neighbors
 
+  !> Typed wrapper of mfree_particles_get_volumes (mfree.h).
   integer(c_int) function mfree_particles_get_volumes(ps, v) result(st)
     type(mfree_particles), intent(in) :: ps
     real(c_double), intent(out) :: v(*)
     st = mfree_particles_get_volumes_c(ps%ptr, v)
   end function mfree_particles_get_volumes
 
+  !> Typed wrapper of mfree_particles_get_site_status (mfree.h).
   integer(c_int) function mfree_particles_get_site_status(ps, status, nfailed) result(st)
     type(mfree_particles), intent(in) :: ps
     integer(c_int32_t), intent(out), optional, target :: status(*)
@@ -1892,6 +1920,7 @@ contains
 
   ! ==== approximants ===================================================================
 
+  !> Typed wrapper of mfree_approximant_create (mfree.h).
   integer(c_int) function mfree_approximant_create(ctx, ps, method, a) result(st)
     type(mfree_context), intent(in) :: ctx
     type(mfree_particles), intent(in) :: ps
@@ -1900,11 +1929,13 @@ contains
     st = mfree_approximant_create_c(ctx%ptr, ps%ptr, method, a%ptr)
   end function mfree_approximant_create
 
+  !> Typed wrapper of mfree_approximant_destroy (mfree.h).
   integer(c_int) function mfree_approximant_destroy(a) result(st)
     type(mfree_approximant), intent(inout) :: a
     st = mfree_approximant_destroy_c(a%ptr)
   end function mfree_approximant_destroy
 
+  !> Typed wrapper of mfree_approximant_set_kernel (mfree.h).
   integer(c_int) function mfree_approximant_set_kernel(a, kernel, param) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int), intent(in) :: kernel
@@ -1921,11 +1952,13 @@ contains
     st = mfree_mesh_create_c(ctx%ptr, ps%ptr, mesh%ptr)
   end function mfree_mesh_create
 
+  !> Typed wrapper of mfree_mesh_destroy (mfree.h).
   integer(c_int) function mfree_mesh_destroy(mesh) result(st)
     type(mfree_mesh), intent(inout) :: mesh
     st = mfree_mesh_destroy_c(mesh%ptr)
   end function mfree_mesh_destroy
 
+  !> Typed wrapper of mfree_mesh_add_elements (mfree.h).
   integer(c_int) function mfree_mesh_add_elements(mesh, type, nelem, conn, index_base, mem) &
       result(st)
     type(mfree_mesh), intent(in) :: mesh
@@ -1937,11 +1970,13 @@ contains
     st = mfree_mesh_add_elements_c(mesh%ptr, type, nelem, conn, index_base, mem)
   end function mfree_mesh_add_elements
 
+  !> Typed wrapper of mfree_mesh_setup (mfree.h).
   integer(c_int) function mfree_mesh_setup(mesh) result(st)
     type(mfree_mesh), intent(in) :: mesh
     st = mfree_mesh_setup_c(mesh%ptr)
   end function mfree_mesh_setup
 
+  !> Typed wrapper of mfree_mesh_get_size (mfree.h).
   integer(c_int) function mfree_mesh_get_size(mesh, nelem) result(st)
     type(mfree_mesh), intent(in) :: mesh
     integer(c_int32_t), intent(out) :: nelem
@@ -1962,12 +1997,14 @@ contains
     st = mfree_mesh_get_quadrature_c(mesh%ptr, ngauss, npts, px, pw)
   end function mfree_mesh_get_quadrature
 
+  !> Typed wrapper of mfree_approximant_set_mesh (mfree.h).
   integer(c_int) function mfree_approximant_set_mesh(a, mesh) result(st)
     type(mfree_approximant), intent(in) :: a
     type(mfree_mesh), intent(in) :: mesh
     st = mfree_approximant_set_mesh_c(a%ptr, mesh%ptr)
   end function mfree_approximant_set_mesh
 
+  !> Typed wrapper of mfree_approximant_set_mpfem (mfree.h).
   integer(c_int) function mfree_approximant_set_mpfem(a, deriv, ngauss) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int), intent(in) :: deriv
@@ -1975,6 +2012,7 @@ contains
     st = mfree_approximant_set_mpfem_c(a%ptr, deriv, ngauss)
   end function mfree_approximant_set_mpfem
 
+  !> Typed wrapper of mfree_approximant_set_order (mfree.h).
   integer(c_int) function mfree_approximant_set_order(a, order) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int32_t), intent(in) :: order
@@ -1988,12 +2026,14 @@ contains
     st = mfree_approximant_set_derivatives_c(a%ptr, flags)
   end function mfree_approximant_set_derivatives
 
+  !> Typed wrapper of mfree_approximant_set_fallback (mfree.h).
   integer(c_int) function mfree_approximant_set_fallback(a, policy) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int), intent(in) :: policy
     st = mfree_approximant_set_fallback_c(a%ptr, policy)
   end function mfree_approximant_set_fallback
 
+  !> Typed wrapper of mfree_approximant_set_points_array (mfree.h).
   integer(c_int) function mfree_approximant_set_points_array(a, npts, x, layout, ld, h, &
                                                              h_stride, mem) result(st)
     type(mfree_approximant), intent(in) :: a
@@ -2004,6 +2044,7 @@ contains
     st = mfree_approximant_set_points_c(a%ptr, npts, x, layout, ld, h, h_stride, mem)
   end function mfree_approximant_set_points_array
 
+  !> Typed wrapper of mfree_approximant_set_points_scalar (mfree.h).
   integer(c_int) function mfree_approximant_set_points_scalar(a, npts, x, layout, ld, h, &
                                                               h_stride, mem) result(st)
     type(mfree_approximant), intent(in) :: a
@@ -2017,11 +2058,13 @@ contains
     st = mfree_approximant_set_points_c(a%ptr, npts, x, layout, ld, p, h_stride, mem)
   end function mfree_approximant_set_points_scalar
 
+  !> Typed wrapper of mfree_approximant_setup (mfree.h).
   integer(c_int) function mfree_approximant_setup(a) result(st)
     type(mfree_approximant), intent(in) :: a
     st = mfree_approximant_setup_c(a%ptr)
   end function mfree_approximant_setup
 
+  !> Typed wrapper of mfree_approximant_update (mfree.h).
   integer(c_int) function mfree_approximant_update(a) result(st)
     type(mfree_approximant), intent(in) :: a
     st = mfree_approximant_update_c(a%ptr)
@@ -2042,6 +2085,7 @@ contains
     st = mfree_approximant_apply_c(a%ptr, op, ncomp, u, ulayout, uld, out, olayout, old)
   end function mfree_approximant_apply
 
+  !> Typed wrapper of mfree_approximant_apply_add (mfree.h).
   integer(c_int) function mfree_approximant_apply_add(a, op, ncomp, u, ulayout, uld, out, &
                                                       olayout, old) result(st)
     type(mfree_approximant), intent(in) :: a
@@ -2054,12 +2098,14 @@ contains
                                        old)
   end function mfree_approximant_apply_add
 
+  !> Typed wrapper of mfree_approximant_get_num_sites (mfree.h).
   integer(c_int) function mfree_approximant_get_num_sites(a, nsites) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int32_t), intent(out) :: nsites
     st = mfree_approximant_get_num_sites_c(a%ptr, nsites)
   end function mfree_approximant_get_num_sites
 
+  !> Typed wrapper of mfree_approximant_get_nnz (mfree.h).
   integer(c_int) function mfree_approximant_get_nnz(a, nnz) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int64_t), intent(out) :: nnz
@@ -2085,6 +2131,7 @@ contains
     st = mfree_approximant_assemble_csr_c(a%ptr, deriv, component, pr, pc, pv)
   end function mfree_approximant_assemble_csr
 
+  !> Typed wrapper of mfree_approximant_check_reproduction (mfree.h).
   integer(c_int) function mfree_approximant_check_reproduction(a, order, fn_err, deriv_err) &
       result(st)
     type(mfree_approximant), intent(in) :: a
@@ -2093,6 +2140,7 @@ contains
     st = mfree_approximant_check_reproduction_c(a%ptr, order, fn_err, deriv_err)
   end function mfree_approximant_check_reproduction
 
+  !> Typed wrapper of mfree_approximant_get_site_status (mfree.h).
   integer(c_int) function mfree_approximant_get_site_status(a, status, nfailed) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int32_t), intent(out), optional, target :: status(*)
@@ -2105,18 +2153,21 @@ contains
     st = mfree_approximant_get_site_status_c(a%ptr, pstat, pf)
   end function mfree_approximant_get_site_status
 
+  !> Typed wrapper of mfree_approximant_get_neighbor_counts (mfree.h).
   integer(c_int) function mfree_approximant_get_neighbor_counts(a, counts) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int32_t), intent(out) :: counts(*)
     st = mfree_approximant_get_neighbor_counts_c(a%ptr, counts)
   end function mfree_approximant_get_neighbor_counts
 
+  !> Typed wrapper of mfree_approximant_get_condition (mfree.h).
   integer(c_int) function mfree_approximant_get_condition(a, cond) result(st)
     type(mfree_approximant), intent(in) :: a
     real(c_double), intent(out) :: cond(*)
     st = mfree_approximant_get_condition_c(a%ptr, cond)
   end function mfree_approximant_get_condition
 
+  !> Typed wrapper of mfree_approximant_get_site_order (mfree.h).
   integer(c_int) function mfree_approximant_get_site_order(a, order) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int32_t), intent(out) :: order(*)
@@ -2137,11 +2188,13 @@ contains
     st = mfree_matrix_create_csr_c(ctx%ptr, nrows, ncols, rowptr, cols, vals, A%ptr)
   end function mfree_matrix_create_csr
 
+  !> Typed wrapper of mfree_matrix_destroy (mfree.h).
   integer(c_int) function mfree_matrix_destroy(A) result(st)
     type(mfree_matrix), intent(inout) :: A
     st = mfree_matrix_destroy_c(A%ptr)
   end function mfree_matrix_destroy
 
+  !> Typed wrapper of mfree_matrix_get_size (mfree.h).
   integer(c_int) function mfree_matrix_get_size(A, nrows, ncols, nnz) result(st)
     type(mfree_matrix), intent(in) :: A
     integer(c_int32_t), intent(out), optional, target :: nrows, ncols
@@ -2269,18 +2322,21 @@ contains
     end if
   end function mfree_matrix_get_csc
 
+  !> Typed wrapper of mfree_matrix_get_pattern_id (mfree.h).
   integer(c_int) function mfree_matrix_get_pattern_id(A, id) result(st)
     type(mfree_matrix), intent(in) :: A
     integer(c_int64_t), intent(out) :: id
     st = mfree_matrix_get_pattern_id_c(A%ptr, id)
   end function mfree_matrix_get_pattern_id
 
+  !> Typed wrapper of mfree_matrix_get_symmetric (mfree.h).
   integer(c_int) function mfree_matrix_get_symmetric(A, symmetric) result(st)
     type(mfree_matrix), intent(in) :: A
     integer(c_int32_t), intent(out) :: symmetric
     st = mfree_matrix_get_symmetric_c(A%ptr, symmetric)
   end function mfree_matrix_get_symmetric
 
+  !> Typed wrapper of mfree_matrix_apply (mfree.h).
   integer(c_int) function mfree_matrix_apply(A, x, y) result(st)
     type(mfree_matrix), intent(in) :: A
     real(c_double), intent(in) :: x(*)
@@ -2299,23 +2355,27 @@ contains
     st = mfree_assembler_create_c(ctx%ptr, trial%ptr, test%ptr, form, as%ptr)
   end function mfree_assembler_create
 
+  !> Typed wrapper of mfree_assembler_destroy (mfree.h).
   integer(c_int) function mfree_assembler_destroy(as) result(st)
     type(mfree_assembler), intent(inout) :: as
     st = mfree_assembler_destroy_c(as%ptr)
   end function mfree_assembler_destroy
 
+  !> Typed wrapper of mfree_assembler_set_material (mfree.h).
   integer(c_int) function mfree_assembler_set_material(as, young, poisson) result(st)
     type(mfree_assembler), intent(in) :: as
     real(c_double), intent(in) :: young, poisson
     st = mfree_assembler_set_material_c(as%ptr, young, poisson)
   end function mfree_assembler_set_material
 
+  !> Typed wrapper of mfree_assembler_set_coefficient (mfree.h).
   integer(c_int) function mfree_assembler_set_coefficient(as, c) result(st)
     type(mfree_assembler), intent(in) :: as
     real(c_double), intent(in) :: c
     st = mfree_assembler_set_coefficient_c(as%ptr, c)
   end function mfree_assembler_set_coefficient
 
+  !> Typed wrapper of mfree_assembler_set_quadrature_nodal (mfree.h).
   integer(c_int) function mfree_assembler_set_quadrature_nodal(as) result(st)
     type(mfree_assembler), intent(in) :: as
     st = mfree_assembler_set_quadrature_nodal_c(as%ptr)
@@ -2337,6 +2397,7 @@ contains
                                                 user_ptr(user))
   end function mfree_assembler_set_quadrature_cells
 
+  !> Typed wrapper of mfree_assembler_set_quadrature_points (mfree.h).
   integer(c_int) function mfree_assembler_set_quadrature_points(as, npts, x, layout, ld, w) &
       result(st)
     type(mfree_assembler), intent(in) :: as
@@ -2358,6 +2419,7 @@ contains
     st = mfree_assembler_set_body_force_c(as%ptr, fp, user_ptr(user))
   end function mfree_assembler_set_body_force
 
+  !> Typed wrapper of mfree_assembler_add_traction (mfree.h).
   integer(c_int) function mfree_assembler_add_traction(as, npts, x, layout, ld, w, t, user) &
       result(st)
     type(mfree_assembler), intent(in) :: as
@@ -2371,6 +2433,7 @@ contains
                                         user_ptr(user))
   end function mfree_assembler_add_traction
 
+  !> Typed wrapper of mfree_assembler_add_traction_segments (mfree.h).
   integer(c_int) function mfree_assembler_add_traction_segments(as, nseg, x, ngauss, t, &
                                                                 user) result(st)
     type(mfree_assembler), intent(in) :: as
@@ -2452,6 +2515,7 @@ contains
                                         ngu, gu, component_mask, c_funloc(g), user_ptr(user))
   end function mfree_assembler_set_fe_layer
 
+  !> Typed wrapper of mfree_assembler_set_penalty (mfree.h).
   integer(c_int) function mfree_assembler_set_penalty(as, alpha) result(st)
     type(mfree_assembler), intent(in) :: as
     real(c_double), intent(in) :: alpha
@@ -2470,16 +2534,19 @@ contains
     st = mfree_assembler_set_consistent_integration_c(as%ptr, npts, x, layout, ld, w, normals)
   end function mfree_assembler_set_consistent_integration
 
+  !> Typed wrapper of mfree_assembler_setup (mfree.h).
   integer(c_int) function mfree_assembler_setup(as) result(st)
     type(mfree_assembler), intent(in) :: as
     st = mfree_assembler_setup_c(as%ptr)
   end function mfree_assembler_setup
 
+  !> Typed wrapper of mfree_assembler_update (mfree.h).
   integer(c_int) function mfree_assembler_update(as) result(st)
     type(mfree_assembler), intent(in) :: as
     st = mfree_assembler_update_c(as%ptr)
   end function mfree_assembler_update
 
+  !> Typed wrapper of mfree_assembler_get_size (mfree.h).
   integer(c_int) function mfree_assembler_get_size(as, ndofs, nquad) result(st)
     type(mfree_assembler), intent(in) :: as
     integer(c_int32_t), intent(out), optional, target :: ndofs, nquad
@@ -2498,6 +2565,7 @@ contains
     st = mfree_assembler_assemble_matrix_c(as%ptr, K%ptr)
   end function mfree_assembler_assemble_matrix
 
+  !> Typed wrapper of mfree_assembler_assemble_rhs (mfree.h).
   integer(c_int) function mfree_assembler_assemble_rhs(as, f) result(st)
     type(mfree_assembler), intent(in) :: as
     real(c_double), intent(out) :: f(*)
@@ -2515,6 +2583,7 @@ contains
     st = mfree_system_create_fluid_c(ctx%ptr, dim, n, sys%ptr)
   end function mfree_system_create_fluid
 
+  !> Typed wrapper of mfree_system_destroy (mfree.h).
   integer(c_int) function mfree_system_destroy(sys) result(st)
     type(mfree_system), intent(inout) :: sys
     st = mfree_system_destroy_c(sys%ptr)
@@ -2530,6 +2599,7 @@ contains
     st = mfree_system_set_fluid_c(sys%ptr, rho0, stride, kappa, gamma, mu)
   end function mfree_system_set_fluid_array
 
+  !> Typed wrapper of mfree_system_set_fluid_scalar (mfree.h).
   integer(c_int) function mfree_system_set_fluid_scalar(sys, rho0, stride, kappa, gamma, mu) &
       result(st)
     type(mfree_system), intent(in) :: sys
@@ -2541,6 +2611,7 @@ contains
     st = mfree_system_set_fluid_c(sys%ptr, one, stride, kappa, gamma, mu)
   end function mfree_system_set_fluid_scalar
 
+  !> Typed wrapper of mfree_system_set_masses_array (mfree.h).
   integer(c_int) function mfree_system_set_masses_array(sys, m, stride) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: m(*)
@@ -2548,6 +2619,7 @@ contains
     st = mfree_system_set_masses_c(sys%ptr, m, stride)
   end function mfree_system_set_masses_array
 
+  !> Typed wrapper of mfree_system_set_masses_scalar (mfree.h).
   integer(c_int) function mfree_system_set_masses_scalar(sys, m, stride) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: m
@@ -2557,18 +2629,21 @@ contains
     st = mfree_system_set_masses_c(sys%ptr, one, stride)
   end function mfree_system_set_masses_scalar
 
+  !> Typed wrapper of mfree_system_set_smoothing (mfree.h).
   integer(c_int) function mfree_system_set_smoothing(sys, h) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: h
     st = mfree_system_set_smoothing_c(sys%ptr, h)
   end function mfree_system_set_smoothing
 
+  !> Typed wrapper of mfree_system_set_gravity (mfree.h).
   integer(c_int) function mfree_system_set_gravity(sys, g) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: g(*)
     st = mfree_system_set_gravity_c(sys%ptr, g)
   end function mfree_system_set_gravity
 
+  !> Typed wrapper of mfree_system_set_lumping (mfree.h).
   integer(c_int) function mfree_system_set_lumping(sys, lump) result(st)
     type(mfree_system), intent(in) :: sys
     integer(c_int), intent(in) :: lump
@@ -2616,18 +2691,21 @@ contains
     st = mfree_system_set_velocity_smoothing_c(sys%ptr, beta)
   end function mfree_system_set_velocity_smoothing
 
+  !> Typed wrapper of mfree_system_set_box (mfree.h).
   integer(c_int) function mfree_system_set_box(sys, lo, hi) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: lo(*), hi(*)
     st = mfree_system_set_box_c(sys%ptr, lo, hi)
   end function mfree_system_set_box
 
+  !> Typed wrapper of mfree_system_get_size (mfree.h).
   integer(c_int) function mfree_system_get_size(sys, neq) result(st)
     type(mfree_system), intent(in) :: sys
     integer(c_int32_t), intent(out) :: neq
     st = mfree_system_get_size_c(sys%ptr, neq)
   end function mfree_system_get_size
 
+  !> Typed wrapper of mfree_system_rhs (mfree.h).
   integer(c_int) function mfree_system_rhs(sys, t, y, ydot) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: t
@@ -2645,6 +2723,7 @@ contains
     st = mfree_system_assemble_mass_c(sys%ptr, y, consistent, M%ptr)
   end function mfree_system_assemble_mass
 
+  !> Typed wrapper of mfree_system_assemble_interpolation (mfree.h).
   integer(c_int) function mfree_system_assemble_interpolation(sys, y, S) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: y(*)
@@ -2652,6 +2731,7 @@ contains
     st = mfree_system_assemble_interpolation_c(sys%ptr, y, S%ptr)
   end function mfree_system_assemble_interpolation
 
+  !> Typed wrapper of mfree_system_get_pressure (mfree.h).
   integer(c_int) function mfree_system_get_pressure(sys, y, p) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: y(*)
@@ -2659,6 +2739,7 @@ contains
     st = mfree_system_get_pressure_c(sys%ptr, y, p)
   end function mfree_system_get_pressure
 
+  !> Typed wrapper of mfree_system_get_velocity (mfree.h).
   integer(c_int) function mfree_system_get_velocity(sys, y, vhat) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: y(*)

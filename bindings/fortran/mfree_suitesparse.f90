@@ -100,6 +100,7 @@ module mfree_suitesparse
 
 contains
 
+  !> Typed wrapper of mfree_suitesparse_create (mfree_suitesparse.h).
   integer(c_int) function mfree_suitesparse_create(ctx, kind, s) result(st)
     type(mfree_context), intent(in) :: ctx
     integer(c_int), intent(in) :: kind
@@ -107,6 +108,7 @@ contains
     st = mfree_suitesparse_create_c(ctx%ptr, kind, s%ptr)
   end function mfree_suitesparse_create
 
+  !> Typed wrapper of mfree_suitesparse_destroy (mfree_suitesparse.h).
   integer(c_int) function mfree_suitesparse_destroy(s) result(st)
     type(mfree_solver), intent(inout) :: s
     st = mfree_suitesparse_destroy_c(s%ptr)
@@ -126,12 +128,14 @@ contains
     st = mfree_suitesparse_set_rcond_threshold_c(s%ptr, threshold)
   end function mfree_suitesparse_set_rcond_threshold
 
+  !> Typed wrapper of mfree_suitesparse_setup (mfree_suitesparse.h).
   integer(c_int) function mfree_suitesparse_setup(s, A) result(st)
     type(mfree_solver), intent(in) :: s
     type(mfree_matrix), intent(in) :: A
     st = mfree_suitesparse_setup_c(s%ptr, A%ptr)
   end function mfree_suitesparse_setup
 
+  !> Typed wrapper of mfree_suitesparse_update (mfree_suitesparse.h).
   integer(c_int) function mfree_suitesparse_update(s, A) result(st)
     type(mfree_solver), intent(in) :: s
     type(mfree_matrix), intent(in) :: A
