@@ -6,10 +6,10 @@
 # clang: the libFuzzer harness (fuzz/); valgrind: the memory-check label; doxygen: the
 # API reference and guide (docs target, test t908); gnuplot-nox: the examples' plots;
 # libopenmpi-dev, openmpi-bin: libmfree_mpi and the mpi tests; libtrilinos-zoltan-dev:
-# partitions in the MPI examples and tests.
+# partitions in the MPI examples and tests; libpetsc-real-dev: libmfree_petsc.
 set -euo pipefail
 
-MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev abigail-tools clang valgrind libnanoflann-dev doxygen gnuplot-nox libopenmpi-dev openmpi-bin libtrilinos-zoltan-dev"
+MFREE_DEB_PACKAGES="build-essential cmake pkg-config libeigen3-dev libcmocka-dev libsuitesparse-dev gfortran libsundials-dev abigail-tools clang valgrind libnanoflann-dev doxygen gnuplot-nox libopenmpi-dev openmpi-bin libtrilinos-zoltan-dev libpetsc-real-dev"
 
 if ! command -v dpkg-query >/dev/null 2>&1; then
   echo "deps.sh: dpkg-query not found: this script is for Debian/Ubuntu." >&2

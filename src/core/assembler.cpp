@@ -1108,6 +1108,14 @@ void Assembler::build_pattern() {
     }
 }
 
+void Assembler::quadrature_order() {
+  // Background and host points keep the host's order; nodal quadrature points are
+  // particles, taken in the set's canonical order.
+  const int32_t nq = collocation() ? 0 : qtrial_.size();
+  qorder_.resize(static_cast<size_t>(nq));
+  for (int32_t q = 0; q < nq; ++q) qorder_[q] = q;
+}
+
 Report Assembler::setup() {
   if (!ps_->is_setup()) throw Error(MFREE_ERR_STATE, "the particle set is not set up");
   // nodal quadrature weighs every particle with its volume (000 eq 95)
@@ -1120,6 +1128,7 @@ Report Assembler::setup() {
   Report rep = build_tables();
   build_qtables();
   build_pattern();
+  quadrature_order();
   // diagnostics: quadrature points outside every support; particles no point sees
   const Approximant &trial = *trial_q_;
   int64_t bad_q = 0;
@@ -1127,7 +1136,9 @@ Report Assembler::setup() {
     if (trial.site_status()[s] != 0 || trial.rowptr()[s + 1] == trial.rowptr()[s]) ++bad_q;
   if (bad_q && rep.ok())
     rep.fail(MFREE_FAIL_NEIGHBORS, std::to_string(bad_q) + " quadrature points are outside every support or failed");
-  for (int32_t d = 0; d < ps_->size() * ncomp_; ++d)
+  // Only owned rows: a ghost beyond the quadrature points' reach has an empty row, which
+  // is no fault (its rows belong to the rank that owns it).
+  for (int32_t d = 0; d < ps_->num_owned() * ncomp_; ++d)
     if (rowptr_[d + 1] == rowptr_[d] && row_kind_[d] == 0) {
       rep.fail(MFREE_FAIL_NEIGHBORS, "particle " + std::to_string(d / ncomp_) +
                                          " is seen by no quadrature point: its row of the matrix is zero");
@@ -1205,7 +1216,7 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
   } else if (form_ == MFREE_FORM_MASS || form_ == MFREE_FORM_MASS_LUMPED) {
     const QTable &qa = qtrial_, &qb = test_table();
     const auto &Pv = qa.val, &Tv = qb.val;
-    for (int32_t q = 0; q < qa.size(); ++q) {
+    for (int32_t q : qorder_) {
       const double w = qa.w[q];
       for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a)
         for (int64_t b = qa.rowptr[q]; b < qa.rowptr[q + 1]; ++b) {
@@ -1229,8 +1240,10 @@ void Assembler::assemble_matrix(SparseMatrix &K) const {
     for (int32_t J : qb.cols) ++tp[static_cast<size_t>(J) + 1];
     for (int32_t J = 0; J < nn; ++J) tp[J + 1] += tp[J];
     {
+      // each row's quadrature points in the canonical order, so that every entry is
+      // summed in the same order whatever the local numbering
       std::vector<int64_t> next(tp.begin(), tp.end() - 1);
-      for (int32_t q = 0; q < qb.size(); ++q)
+      for (int32_t q : qorder_)
         for (int64_t a = qb.rowptr[q]; a < qb.rowptr[q + 1]; ++a) {
           const int64_t k = next[qb.cols[a]]++;
           tq[k] = q;
@@ -1397,7 +1410,7 @@ void Assembler::assemble_rhs(double *f) const {
   } else if (!mass()) {
     if (body_ && load_q_) {
       const Approximant &L = *load_q_;
-      for (int32_t q = 0; q < L.num_sites(); ++q) {
+      for (int32_t q : qorder_) {
         const double w = quad_kind_ == 0 ? ps_->volume(q) : qw_[q];
         for (int d = 0; d < dim; ++d) x[d] = quad_kind_ == 0 ? ps_->x(q, d) : qx_[static_cast<size_t>(q) * dim + d];
         body_(body_user_, x, val);

@@ -142,6 +142,11 @@ class Assembler {
   void read_points(int32_t npts, const double *x, int layout, int64_t ld, std::vector<double> &out) const;
   Report build_tables();
   void build_pattern();
+  // The order in which the quadrature points' contributions are summed (qorder_): the
+  // host's order of background or host points; for nodal quadrature the particles in
+  // the set's canonical (global-id) order, so that a rank's rows of its owned nodes equal
+  // the one-rank rows bit for bit.
+  void quadrature_order();
   void material_matrix(double *D, int &nv) const;
   // Traction operator: (sigma(u) n)_c = sum_e T[c][e] u_e for the field u = phi e_e with
   // gradient g (elasticity), or c n.g (Laplace, T[0][0]).
@@ -179,6 +184,7 @@ class Assembler {
   std::vector<int32_t> row_set_, row_node_;  // which node set / position replaces the row
   FeLayer fe_;
   QTable qtrial_, qtest_;
+  std::vector<int32_t> qorder_;  // quadrature points in summation order
   bool own_test_table_ = false;
   std::vector<QTable> ps_test_, ps_trial_;  // per point set (same order as psets_)
 };
