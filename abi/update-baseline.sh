@@ -31,3 +31,5 @@ write "$build/adapters/sundials/libmfree_sundials.so" libmfree_sundials.abi \
       adapters/sundials/include include "$build/include"
 write "$build/adapters/mpi/libmfree_mpi.so" libmfree_mpi.abi \
       adapters/mpi/include include "$build/include"
+write "$build/adapters/petsc/libmfree_petsc.so" libmfree_petsc.abi \
+      adapters/petsc/include include "$build/include"

@@ -299,9 +299,7 @@ mfree_status_t pk_system(mfree_context_t *ctx, const pk_problem_t *p, const pk_l
   TRY(mfree_particles_set_volumes(s->ps, vol, 1, MFREE_COPY));
   TRY(mfree_particles_set_support(s->ps, &p->h, 0, MFREE_COPY));
   TRY(mfree_particles_set_num_ghost(s->ps, l->nghost));
-#ifdef MFREE_PKTEST_GLOBAL_IDS
   TRY(mfree_particles_set_global_ids(s->ps, l->gid, MFREE_COPY));
-#endif
   TRY(mfree_particles_setup(s->ps));
   TRY(mfree_approximant_create(ctx, s->ps, MFREE_METHOD_MLS, &s->ap));
   TRY(mfree_approximant_set_order(s->ap, 1));
