@@ -358,3 +358,12 @@ void pk_dirichlet(const pk_problem_t *p, const pk_local_t *l, int32_t *n, int32_
   }
   *n = m;
 }
+
+int pk_main(int *argc, char ***argv, const struct CMUnitTest *tests, size_t n, int *rank, int *size) {
+  if (PetscInitialize(argc, argv, NULL, NULL)) return 1;
+  MPI_Comm_rank(PETSC_COMM_WORLD, rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, size);
+  const int rc = _cmocka_run_group_tests("tests", tests, n, NULL, NULL);
+  PetscFinalize();
+  return rc;
+}

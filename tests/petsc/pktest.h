@@ -75,4 +75,8 @@ void pk_beam_exact(const pk_problem_t *p, const double *x, double *u);
  * values (caller frees). */
 void pk_dirichlet(const pk_problem_t *p, const pk_local_t *l, int32_t *n, int32_t **dofs, double **vals);
 
+/* PetscInitialize, the rank and size of PETSC_COMM_WORLD, the cmocka tests, PetscFinalize:
+ * the main program of a test. */
+int pk_main(int *argc, char ***argv, const struct CMUnitTest *tests, size_t n, int *rank, int *size);
+
 #endif

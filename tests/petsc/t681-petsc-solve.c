@@ -105,15 +105,10 @@ static void block(void **state) {
 }
 
 int main(int argc, char **argv) {
-  if (PetscInitialize(&argc, &argv, NULL, NULL)) return 1;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank_);
-  MPI_Comm_size(PETSC_COMM_WORLD, &size_);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(beam_nodal),
       cmocka_unit_test(beam_gauss),
       cmocka_unit_test(block),
   };
-  const int rc = cmocka_run_group_tests(tests, NULL, NULL);
-  PetscFinalize();
-  return rc;
+  return pk_main(&argc, &argv, tests, sizeof tests / sizeof tests[0], &rank_, &size_);
 }
