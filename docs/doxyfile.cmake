@@ -9,7 +9,8 @@ function(mfree_doxyfile out)
   set(src ${PROJECT_SOURCE_DIR})
   set(inputs ${src}/include/mfree.h ${src}/adapters/sundials/include/mfree_sundials.h
              ${src}/adapters/suitesparse/include/mfree_suitesparse.h
-             ${src}/adapters/mpi/include/mfree_mpi.h)
+             ${src}/adapters/mpi/include/mfree_mpi.h
+             ${src}/adapters/petsc/include/mfree_petsc.h)
   if(NOT D_HEADERS_ONLY)
     file(GLOB top CONFIGURE_DEPENDS ${src}/*.md)
     list(FILTER top EXCLUDE REGEX "/README\\.md$")  # the repository's front page, not the site's

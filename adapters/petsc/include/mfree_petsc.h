@@ -18,9 +18,9 @@
  * one rank, the particle set must hold every particle within two support radii of an
  * owned node (the quadrature points that see an owned node, and their neighbours), and
  * with nodal quadrature the particles within one support radius of an owned node must
- * be non-ghosts of the set (they are the quadrature points): see the halo rule in the
- * guide (docs/mpi.md). With global ids on the set, those rows are then bitwise equal to
- * the one-rank rows.
+ * be non-ghosts of the set (they are the quadrature points): see the halo rule in
+ * docs/petsc.md. With global ids on the set, those rows are then bitwise equal to the
+ * one-rank rows.
  *
  * Collective calls. mfree_petsc_setup, _assemble, _set_dirichlet and _solve are
  * collective over the communicator. Each checks its arguments on every rank and the
@@ -82,7 +82,8 @@ typedef struct mfree_petsc mfree_petsc_t;
  * @param[in]  ctx   context for error messages
  * @param[in]  comm  MPI communicator (MPI_COMM_NULL: MFREE_ERR_ARG)
  * @param[out] pk    the new system (NULL on failure)
- * @return MFREE_ERR_STATE when PETSc is not initialised (PetscInitialize)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (ctx or pk NULL); MFREE_ERR_ARG; MFREE_ERR_STATE
+ *         when PETSc is not initialised (PetscInitialize); MFREE_ERR_ALLOC
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_create(mfree_context_t *ctx, MPI_Comm comm,
                                                   mfree_petsc_t **pk);
@@ -90,6 +91,7 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_create(mfree_context_t *ctx, MPI_Comm
 /**
  * Destroy the system and its PETSc objects (collective, as PETSc's destroys are).
  * @param[in,out] pk  may be NULL or point to NULL; set to NULL
+ * @return MFREE_SUCCESS
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_destroy(mfree_petsc_t **pk);
 
@@ -97,8 +99,10 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_destroy(mfree_petsc_t **pk);
  * Options prefix of the matrix, the vectors and the solver in PETSc's options database
  * (e.g. "elast_" reads -elast_ksp_type). Copied. Takes effect at the next setup.
  * Not collective.
- * @param[in] prefix  letters, digits and '_', not starting with a digit or '-', at most
- *                    63 characters; NULL or "" for none (else MFREE_ERR_ARG)
+ * @param[in] pk      the system
+ * @param[in] prefix  letters, digits and '_', not starting with a digit, at most 63
+ *                    characters; NULL or "" for none
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_ARG for another prefix
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_set_options_prefix(mfree_petsc_t *pk,
                                                               const char *prefix);
@@ -108,11 +112,13 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_set_options_prefix(mfree_petsc_t *pk,
  * modes, MatNullSpaceCreateRigidBody) that algebraic multigrid uses. Copied; takes
  * effect at the next setup, and only when the number of components per node equals dim.
  * Not collective.
+ * @param[in] pk      the system
  * @param[in] dim     2 or 3 (else MFREE_ERR_ARG)
  * @param[in] nowned  number of owned nodes (must match setup's, else setup returns
  *                    MFREE_ERR_MISMATCH)
  * @param[in] x       nowned * dim values, node after node (NULL with nowned > 0:
  *                    MFREE_ERR_NULL; a non-finite value: MFREE_ERR_INPUT)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_ARG; MFREE_ERR_INPUT (nothing changed)
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_set_coordinates(mfree_petsc_t *pk, int32_t dim,
                                                            int32_t nowned, const double *x);
@@ -126,6 +132,7 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_set_coordinates(mfree_petsc_t *pk, in
  * assembly (as mfree_petsc_assemble). Replaces a previous setup (Dirichlet rows are
  * cleared). The assembler is borrowed: it must stay alive and set up while the system
  * assembles from it.
+ * @param[in] pk      the system
  * @param[in] as      a set-up Galerkin assembler on this rank's particle set of nlocal
  *                    particles, without Lagrange multipliers (its unknowns must be
  *                    nlocal * ncomp, else MFREE_ERR_MISMATCH)
@@ -137,7 +144,9 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_set_coordinates(mfree_petsc_t *pk, in
  *                    for PETSc's 32-bit indices; the owned ids of all ranks distinct,
  *                    and every ghost's id owned by some rank (else MFREE_ERR_INPUT on
  *                    every rank)
- * @return MFREE_ERR_STATE when the assembler is not set up; MFREE_ERR_INPUT for
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_ARG; MFREE_ERR_MISMATCH (unknowns, or
+ *         coordinates of another node count); MFREE_ERR_STATE when the assembler is
+ *         not set up (the assembler's own failure otherwise); MFREE_ERR_INPUT for
  *         repeated or out-of-range ids, a ghost id that no rank owns, or a non-finite
  *         matrix or load entry of an owned row (naming the node and its id);
  *         MFREE_ERR_ALLOC; MFREE_ERR_INTERNAL with PETSc's message for a PETSc failure
@@ -154,7 +163,9 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_setup(mfree_petsc_t *pk, mfree_assemb
  * mfree_assembler_update, or after changing the assembler's material, coefficient or
  * loads. An assembler set up again with another pattern gives MFREE_ERR_STATE (call
  * mfree_petsc_setup).
- * @return MFREE_ERR_STATE before setup; MFREE_ERR_INPUT for a non-finite entry
+ * @param[in] pk  the system
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_STATE before setup or after a new
+ *         pattern; MFREE_ERR_INPUT for a non-finite entry; the assembler's failure
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_assemble(mfree_petsc_t *pk);
 
@@ -167,11 +178,13 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_assemble(mfree_petsc_t *pk);
  * particles-only methods), an approximation of the boundary values otherwise (where the
  * assembler's penalty or Nitsche conditions are exact to the quadrature). Copied;
  * replaces the previous set and is applied at once to the assembled system.
+ * @param[in] pk      the system
  * @param[in] n       number of constrained unknowns on this rank (>= 0; 0 clears)
  * @param[in] dofs    n local unknowns node * ncomp + component, node < nowned, distinct
  *                    (else MFREE_ERR_INPUT)
  * @param[in] values  n finite values (else MFREE_ERR_INPUT)
- * @return MFREE_ERR_STATE before setup
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_ARG (n < 0); MFREE_ERR_INPUT;
+ *         MFREE_ERR_STATE before setup (nothing changed on failure)
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_set_dirichlet(mfree_petsc_t *pk, int32_t n,
                                                          const int32_t *dofs,
@@ -180,9 +193,11 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_set_dirichlet(mfree_petsc_t *pk, int3
 /**
  * Solve the system with the KSP (collective) from a zero initial guess, and copy the
  * owned part of the solution to u.
+ * @param[in]  pk the system
  * @param[out] u  nowned * ncomp values, node * ncomp + component; may be NULL (the
  *                solution stays in the vector of mfree_petsc_get_vectors)
- * @return MFREE_ERR_STATE before setup; MFREE_FAIL_SINGULAR (positive) when the
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_STATE before setup;
+ *         MFREE_ERR_INTERNAL for a PETSc failure; MFREE_FAIL_SINGULAR (positive) when the
  *         solver diverged or stopped at its iteration limit (the reason in the message
  *         and from mfree_petsc_get_info; u holds the last iterate)
  */
@@ -190,9 +205,11 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_solve(mfree_petsc_t *pk, double *u);
 
 /**
  * Facts about the last solve (not collective). Each output may be NULL.
+ * @param[in]  pk          the system
  * @param[out] iterations  Krylov iterations
  * @param[out] residual    the solver's last residual norm
  * @param[out] reason      KSPConvergedReason (> 0 converged, < 0 diverged, 0 none yet)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_get_info(const mfree_petsc_t *pk,
                                                     int32_t *iterations, double *residual,
@@ -203,10 +220,11 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_get_info(const mfree_petsc_t *pk,
  * unknowns are rows first .. first + nowned * ncomp - 1, in local order) and the global
  * number of rows; and, when node_rows is not NULL, the PETSc number of each of the
  * nlocal particles' nodes (its rows are node * ncomp + component).
+ * @param[in]  pk         the system
  * @param[out] first      may be NULL
  * @param[out] nglobal    may be NULL
  * @param[out] node_rows  nlocal values, or NULL
- * @return MFREE_ERR_STATE before setup
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_STATE before setup
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_get_numbering(const mfree_petsc_t *pk,
                                                          int64_t *first, int64_t *nglobal,
@@ -218,7 +236,12 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_get_numbering(const mfree_petsc_t *pk
  * change them (KSPSetType, extra options, MatView); mfree_petsc_assemble overwrites the
  * matrix values of the owned rows and the right-hand side. Not collective. Each output
  * may be NULL.
- * @return MFREE_ERR_STATE before setup
+ * @param[in]  pk   the system
+ * @param[out] A    the matrix
+ * @param[out] ksp  the Krylov solver
+ * @param[out] b    the right-hand side
+ * @param[out] x    the solution
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_STATE before setup
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_get_objects(const mfree_petsc_t *pk, Mat *A,
                                                        KSP *ksp, Vec *b, Vec *x);
