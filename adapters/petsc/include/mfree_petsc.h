@@ -150,7 +150,8 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_set_coordinates(mfree_petsc_t *pk, in
  *         repeated or out-of-range ids, a ghost id that no rank owns, or a non-finite
  *         matrix or load entry of an owned row (naming the node and its id);
  *         MFREE_ERR_ALLOC; MFREE_ERR_INTERNAL with PETSc's message for a PETSc failure
- *         (MFREE_ERR_ARG for a bad option value). On failure the system has no setup.
+ *         (MFREE_ERR_ARG for a bad option value). On failure on any rank nothing changes on
+ *         any rank: a previous setup stays in use.
  */
 MFREE_PETSC_API mfree_status_t mfree_petsc_setup(mfree_petsc_t *pk, mfree_assembler_t *as,
                                                  int32_t ncomp, int32_t nlocal,
