@@ -209,7 +209,7 @@ int main(int argc, char **argv) {
   int bad = write_vtu(out, rank, size, nowned, x, u, ue), anybad = 0;
   MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD);
   if (rank == 0) {
-    printf("beam %dx%d nodes on %d ranks: %d unknowns, %d CG iterations (residual %.2e)\n", (int)nx, (int)ny, size,
+    printf("beam %dx%d nodes on %d ranks: %d unknowns, %d Krylov iterations (residual %.2e)\n", (int)nx, (int)ny, size,
            (int)(2 * nx * ny), (int)its, rnorm);
     printf("tip deflection %.6e, exact %.6e: relative error %.3e; nodal displacement error %.3e\n", tip[0], ut[1],
            tip_err, l2);
