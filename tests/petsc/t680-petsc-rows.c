@@ -117,8 +117,18 @@ static void run(pk_problem_t *p, const char *name) {
     assert_ok(ctx, mfree_petsc_setup(pk, s.as, p->dim, l.nlocal, l.nowned, l.gid));
     const double m0 = mallocs(pk);
     int64_t bad = compare_rows(p, &l, pk, K1, f1), all = 0;
+    /* new values on the same pattern (another Young's modulus) on both sides */
+    assert_ok(ctx, mfree_assembler_set_material(s.as, 2.0 * p->E, p->nu));
+    assert_ok(ctx, mfree_assembler_set_material(s1.as, 2.0 * p->E, p->nu));
+    mfree_matrix_t *K2 = NULL;
+    double *f2 = malloc(sizeof(double) * (size_t)p->n * (size_t)p->dim);
+    assert_ok(ctx, mfree_assembler_assemble_matrix(s1.as, &K2));
+    assert_ok(ctx, mfree_assembler_assemble_rhs(s1.as, f2));
     assert_ok(ctx, mfree_petsc_assemble(pk));
-    bad += compare_rows(p, &l, pk, K1, f1);
+    bad += compare_rows(p, &l, pk, K2, f2);
+    assert_ok(ctx, mfree_assembler_set_material(s1.as, p->E, p->nu));
+    mfree_matrix_destroy(&K2);
+    free(f2);
     const double m1 = mallocs(pk);
     MPI_Allreduce(&bad, &all, 1, MPI_INT64_T, MPI_SUM, PETSC_COMM_WORLD);
     if (rank_ == 0)
