@@ -1114,6 +1114,10 @@ void Assembler::quadrature_order() {
   const int32_t nq = collocation() ? 0 : qtrial_.size();
   qorder_.resize(static_cast<size_t>(nq));
   for (int32_t q = 0; q < nq; ++q) qorder_[q] = q;
+  if (quad_kind_ == 0 && ps_->has_global_ids()) {
+    const int64_t *gid = ps_->global_ids();
+    std::sort(qorder_.begin(), qorder_.end(), [gid](int32_t a, int32_t b) { return gid[a] < gid[b]; });
+  }
 }
 
 Report Assembler::setup() {

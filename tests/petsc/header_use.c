@@ -1,4 +1,4 @@
-/* Compiled with -fsyntax-only as strict C99 (t685) and as C++11 (t686): the adapter's
+/* Compiled with -fsyntax-only as strict C99 (t970) and as C++11 (t971): the adapter's
  * header (with PETSc's and MPI's) must be clean in both, every warning an error, and its
  * declarations usable. */
 #include <mfree_petsc.h>
