@@ -428,6 +428,55 @@ MFREE_API mfree_status_t mfree_context_get_num_threads(const mfree_context_t *ct
 MFREE_API mfree_status_t mfree_context_set_allocator(mfree_context_t *ctx, mfree_alloc_fn alloc,
                                                      mfree_free_fn release, void *user);
 
+/**
+ * The context an object was created on, for host wrappers that check arguments
+ * themselves and record their failures with mfree_context_set_error (the Fortran module
+ * does). One function per object type, all alike.
+ * @param[in]  ps   the object (particle set, approximant, mesh, matrix, assembler,
+ *                  system)
+ * @param[out] ctx  its context, borrowed: the object keeps it alive; never destroy it
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (without a message: there is no context to
+ *         hold one) for a NULL handle or output
+ */
+MFREE_API mfree_status_t mfree_particles_get_context(const mfree_particles_t *ps,
+                                                     mfree_context_t **ctx);
+/** As mfree_particles_get_context, for an approximant.
+ * @param[in] a the approximant @param[out] ctx its context (borrowed)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle or output */
+MFREE_API mfree_status_t mfree_approximant_get_context(const mfree_approximant_t *a,
+                                                       mfree_context_t **ctx);
+/** As mfree_particles_get_context, for a mesh.
+ * @param[in] mesh the mesh @param[out] ctx its context (borrowed)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle or output */
+MFREE_API mfree_status_t mfree_mesh_get_context(const mfree_mesh_t *mesh, mfree_context_t **ctx);
+/** As mfree_particles_get_context, for a matrix.
+ * @param[in] A the matrix @param[out] ctx its context (borrowed)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle or output */
+MFREE_API mfree_status_t mfree_matrix_get_context(const mfree_matrix_t *A, mfree_context_t **ctx);
+/** As mfree_particles_get_context, for an assembler.
+ * @param[in] as the assembler @param[out] ctx its context (borrowed)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle or output */
+MFREE_API mfree_status_t mfree_assembler_get_context(const mfree_assembler_t *as,
+                                                     mfree_context_t **ctx);
+/** As mfree_particles_get_context, for a system.
+ * @param[in] sys the system @param[out] ctx its context (borrowed)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle or output */
+MFREE_API mfree_status_t mfree_system_get_context(const mfree_system_t *sys,
+                                                  mfree_context_t **ctx);
+
+/** The particle set an approximant is built on, so that a wrapper can size the arrays it
+ * passes (dimension, particle count, pairs).
+ * @param[in] a the approximant @param[out] ps its particle set, borrowed (a keeps it
+ * alive; never destroy it)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle or output */
+MFREE_API mfree_status_t mfree_approximant_get_particles(const mfree_approximant_t *a,
+                                                         mfree_particles_t **ps);
+/** The particle set a mesh is built on (as mfree_approximant_get_particles).
+ * @param[in] mesh the mesh @param[out] ps its particle set (borrowed)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle or output */
+MFREE_API mfree_status_t mfree_mesh_get_particles(const mfree_mesh_t *mesh,
+                                                  mfree_particles_t **ps);
+
 /* ------------------------------------------------------------------------------------ */
 /* Kernels                                                                                */
 /* ------------------------------------------------------------------------------------ */
@@ -641,6 +690,37 @@ MFREE_API mfree_status_t mfree_particles_get_global_ids(const mfree_particles_t 
  * @return MFREE_SUCCESS; setups then return MFREE_ERR_HALO naming the particle
  */
 MFREE_API mfree_status_t mfree_particles_set_halo_width(mfree_particles_t *ps, double w);
+
+/**
+ * A host half pair list instead of CSR lists (each replaces the other; docs/pair-lists.md):
+ * pair k joins particles pair_i[k] and pair_j[k], each unordered pair listed once, in
+ * any order, as a legacy hydrocode's pair_i, pair_j, niac. Setup builds the rows from it
+ * in O(npairs + n), without a search: row i holds every j paired with i, ascending (by
+ * global id when the set has ids), as CSR lists of the same neighbourhoods would (the
+ * tables are the same bit for bit).
+ * Pairs may join owned particles and ghosts (ghosts get no rows); pairs between two
+ * ghosts are ignored. The pair order is kept for mfree_approximant_get_pair_gradients.
+ * Messages name pairs and particles in the host's numbering (1-based for index_base 1).
+ * @param[in] ps              the set
+ * @param[in] npairs          number of pairs (>= 0, else MFREE_ERR_ARG)
+ * @param[in] pair_i, pair_j  npairs particle indices each, in [index_base,
+ *                            index_base + n); may be NULL when npairs is 0
+ * @param[in] index_base      0 (C) or 1 (Fortran) (else MFREE_ERR_ARG)
+ * @param[in] mem             copied or borrowed (borrowed lists are re-read and
+ *                            re-checked at every setup)
+ * @return MFREE_SUCCESS; MFREE_ERR_INPUT for an index out of range or a self pair (here
+ *         and at setup) and, at setup, for a pair listed twice in either orientation
+ */
+MFREE_API mfree_status_t mfree_particles_set_pairs(mfree_particles_t *ps, int64_t npairs,
+                                                   const int32_t *pair_i,
+                                                   const int32_t *pair_j,
+                                                   int32_t index_base, mfree_mem_t mem);
+
+/** Number of pairs of the set's pair list.
+ * @param[in] ps the set @param[out] npairs the count
+ * @return MFREE_SUCCESS; MFREE_ERR_STATE when the set has no pair list */
+MFREE_API mfree_status_t mfree_particles_get_num_pairs(const mfree_particles_t *ps,
+                                                       int64_t *npairs);
 
 /**
  * Validate the particle data and build the neighbour lists (cell-list search, or the
@@ -995,6 +1075,88 @@ MFREE_API mfree_status_t mfree_approximant_get_condition(const mfree_approximant
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
 MFREE_API mfree_status_t mfree_approximant_get_site_order(const mfree_approximant_t *a,
                                                           int32_t *order);
+
+/**
+ * Per-pair kernel gradients for a host that loops over its half pair list
+ * (mfree_particles_set_pairs; the approximant set up after the set; docs/pair-lists.md).
+ * For pair k = (i, j) in the host's order, gi[k*ld + c] is the gradient entry of
+ * particle i's row at j and gj[k*ld + c] that of j's row at i, each per unit volume (the
+ * table entry divided by V_j, resp. V_i, or by 1 when the set has no volumes), so that
+ * summing V_j (u_j - u_i) gi over i's pairs (gj where i is the pair's second particle)
+ * gives the method's gradient of u at i, for every method whose rows sum to zero (all
+ * the corrected ones). Signs are those of a hydrocode's dwdx = grad_i W(x_i - x_j, h_ij):
+ * for MFREE_METHOD_SPH and _SPH_SYMMETRIC, gi is exactly that, from the kernel, and
+ * gj = -gi exactly when h_ij is symmetric (search convention SYMMETRIC_MEAN or _MAX, or
+ * one h for all). Corrected gradients are not antisymmetric: gj != -gi. A side whose
+ * particle has no row (a ghost, an isolated particle, a failed site) is 0, except for
+ * SPH, which needs no row; a pair outside the kernel's support is 0. No allocation.
+ * @param[in]  a         a set-up approximant at the particles (not MPFEM, not host
+ *                       points: MFREE_ERR_UNSUPPORTED) with a gradient table
+ * @param[out] gi, gj    npairs records of dim doubles every ld; gj may be NULL
+ * @param[in]  ld        doubles from one record to the next (>= dim; 3 for a Fortran
+ *                       dwdx(3, :))
+ * @param[in]  capacity  doubles each buffer holds, at least (npairs - 1) * ld + dim
+ * @return MFREE_SUCCESS; MFREE_ERR_ARG (nothing written) for ld < dim or a capacity too
+ *         small; MFREE_ERR_STATE when the set has no pair list, was set up again after
+ *         the approximant, or the gradient table was not built
+ */
+MFREE_API mfree_status_t mfree_approximant_get_pair_gradients(const mfree_approximant_t *a,
+                                                              double *gi, double *gj,
+                                                              int64_t ld, int64_t capacity);
+
+/**
+ * One antisymmetrised gradient per pair, g = (gi - gj) / 2 of
+ * mfree_approximant_get_pair_gradients, the j side being -g (a pair with one side
+ * without a row takes the other side's). A pair loop that adds m_j F g to i and
+ * subtracts m_i F g from j conserves linear momentum to round-off; the price is the
+ * method's first-order consistency (the gradient of a linear field is no longer exact).
+ * For SPH, g = gi.
+ * @param[in] a the approximant @param[out] g npairs records of dim doubles every ld
+ * @param[in] ld >= dim @param[in] capacity doubles g holds
+ * @return as mfree_approximant_get_pair_gradients
+ */
+MFREE_API mfree_status_t mfree_approximant_get_pair_gradients_antisymmetric(
+    const mfree_approximant_t *a, double *g, int64_t ld, int64_t capacity);
+
+/** Doubles per particle of mfree_approximant_get_correction for the approximant's
+ * method (listed there).
+ * @param[in] a the approximant @param[out] ncoef the record length
+ * @return MFREE_SUCCESS; MFREE_ERR_UNSUPPORTED for a method without correction data */
+MFREE_API mfree_status_t mfree_approximant_get_correction_size(const mfree_approximant_t *a,
+                                                               int32_t *ncoef);
+
+/**
+ * Per-particle correction data, for hosts that apply the correction themselves: one
+ * record of ncoef doubles per owned particle i at c[i*ld]. With d = dim,
+ * w_j = W(|x_j - x_i|, h_ij), grad w_j its gradient with respect to x_i (the dwdx of the
+ * pair (i, j)), V_j the volumes and matrices stored column by column (M(a, b) at
+ * a + b*d, Fortran's order), the records are:
+ *  - RANDLES_LIBERSKY, d*d: M, the corrected gradient being M grad w_j (M = B^T of
+ *    [Belytschko1998] eqs 68-69); the table entry is M grad w_j V_j.
+ *  - KB_METHOD1, d*d + 1 + d: M, S = sum_j w_j, grad S; the gradient of neighbour j is
+ *    M grad(w_j / S), grad(w_j / S) = grad w_j / S - w_j grad S / S^2 (M = A^-T of
+ *    [Belytschko1998] eqs 56-61).
+ *  - MLS, RKPM of order <= 2, (d + 1) L with L the basis size: gamma (L), then
+ *    d gamma / dx_c (L) for c = 0 .. d-1, so that with s = (x_j - x_i) / h_i and the
+ *    monomials p(s) in the order 1; s_1 .. s_d; s_1^2 .. s_d^2; s_1 s_2, s_2 s_3, s_3 s_1:
+ *    Phi_j = o_j gamma . p(s) and dPhi_j/dx_c = o_j (d gamma/dx_c) . p(s) +
+ *    (grad o_j)_c gamma . p(s), o_j = w_j (MLS) or w_j V_j (RKPM).
+ *  - SHEPARD, 1 + d: S and grad S as above. JOHNSON_BEISSEL, d: beta_c
+ *    ([Belytschko1998] eq 52).
+ * A particle whose site failed or fell back to another order gets zeros (see
+ * mfree_approximant_get_site_status, _get_site_order). Every particle's record has the
+ * same layout.
+ * @param[in]  a         a set-up approximant at the particles
+ * @param[out] c         records of ncoef doubles every ld
+ * @param[in]  ld        >= ncoef
+ * @param[in]  capacity  doubles c holds, at least (n_owned - 1) * ld + ncoef
+ * @return MFREE_SUCCESS; MFREE_ERR_ARG (nothing written) for ld or capacity too small;
+ *         MFREE_ERR_UNSUPPORTED for a method without correction data (MLS/RKPM of order 3
+ *         included); MFREE_ERR_STATE when the set was set up again after the approximant
+ */
+MFREE_API mfree_status_t mfree_approximant_get_correction(const mfree_approximant_t *a,
+                                                          double *c, int64_t ld,
+                                                          int64_t capacity);
 
 /* ------------------------------------------------------------------------------------ */
 /* Sparse matrices                                                                        */
@@ -1486,6 +1648,12 @@ MFREE_API mfree_status_t mfree_system_set_velocity_smoothing(mfree_system_t *sys
  * @param[in] sys the system @param[out] neq the length
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
 MFREE_API mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq);
+/** Spatial dimension and number of particles of a system, the sizes of get_pressure
+ * (n values), get_velocity (dim n) and get_stress (n times 1, 3 or 6 for dim 1, 2, 3).
+ * @param[in] sys the system @param[out] dim, n either may be NULL, not both
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for two NULL outputs */
+MFREE_API mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, int32_t *dim,
+                                                    int32_t *n);
 /** ydot = f(t, y).
  * @param[in] sys the system @param[in] t time @param[in] y state
  * @param[out] ydot its rate (unspecified after a positive status)

@@ -510,6 +510,126 @@ module mfree
       type(c_ptr), value :: nfailed
     end function mfree_particles_get_site_status_c
 
+    integer(c_int) function mfree_particles_set_pairs_c(ps, npairs, pair_i, pair_j, &
+                                                       index_base, mem) &
+        bind(C, name="mfree_particles_set_pairs")
+      import :: c_int, c_int32_t, c_int64_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int64_t), value :: npairs
+      type(c_ptr), value :: pair_i
+      type(c_ptr), value :: pair_j
+      integer(c_int32_t), value :: index_base
+      integer(c_int), value :: mem
+    end function mfree_particles_set_pairs_c
+
+    integer(c_int) function mfree_particles_get_num_pairs_c(ps, npairs) &
+        bind(C, name="mfree_particles_get_num_pairs")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int64_t), intent(out) :: npairs
+    end function mfree_particles_get_num_pairs_c
+
+    integer(c_int) function mfree_approximant_get_pair_gradients_c(a, gi, gj, ld, capacity) &
+        bind(C, name="mfree_approximant_get_pair_gradients")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: a
+      type(c_ptr), value :: gi
+      type(c_ptr), value :: gj
+      integer(c_int64_t), value :: ld
+      integer(c_int64_t), value :: capacity
+    end function mfree_approximant_get_pair_gradients_c
+
+    integer(c_int) function mfree_approximant_get_pair_gradients_antisymmetric_c(a, g, ld, &
+                                                                                capacity) &
+        bind(C, name="mfree_approximant_get_pair_gradients_antisymmetric")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: a
+      type(c_ptr), value :: g
+      integer(c_int64_t), value :: ld
+      integer(c_int64_t), value :: capacity
+    end function mfree_approximant_get_pair_gradients_antisymmetric_c
+
+    integer(c_int) function mfree_approximant_get_correction_size_c(a, ncoef) &
+        bind(C, name="mfree_approximant_get_correction_size")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: a
+      integer(c_int32_t), intent(out) :: ncoef
+    end function mfree_approximant_get_correction_size_c
+
+    integer(c_int) function mfree_approximant_get_correction_c(a, c, ld, capacity) &
+        bind(C, name="mfree_approximant_get_correction")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: a
+      type(c_ptr), value :: c
+      integer(c_int64_t), value :: ld
+      integer(c_int64_t), value :: capacity
+    end function mfree_approximant_get_correction_c
+
+    ! -- an object's context and particle set (for the wrappers' own checks)
+    integer(c_int) function mfree_particles_get_context_c(ps, ctx) &
+        bind(C, name="mfree_particles_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: ps
+      type(c_ptr) :: ctx
+    end function mfree_particles_get_context_c
+
+    integer(c_int) function mfree_approximant_get_context_c(a, ctx) &
+        bind(C, name="mfree_approximant_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: a
+      type(c_ptr) :: ctx
+    end function mfree_approximant_get_context_c
+
+    integer(c_int) function mfree_mesh_get_context_c(mesh, ctx) &
+        bind(C, name="mfree_mesh_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: mesh
+      type(c_ptr) :: ctx
+    end function mfree_mesh_get_context_c
+
+    integer(c_int) function mfree_matrix_get_context_c(A, ctx) &
+        bind(C, name="mfree_matrix_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: A
+      type(c_ptr) :: ctx
+    end function mfree_matrix_get_context_c
+
+    integer(c_int) function mfree_assembler_get_context_c(as, ctx) &
+        bind(C, name="mfree_assembler_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: as
+      type(c_ptr) :: ctx
+    end function mfree_assembler_get_context_c
+
+    integer(c_int) function mfree_system_get_context_c(sys, ctx) &
+        bind(C, name="mfree_system_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: sys
+      type(c_ptr) :: ctx
+    end function mfree_system_get_context_c
+
+    integer(c_int) function mfree_approximant_get_particles_c(a, ps) &
+        bind(C, name="mfree_approximant_get_particles")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: a
+      type(c_ptr) :: ps
+    end function mfree_approximant_get_particles_c
+
+    integer(c_int) function mfree_mesh_get_particles_c(mesh, ps) &
+        bind(C, name="mfree_mesh_get_particles")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: mesh
+      type(c_ptr) :: ps
+    end function mfree_mesh_get_particles_c
+
+    integer(c_int) function mfree_system_get_dimension_c(sys, dim, n) &
+        bind(C, name="mfree_system_get_dimension")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: sys
+      type(c_ptr), value :: dim
+      type(c_ptr), value :: n
+    end function mfree_system_get_dimension_c
+
     ! -- approximants
     integer(c_int) function mfree_approximant_create_c(ctx, ps, method, a) &
         bind(C, name="mfree_approximant_create")
@@ -1285,6 +1405,15 @@ module mfree
   public :: mfree_particles_get_size_c, mfree_particles_get_neighbor_nnz_c
   public :: mfree_particles_get_neighbors_c, mfree_particles_get_volumes_c
   public :: mfree_particles_get_site_status_c, mfree_approximant_create_c
+  public :: mfree_particles_set_pairs_c, mfree_particles_get_num_pairs_c
+  public :: mfree_approximant_get_pair_gradients_c
+  public :: mfree_approximant_get_pair_gradients_antisymmetric_c
+  public :: mfree_approximant_get_correction_size_c, mfree_approximant_get_correction_c
+  public :: mfree_particles_get_context_c, mfree_approximant_get_context_c
+  public :: mfree_mesh_get_context_c, mfree_matrix_get_context_c
+  public :: mfree_assembler_get_context_c, mfree_system_get_context_c
+  public :: mfree_approximant_get_particles_c, mfree_mesh_get_particles_c
+  public :: mfree_system_get_dimension_c
   public :: mfree_approximant_destroy_c, mfree_approximant_set_kernel_c
   public :: mfree_approximant_set_order_c, mfree_approximant_set_derivatives_c
   public :: mfree_approximant_set_fallback_c, mfree_approximant_set_points_c
@@ -1327,22 +1456,42 @@ module mfree
   public :: mfree_system_set_shepard_condition_c
   public :: mfree_system_get_stress_c
 
-  ! ---- per-particle scalars and point supports: an array, or one value (stride 0) -----
+  ! ---- generic wrappers: strides, leading dimensions and counts of either integer kind
+  ! (c_int64_t, or a legacy code's default integers); arrays of any rank; per-particle
+  ! scalars as an array, or one value with stride 0
+  interface mfree_particles_set_positions
+    module procedure mfree_particles_set_positions_i64, mfree_particles_set_positions_i32
+  end interface mfree_particles_set_positions
   interface mfree_particles_set_volumes
-    module procedure mfree_particles_set_volumes_array, mfree_particles_set_volumes_scalar
+    module procedure mfree_particles_set_volumes_i64, mfree_particles_set_volumes_i32
   end interface mfree_particles_set_volumes
   interface mfree_particles_set_masses
-    module procedure mfree_particles_set_masses_array, mfree_particles_set_masses_scalar
+    module procedure mfree_particles_set_masses_i64, mfree_particles_set_masses_i32
   end interface mfree_particles_set_masses
   interface mfree_particles_set_densities
-    module procedure mfree_particles_set_densities_array, mfree_particles_set_densities_scalar
+    module procedure mfree_particles_set_densities_i64, mfree_particles_set_densities_i32
   end interface mfree_particles_set_densities
   interface mfree_particles_set_support
-    module procedure mfree_particles_set_support_array, mfree_particles_set_support_scalar
+    module procedure mfree_particles_set_support_i64, mfree_particles_set_support_i32
   end interface mfree_particles_set_support
+  interface mfree_particles_set_neighbors
+    module procedure mfree_particles_set_neighbors_i64, mfree_particles_set_neighbors_i32
+  end interface mfree_particles_set_neighbors
+  interface mfree_particles_set_pairs
+    module procedure mfree_particles_set_pairs_i64, mfree_particles_set_pairs_i32
+  end interface mfree_particles_set_pairs
   interface mfree_approximant_set_points
-    module procedure mfree_approximant_set_points_array, mfree_approximant_set_points_scalar
+    module procedure mfree_approximant_set_points_i64, mfree_approximant_set_points_i32
   end interface mfree_approximant_set_points
+  interface mfree_approximant_apply
+    module procedure mfree_approximant_apply_i64, mfree_approximant_apply_i32
+  end interface mfree_approximant_apply
+  interface mfree_approximant_apply_add
+    module procedure mfree_approximant_apply_add_i64, mfree_approximant_apply_add_i32
+  end interface mfree_approximant_apply_add
+  interface mfree_kernel_eval
+    module procedure mfree_kernel_eval_i64, mfree_kernel_eval_i32
+  end interface mfree_kernel_eval
   interface mfree_system_set_fluid
     module procedure mfree_system_set_fluid_array, mfree_system_set_fluid_scalar
   end interface mfree_system_set_fluid
@@ -1370,6 +1519,15 @@ module mfree
   public :: mfree_particles_get_size, mfree_particles_get_neighbor_nnz
   public :: mfree_particles_get_neighbors, mfree_particles_get_volumes
   public :: mfree_particles_get_site_status
+  public :: mfree_particles_set_pairs, mfree_particles_get_num_pairs
+  public :: mfree_approximant_get_pair_gradients
+  public :: mfree_approximant_get_pair_gradients_antisymmetric
+  public :: mfree_approximant_get_correction_size, mfree_approximant_get_correction
+  public :: mfree_particles_get_context, mfree_approximant_get_context
+  public :: mfree_mesh_get_context, mfree_matrix_get_context
+  public :: mfree_assembler_get_context, mfree_system_get_context
+  public :: mfree_approximant_get_particles, mfree_mesh_get_particles
+  public :: mfree_system_get_dimension
   public :: mfree_approximant_create, mfree_approximant_destroy
   public :: mfree_approximant_set_kernel, mfree_approximant_set_order
   public :: mfree_approximant_set_derivatives, mfree_approximant_set_fallback
@@ -1468,6 +1626,155 @@ contains
     end do
     buf(len(s) + 1) = c_null_char
   end subroutine to_c_chars
+
+  ! ==== argument checks of the wrappers =================================================
+  ! Every wrapper that writes into a caller array checks it first: contiguous, and large
+  ! enough for what mfree will write (else MFREE_ERR_ARG, recorded on the object's
+  ! context like mfree's own failures, and nothing is written). Borrowed inputs must be
+  ! contiguous (a section would be passed as a temporary that dies with the call);
+  ! copied ones may be sections (they are packed here first).
+
+  !> Record a failure a wrapper found before calling mfree on context ctx and return its
+  !> code (MFREE_ERR_NULL when there is no context: a NULL handle).
+  integer(c_int) function wrapper_error(ctx, code, message) result(st)
+    type(c_ptr), intent(in) :: ctx
+    integer(c_int), intent(in) :: code
+    character(len=*), intent(in) :: message
+    character(kind=c_char), allocatable, target :: buf(:)
+    st = MFREE_ERR_NULL
+    if (.not. c_associated(ctx)) return
+    call to_c_chars(message, buf)
+    st = mfree_context_set_error_c(ctx, code, c_loc(buf))
+  end function wrapper_error
+
+  !> A 64-bit integer as text.
+  function int_str(i) result(s)
+    integer(c_int64_t), intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=24) :: b
+    write (b, '(i0)') i
+    s = trim(b)
+  end function int_str
+
+  !> MFREE_SUCCESS when an output array (contiguous: is_contiguous, have elements) can
+  !> take need elements; else MFREE_ERR_ARG recorded on ctx.
+  integer(c_int) function check_out(ctx, fn, what, contig, have, need) result(st)
+    type(c_ptr), intent(in) :: ctx
+    character(len=*), intent(in) :: fn, what
+    logical, intent(in) :: contig
+    integer(c_int64_t), intent(in) :: have, need
+    st = MFREE_SUCCESS
+    if (.not. contig) then
+      st = wrapper_error(ctx, MFREE_ERR_ARG, fn // ': ' // what // &
+                         ' is not contiguous (a strided section?): mfree writes it as one block')
+    else if (have < need) then
+      st = wrapper_error(ctx, MFREE_ERR_ARG, fn // ': ' // what // ' holds ' // &
+                         int_str(have) // ' elements, ' // int_str(need) // ' are needed')
+    end if
+  end function check_out
+
+  !> MFREE_SUCCESS unless a non-contiguous array is to be borrowed (MFREE_ERR_ARG).
+  integer(c_int) function check_borrow(ctx, fn, what, contig, mem) result(st)
+    type(c_ptr), intent(in) :: ctx
+    character(len=*), intent(in) :: fn, what
+    logical, intent(in) :: contig
+    integer(c_int), intent(in) :: mem
+    st = MFREE_SUCCESS
+    if (mem == MFREE_BORROW .and. .not. contig) &
+      st = wrapper_error(ctx, MFREE_ERR_ARG, fn // ': ' // what // &
+                         ' is not contiguous and cannot be borrowed (its temporary copy would die' // &
+                         ' with the call): pass a whole contiguous array, or MFREE_COPY')
+  end function check_borrow
+
+  ! A rank-1 view of an array of any rank: the array itself when contiguous, else a packed
+  ! copy in tmp (for copied inputs); empty arrays view a static empty array.
+  !> A rank-1 view of a real array of any rank (packed into tmp when not contiguous).
+  subroutine view_dbl(x, tmp, p)
+    real(c_double), intent(in), target :: x(..)
+    real(c_double), allocatable, target, intent(inout) :: tmp(:)
+    real(c_double), pointer, intent(out) :: p(:)
+    if (size(x) == 0) then
+      p => empty_dbl
+    else if (is_contiguous(x)) then
+      call c_f_pointer(c_loc(x), p, [size(x)])
+    else
+      select rank (x)
+      rank (0)
+        tmp = [x]
+      rank (1)
+        tmp = x
+      rank (2)
+        tmp = reshape(x, [size(x)])
+      rank (3)
+        tmp = reshape(x, [size(x)])
+      end select
+      p => tmp
+    end if
+  end subroutine view_dbl
+
+  !> A rank-1 view of an integer array of any rank (packed into tmp when not contiguous).
+  subroutine view_i32(x, tmp, p)
+    integer(c_int32_t), intent(in), target :: x(..)
+    integer(c_int32_t), allocatable, target, intent(inout) :: tmp(:)
+    integer(c_int32_t), pointer, intent(out) :: p(:)
+    if (size(x) == 0) then
+      p => empty_i32
+    else if (is_contiguous(x)) then
+      call c_f_pointer(c_loc(x), p, [size(x)])
+    else
+      select rank (x)
+      rank (0)
+        tmp = [x]
+      rank (1)
+        tmp = x
+      rank (2)
+        tmp = reshape(x, [size(x)])
+      end select
+      p => tmp
+    end if
+  end subroutine view_i32
+
+  !> The C address of a contiguous output array (NULL when it is empty).
+  type(c_ptr) function out_loc(x) result(p)
+    type(*), intent(in), target :: x(..)
+    p = c_null_ptr
+    if (size(x) > 0) p = c_loc(x)
+  end function out_loc
+
+  !> The context of a particle set (NULL for a NULL handle).
+  type(c_ptr) function ctx_of_particles(ps) result(ctx)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int) :: st
+    ctx = c_null_ptr
+    st = mfree_particles_get_context_c(ps%ptr, ctx)
+  end function ctx_of_particles
+
+  !> The context of an approximant (NULL for a NULL handle).
+  type(c_ptr) function ctx_of_approximant(a) result(ctx)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int) :: st
+    ctx = c_null_ptr
+    st = mfree_approximant_get_context_c(a%ptr, ctx)
+  end function ctx_of_approximant
+
+  !> Dimension, particles (owned and ghost) and ghosts of an approximant's particle set.
+  integer(c_int) function approximant_sizes(a, dim, n, ng) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out) :: dim, n, ng
+    type(c_ptr) :: ps
+    integer(c_int32_t), target :: tn, tg
+    dim = 0
+    n = 0
+    ng = 0
+    ps = c_null_ptr
+    st = mfree_approximant_get_particles_c(a%ptr, ps)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_particles_get_dimension_c(ps, dim)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_particles_get_size_c(ps, c_loc(tn), c_loc(tg))
+    n = tn
+    ng = tg
+  end function approximant_sizes
 
   ! ==== version and status =============================================================
 
@@ -1645,25 +1952,54 @@ contains
 
   ! ==== kernels ========================================================================
 
-  !> W, dW/dr, d2W/dr2 at the n distances r; request any subset of the outputs.
-  integer(c_int) function mfree_kernel_eval(ctx, kernel, dim, param, h, n, r, w, dwdr, &
-                                            d2wdr2) result(st)
+  !> W, dW/dr, d2W/dr2 at the n distances r; request any subset of the outputs, each of
+  !> at least n values (as r; else MFREE_ERR_ARG); n of either integer kind.
+  integer(c_int) function mfree_kernel_eval_i64(ctx, kernel, dim, param, h, n, r, w, dwdr, &
+                                                d2wdr2) result(st)
     type(mfree_context), intent(in) :: ctx
     integer(c_int), intent(in) :: kernel
     integer(c_int32_t), intent(in) :: dim
     real(c_double), intent(in) :: param, h
     integer(c_int64_t), intent(in) :: n
-    real(c_double), intent(in) :: r(*)
-    real(c_double), intent(out), optional, target :: w(*), dwdr(*), d2wdr2(*)
+    real(c_double), intent(in) :: r(:)
+    real(c_double), intent(out), optional, target :: w(:), dwdr(:), d2wdr2(:)
     type(c_ptr) :: pw, pd, pd2
+    character(len=*), parameter :: fn = 'mfree_kernel_eval'
     pw = c_null_ptr
     pd = c_null_ptr
     pd2 = c_null_ptr
-    if (present(w)) pw = c_loc(w)
-    if (present(dwdr)) pd = c_loc(dwdr)
-    if (present(d2wdr2)) pd2 = c_loc(d2wdr2)
+    st = check_out(ctx%ptr, fn, 'r', .true., size(r, kind=c_int64_t), n)
+    if (st /= MFREE_SUCCESS) return
+    if (present(w)) then
+      st = check_out(ctx%ptr, fn, 'w', is_contiguous(w), size(w, kind=c_int64_t), n)
+      if (st /= MFREE_SUCCESS) return
+      pw = out_loc(w)
+    end if
+    if (present(dwdr)) then
+      st = check_out(ctx%ptr, fn, 'dwdr', is_contiguous(dwdr), size(dwdr, kind=c_int64_t), n)
+      if (st /= MFREE_SUCCESS) return
+      pd = out_loc(dwdr)
+    end if
+    if (present(d2wdr2)) then
+      st = check_out(ctx%ptr, fn, 'd2wdr2', is_contiguous(d2wdr2), size(d2wdr2, kind=c_int64_t), n)
+      if (st /= MFREE_SUCCESS) return
+      pd2 = out_loc(d2wdr2)
+    end if
     st = mfree_kernel_eval_c(ctx%ptr, kernel, dim, param, h, n, r, pw, pd, pd2)
-  end function mfree_kernel_eval
+  end function mfree_kernel_eval_i64
+
+  !> Typed wrapper of mfree_kernel_eval (mfree.h).
+  integer(c_int) function mfree_kernel_eval_i32(ctx, kernel, dim, param, h, n, r, w, dwdr, &
+                                                d2wdr2) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int), intent(in) :: kernel
+    integer(c_int32_t), intent(in) :: dim
+    real(c_double), intent(in) :: param, h
+    integer(c_int32_t), intent(in) :: n
+    real(c_double), intent(in) :: r(:)
+    real(c_double), intent(out), optional, target :: w(:), dwdr(:), d2wdr2(:)
+    st = mfree_kernel_eval_i64(ctx, kernel, dim, param, h, int(n, c_int64_t), r, w, dwdr, d2wdr2)
+  end function mfree_kernel_eval_i32
 
   !> Typed wrapper of mfree_kernel_get_support_radius (mfree.h).
   integer(c_int) function mfree_kernel_get_support_radius(ctx, kernel, param, radius) &
@@ -1710,96 +2046,228 @@ contains
   end function mfree_particles_set_num_ghost
 
   !> Positions: x(3,n) -> MFREE_LAYOUT_AOS, ld = 3; x(n,3) -> MFREE_LAYOUT_SOA, ld = n.
-  !> With MFREE_BORROW, x must be a whole contiguous array with the TARGET attribute.
-  integer(c_int) function mfree_particles_set_positions(ps, x, layout, ld, mem) result(st)
+  !> With MFREE_BORROW, x must be contiguous with the TARGET attribute (else
+  !> MFREE_ERR_ARG); a copied x may be any array or section. ld of any integer kind.
+  integer(c_int) function mfree_particles_set_positions_i64(ps, x, layout, ld, mem) result(st)
     type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: x(*)
+    real(c_double), intent(in), target :: x(..)
     integer(c_int), intent(in) :: layout, mem
     integer(c_int64_t), intent(in) :: ld
-    st = mfree_particles_set_positions_c(ps%ptr, x, layout, ld, mem)
-  end function mfree_particles_set_positions
-
-  !> Typed wrapper of mfree_particles_set_volumes_array (mfree.h).
-  integer(c_int) function mfree_particles_set_volumes_array(ps, v, stride, mem) result(st)
-    type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: v(*)
-    integer(c_int64_t), intent(in) :: stride
-    integer(c_int), intent(in) :: mem
-    st = mfree_particles_set_volumes_c(ps%ptr, v, stride, mem)
-  end function mfree_particles_set_volumes_array
-
-  !> Typed wrapper of mfree_particles_set_volumes_scalar (mfree.h).
-  integer(c_int) function mfree_particles_set_volumes_scalar(ps, v, stride, mem) result(st)
-    type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: v
-    integer(c_int64_t), intent(in) :: stride
-    integer(c_int), intent(in) :: mem
+    real(c_double), allocatable, target :: tmp(:)
     real(c_double), pointer :: p(:)
-    call c_f_pointer(c_loc(v), p, [1])
-    st = mfree_particles_set_volumes_c(ps%ptr, p, stride, mem)
-  end function mfree_particles_set_volumes_scalar
+    st = check_borrow(ctx_of_particles(ps), 'mfree_particles_set_positions', 'x', &
+                      is_contiguous(x), mem)
+    if (st /= MFREE_SUCCESS) return
+    call view_dbl(x, tmp, p)
+    st = mfree_particles_set_positions_c(ps%ptr, p, layout, ld, mem)
+  end function mfree_particles_set_positions_i64
 
-  !> Typed wrapper of mfree_particles_set_masses_array (mfree.h).
-  integer(c_int) function mfree_particles_set_masses_array(ps, m, stride, mem) result(st)
+  !> Typed wrapper of mfree_particles_set_positions (mfree.h).
+  integer(c_int) function mfree_particles_set_positions_i32(ps, x, layout, ld, mem) result(st)
     type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: m(*)
-    integer(c_int64_t), intent(in) :: stride
-    integer(c_int), intent(in) :: mem
-    st = mfree_particles_set_masses_c(ps%ptr, m, stride, mem)
-  end function mfree_particles_set_masses_array
+    real(c_double), intent(in), target :: x(..)
+    integer(c_int), intent(in) :: layout, mem
+    integer(c_int32_t), intent(in) :: ld
+    st = mfree_particles_set_positions_i64(ps, x, layout, int(ld, c_int64_t), mem)
+  end function mfree_particles_set_positions_i32
 
-  !> Typed wrapper of mfree_particles_set_masses_scalar (mfree.h).
-  integer(c_int) function mfree_particles_set_masses_scalar(ps, m, stride, mem) result(st)
+  !> Per-particle scalars (an array, or one value with stride 0), as for positions.
+  integer(c_int) function set_scalar(ps, fn, v, stride, mem, which) result(st)
     type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: m
+    character(len=*), intent(in) :: fn
+    real(c_double), intent(in), target :: v(..)
     integer(c_int64_t), intent(in) :: stride
-    integer(c_int), intent(in) :: mem
+    integer(c_int), intent(in) :: mem, which
+    real(c_double), allocatable, target :: tmp(:)
     real(c_double), pointer :: p(:)
-    call c_f_pointer(c_loc(m), p, [1])
-    st = mfree_particles_set_masses_c(ps%ptr, p, stride, mem)
-  end function mfree_particles_set_masses_scalar
+    st = check_borrow(ctx_of_particles(ps), fn, 'the array', is_contiguous(v), mem)
+    if (st /= MFREE_SUCCESS) return
+    call view_dbl(v, tmp, p)
+    select case (which)
+    case (1)
+      st = mfree_particles_set_volumes_c(ps%ptr, p, stride, mem)
+    case (2)
+      st = mfree_particles_set_masses_c(ps%ptr, p, stride, mem)
+    case (3)
+      st = mfree_particles_set_densities_c(ps%ptr, p, stride, mem)
+    case default
+      st = mfree_particles_set_support_c(ps%ptr, p, stride, mem)
+    end select
+  end function set_scalar
 
-  !> Typed wrapper of mfree_particles_set_densities_array (mfree.h).
-  integer(c_int) function mfree_particles_set_densities_array(ps, rho, stride, mem) &
-      result(st)
+  !> Typed wrapper of mfree_particles_set_volumes (mfree.h).
+  integer(c_int) function mfree_particles_set_volumes_i64(ps, v, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: rho(*)
+    real(c_double), intent(in), target :: v(..)
     integer(c_int64_t), intent(in) :: stride
     integer(c_int), intent(in) :: mem
-    st = mfree_particles_set_densities_c(ps%ptr, rho, stride, mem)
-  end function mfree_particles_set_densities_array
-
-  !> Typed wrapper of mfree_particles_set_densities_scalar (mfree.h).
-  integer(c_int) function mfree_particles_set_densities_scalar(ps, rho, stride, mem) &
-      result(st)
+    st = set_scalar(ps, 'mfree_particles_set_volumes', v, stride, mem, 1)
+  end function mfree_particles_set_volumes_i64
+  !> Typed wrapper of mfree_particles_set_volumes (mfree.h).
+  integer(c_int) function mfree_particles_set_volumes_i32(ps, v, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: rho
+    real(c_double), intent(in), target :: v(..)
+    integer(c_int32_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    st = set_scalar(ps, 'mfree_particles_set_volumes', v, int(stride, c_int64_t), mem, 1)
+  end function mfree_particles_set_volumes_i32
+  !> Typed wrapper of mfree_particles_set_masses (mfree.h).
+  integer(c_int) function mfree_particles_set_masses_i64(ps, m, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: m(..)
     integer(c_int64_t), intent(in) :: stride
     integer(c_int), intent(in) :: mem
-    real(c_double), pointer :: p(:)
-    call c_f_pointer(c_loc(rho), p, [1])
-    st = mfree_particles_set_densities_c(ps%ptr, p, stride, mem)
-  end function mfree_particles_set_densities_scalar
-
-  !> Typed wrapper of mfree_particles_set_support_array (mfree.h).
-  integer(c_int) function mfree_particles_set_support_array(ps, h, stride, mem) result(st)
+    st = set_scalar(ps, 'mfree_particles_set_masses', m, stride, mem, 2)
+  end function mfree_particles_set_masses_i64
+  !> Typed wrapper of mfree_particles_set_masses (mfree.h).
+  integer(c_int) function mfree_particles_set_masses_i32(ps, m, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: h(*)
+    real(c_double), intent(in), target :: m(..)
+    integer(c_int32_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    st = set_scalar(ps, 'mfree_particles_set_masses', m, int(stride, c_int64_t), mem, 2)
+  end function mfree_particles_set_masses_i32
+  !> Typed wrapper of mfree_particles_set_densities (mfree.h).
+  integer(c_int) function mfree_particles_set_densities_i64(ps, rho, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: rho(..)
     integer(c_int64_t), intent(in) :: stride
     integer(c_int), intent(in) :: mem
-    st = mfree_particles_set_support_c(ps%ptr, h, stride, mem)
-  end function mfree_particles_set_support_array
-
-  !> Typed wrapper of mfree_particles_set_support_scalar (mfree.h).
-  integer(c_int) function mfree_particles_set_support_scalar(ps, h, stride, mem) result(st)
+    st = set_scalar(ps, 'mfree_particles_set_densities', rho, stride, mem, 3)
+  end function mfree_particles_set_densities_i64
+  !> Typed wrapper of mfree_particles_set_densities (mfree.h).
+  integer(c_int) function mfree_particles_set_densities_i32(ps, rho, stride, mem) result(st)
     type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(in), target :: h
+    real(c_double), intent(in), target :: rho(..)
+    integer(c_int32_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    st = set_scalar(ps, 'mfree_particles_set_densities', rho, int(stride, c_int64_t), mem, 3)
+  end function mfree_particles_set_densities_i32
+  !> Typed wrapper of mfree_particles_set_support (mfree.h).
+  integer(c_int) function mfree_particles_set_support_i64(ps, h, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: h(..)
     integer(c_int64_t), intent(in) :: stride
     integer(c_int), intent(in) :: mem
-    real(c_double), pointer :: p(:)
-    call c_f_pointer(c_loc(h), p, [1])
-    st = mfree_particles_set_support_c(ps%ptr, p, stride, mem)
-  end function mfree_particles_set_support_scalar
+    st = set_scalar(ps, 'mfree_particles_set_support', h, stride, mem, 4)
+  end function mfree_particles_set_support_i64
+  !> Typed wrapper of mfree_particles_set_support (mfree.h).
+  integer(c_int) function mfree_particles_set_support_i32(ps, h, stride, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in), target :: h(..)
+    integer(c_int32_t), intent(in) :: stride
+    integer(c_int), intent(in) :: mem
+    st = set_scalar(ps, 'mfree_particles_set_support', h, int(stride, c_int64_t), mem, 4)
+  end function mfree_particles_set_support_i32
+
+  !> Host CSR lists, 1-based with index_base = 1. rowptr may be 64-bit or 32-bit (legacy
+  !> codes); 32-bit offsets are converted, so they can only be copied (MFREE_COPY; with
+  !> MFREE_BORROW: MFREE_ERR_ARG). Borrowed arrays must be contiguous.
+  integer(c_int) function mfree_particles_set_neighbors_i64(ps, rowptr, cols, index_base, &
+                                                            mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(in), target :: rowptr(:)
+    integer(c_int32_t), intent(in), target :: cols(:)
+    integer(c_int32_t), intent(in) :: index_base
+    integer(c_int), intent(in) :: mem
+    integer(c_int64_t), allocatable, target :: rtmp(:)
+    integer(c_int32_t), allocatable, target :: ctmp(:)
+    character(len=*), parameter :: fn = 'mfree_particles_set_neighbors'
+    st = check_borrow(ctx_of_particles(ps), fn, 'rowptr', is_contiguous(rowptr), mem)
+    if (st == MFREE_SUCCESS) &
+      st = check_borrow(ctx_of_particles(ps), fn, 'cols', is_contiguous(cols), mem)
+    if (st /= MFREE_SUCCESS) return
+    if (is_contiguous(rowptr) .and. is_contiguous(cols)) then
+      st = mfree_particles_set_neighbors_c(ps%ptr, rowptr, cols, index_base, mem)
+    else
+      rtmp = rowptr
+      ctmp = cols
+      st = mfree_particles_set_neighbors_c(ps%ptr, rtmp, ctmp, index_base, mem)
+    end if
+  end function mfree_particles_set_neighbors_i64
+
+  !> Typed wrapper of mfree_particles_set_neighbors (mfree.h).
+  integer(c_int) function mfree_particles_set_neighbors_i32(ps, rowptr, cols, index_base, &
+                                                            mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int32_t), intent(in), target :: rowptr(:)
+    integer(c_int32_t), intent(in), target :: cols(:)
+    integer(c_int32_t), intent(in) :: index_base
+    integer(c_int), intent(in) :: mem
+    integer(c_int64_t), allocatable, target :: r64(:)
+    integer(c_int32_t), allocatable, target :: ctmp(:)
+    if (mem == MFREE_BORROW) then
+      st = wrapper_error(ctx_of_particles(ps), MFREE_ERR_ARG, 'mfree_particles_set_neighbors: ' // &
+                         '32-bit rowptr offsets are converted to 64 bits, so they cannot be ' // &
+                         'borrowed: pass MFREE_COPY (and set the lists again when they change)')
+      return
+    end if
+    allocate (r64(size(rowptr)))
+    r64 = int(rowptr, c_int64_t)
+    ctmp = cols
+    if (size(ctmp) == 0) ctmp = [index_base]
+    st = mfree_particles_set_neighbors_c(ps%ptr, r64, ctmp, index_base, mem)
+  end function mfree_particles_set_neighbors_i32
+
+  !> A half pair list (pair k joins pair_i(k) and pair_j(k), k = 1..npairs; each pair
+  !> once), 1-based with index_base = 1; npairs of any integer kind (a legacy code's
+  !> niac). pair_i and pair_j must hold npairs values (else MFREE_ERR_ARG) and, borrowed,
+  !> be contiguous.
+  integer(c_int) function mfree_particles_set_pairs_i64(ps, npairs, pair_i, pair_j, &
+                                                        index_base, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(in) :: npairs
+    integer(c_int32_t), intent(in), target :: pair_i(:), pair_j(:)
+    integer(c_int32_t), intent(in) :: index_base
+    integer(c_int), intent(in) :: mem
+    integer(c_int32_t), allocatable, target :: ti(:), tj(:)
+    character(len=*), parameter :: fn = 'mfree_particles_set_pairs'
+    type(c_ptr) :: ctx, pi, pj
+    ctx = ctx_of_particles(ps)
+    st = check_borrow(ctx, fn, 'pair_i', is_contiguous(pair_i), mem)
+    if (st == MFREE_SUCCESS) st = check_borrow(ctx, fn, 'pair_j', is_contiguous(pair_j), mem)
+    if (st /= MFREE_SUCCESS) return
+    if (npairs > 0 .and. (size(pair_i, kind=c_int64_t) < npairs .or. &
+                          size(pair_j, kind=c_int64_t) < npairs)) then
+      st = wrapper_error(ctx, MFREE_ERR_ARG, fn // ': pair_i and pair_j hold ' // &
+                         int_str(min(size(pair_i, kind=c_int64_t), size(pair_j, kind=c_int64_t))) // &
+                         ' values, npairs = ' // int_str(npairs))
+      return
+    end if
+    pi = c_null_ptr
+    pj = c_null_ptr
+    if (npairs > 0) then
+      if (is_contiguous(pair_i) .and. is_contiguous(pair_j)) then
+        pi = c_loc(pair_i)
+        pj = c_loc(pair_j)
+      else
+        ti = pair_i(1:npairs)
+        tj = pair_j(1:npairs)
+        pi = c_loc(ti)
+        pj = c_loc(tj)
+      end if
+    end if
+    st = mfree_particles_set_pairs_c(ps%ptr, npairs, pi, pj, index_base, mem)
+  end function mfree_particles_set_pairs_i64
+
+  !> Typed wrapper of mfree_particles_set_pairs (mfree.h).
+  integer(c_int) function mfree_particles_set_pairs_i32(ps, npairs, pair_i, pair_j, &
+                                                        index_base, mem) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int32_t), intent(in) :: npairs
+    integer(c_int32_t), intent(in), target :: pair_i(:), pair_j(:)
+    integer(c_int32_t), intent(in) :: index_base
+    integer(c_int), intent(in) :: mem
+    st = mfree_particles_set_pairs_i64(ps, int(npairs, c_int64_t), pair_i, pair_j, index_base, &
+                                       mem)
+  end function mfree_particles_set_pairs_i32
+
+  !> Typed wrapper of mfree_particles_get_num_pairs (mfree.h).
+  integer(c_int) function mfree_particles_get_num_pairs(ps, npairs) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(out) :: npairs
+    st = mfree_particles_get_num_pairs_c(ps%ptr, npairs)
+  end function mfree_particles_get_num_pairs
 
   !> Typed wrapper of mfree_particles_set_search (mfree.h).
   integer(c_int) function mfree_particles_set_search(ps, convention, kappa) result(st)
@@ -1817,31 +2285,39 @@ contains
     st = mfree_particles_set_periodic_c(ps%ptr, lo, hi, periodic)
   end function mfree_particles_set_periodic
 
-  !> Host neighbour lists as CSR; Fortran 1-based lists: index_base = 1 (rowptr(1) = 1,
-  !> row i is cols(rowptr(i) : rowptr(i+1)-1)).
-  integer(c_int) function mfree_particles_set_neighbors(ps, rowptr, cols, index_base, mem) &
-      result(st)
-    type(mfree_particles), intent(in) :: ps
-    integer(c_int64_t), intent(in), target :: rowptr(*)
-    integer(c_int32_t), intent(in), target :: cols(*)
-    integer(c_int32_t), intent(in) :: index_base
-    integer(c_int), intent(in) :: mem
-    st = mfree_particles_set_neighbors_c(ps%ptr, rowptr, cols, index_base, mem)
-  end function mfree_particles_set_neighbors
-
-  !> Global ids, one per particle (owned and ghost); borrowed ids need a target that
-  !> outlives the set's setups.
+  !> Global ids, one per particle (owned and ghost): ids must hold n values (else
+  !> MFREE_ERR_ARG); borrowed ids must be contiguous with a target that outlives the
+  !> set's setups.
   integer(c_int) function mfree_particles_set_global_ids(ps, ids, mem) result(st)
     type(mfree_particles), intent(in) :: ps
-    integer(c_int64_t), intent(in), target :: ids(*)
+    integer(c_int64_t), intent(in), target :: ids(:)
     integer(c_int), intent(in) :: mem
-    st = mfree_particles_set_global_ids_c(ps%ptr, ids, mem)
+    integer(c_int64_t), allocatable, target :: tmp(:)
+    integer(c_int32_t), target :: n
+    character(len=*), parameter :: fn = 'mfree_particles_set_global_ids'
+    st = check_borrow(ctx_of_particles(ps), fn, 'ids', is_contiguous(ids), mem)
+    if (st == MFREE_SUCCESS) st = mfree_particles_get_size_c(ps%ptr, c_loc(n), c_null_ptr)
+    if (st == MFREE_SUCCESS) st = check_out(ctx_of_particles(ps), fn, 'ids', .true., &
+                                            size(ids, kind=c_int64_t), int(n, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
+    if (is_contiguous(ids)) then
+      st = mfree_particles_set_global_ids_c(ps%ptr, ids, mem)
+    else
+      tmp = ids
+      st = mfree_particles_set_global_ids_c(ps%ptr, tmp, mem)
+    end if
   end function mfree_particles_set_global_ids
 
-  !> Typed wrapper of mfree_particles_get_global_ids (mfree.h).
+  !> ids must be contiguous and hold n values (else MFREE_ERR_ARG).
   integer(c_int) function mfree_particles_get_global_ids(ps, ids) result(st)
     type(mfree_particles), intent(in) :: ps
-    integer(c_int64_t), intent(out) :: ids(*)
+    integer(c_int64_t), intent(out), target :: ids(:)
+    integer(c_int32_t), target :: n
+    st = mfree_particles_get_size_c(ps%ptr, c_loc(n), c_null_ptr)
+    if (st == MFREE_SUCCESS) st = check_out(ctx_of_particles(ps), 'mfree_particles_get_global_ids', &
+                                            'ids', is_contiguous(ids), size(ids, kind=c_int64_t), &
+                                            int(n, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
     st = mfree_particles_get_global_ids_c(ps%ptr, ids)
   end function mfree_particles_get_global_ids
 
@@ -1891,32 +2367,66 @@ contains
   end function mfree_particles_get_neighbor_nnz
 
   !> 0-based CSR copy: row i (1-based) is cols(rowptr(i)+1 : rowptr(i+1)), values 0..n-1.
+  !> rowptr must hold n_owned + 1 values and cols the neighbour count (else MFREE_ERR_ARG).
   integer(c_int) function mfree_particles_get_neighbors(ps, rowptr, cols) result(st)
     type(mfree_particles), intent(in) :: ps
-    integer(c_int64_t), intent(out) :: rowptr(*)
-    integer(c_int32_t), intent(out) :: cols(*)
+    integer(c_int64_t), intent(out), target :: rowptr(:)
+    integer(c_int32_t), intent(out), target :: cols(:)
+    integer(c_int32_t), target :: n, ng
+    integer(c_int64_t) :: nnz
+    character(len=*), parameter :: fn = 'mfree_particles_get_neighbors'
+    st = mfree_particles_get_size_c(ps%ptr, c_loc(n), c_loc(ng))
+    if (st == MFREE_SUCCESS) st = mfree_particles_get_neighbor_nnz_c(ps%ptr, nnz)
+    if (st /= MFREE_SUCCESS) return
+    st = check_out(ctx_of_particles(ps), fn, 'rowptr', is_contiguous(rowptr), &
+                   size(rowptr, kind=c_int64_t), int(n - ng, c_int64_t) + 1)
+    if (st == MFREE_SUCCESS) st = check_out(ctx_of_particles(ps), fn, 'cols', &
+                                            is_contiguous(cols), size(cols, kind=c_int64_t), nnz)
+    if (st /= MFREE_SUCCESS) return
     st = mfree_particles_get_neighbors_c(ps%ptr, rowptr, cols)
   end function mfree_particles_get_neighbors
 
-  !> Typed wrapper of mfree_particles_get_volumes (mfree.h).
+  !> v must hold n values (else MFREE_ERR_ARG).
   integer(c_int) function mfree_particles_get_volumes(ps, v) result(st)
     type(mfree_particles), intent(in) :: ps
-    real(c_double), intent(out) :: v(*)
+    real(c_double), intent(out), target :: v(:)
+    integer(c_int32_t), target :: n
+    st = mfree_particles_get_size_c(ps%ptr, c_loc(n), c_null_ptr)
+    if (st == MFREE_SUCCESS) st = check_out(ctx_of_particles(ps), 'mfree_particles_get_volumes', &
+                                            'v', is_contiguous(v), size(v, kind=c_int64_t), &
+                                            int(n, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
     st = mfree_particles_get_volumes_c(ps%ptr, v)
   end function mfree_particles_get_volumes
 
-  !> Typed wrapper of mfree_particles_get_site_status (mfree.h).
+  !> status, if present, must hold n values (else MFREE_ERR_ARG).
   integer(c_int) function mfree_particles_get_site_status(ps, status, nfailed) result(st)
     type(mfree_particles), intent(in) :: ps
-    integer(c_int32_t), intent(out), optional, target :: status(*)
+    integer(c_int32_t), intent(out), optional, target :: status(:)
     integer(c_int32_t), intent(out), optional, target :: nfailed
     type(c_ptr) :: pstat, pf
+    integer(c_int32_t), target :: n
     pstat = c_null_ptr
     pf = c_null_ptr
-    if (present(status)) pstat = c_loc(status)
+    if (present(status)) then
+      st = mfree_particles_get_size_c(ps%ptr, c_loc(n), c_null_ptr)
+      if (st == MFREE_SUCCESS) st = check_out(ctx_of_particles(ps), &
+                                              'mfree_particles_get_site_status', 'status', &
+                                              is_contiguous(status), &
+                                              size(status, kind=c_int64_t), int(n, c_int64_t))
+      if (st /= MFREE_SUCCESS) return
+      pstat = out_loc(status)
+    end if
     if (present(nfailed)) pf = c_loc(nfailed)
     st = mfree_particles_get_site_status_c(ps%ptr, pstat, pf)
   end function mfree_particles_get_site_status
+
+  !> Typed wrapper of mfree_particles_get_context (mfree.h).
+  integer(c_int) function mfree_particles_get_context(ps, ctx) result(st)
+    type(mfree_particles), intent(in) :: ps
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_particles_get_context_c(ps%ptr, ctx%ptr)
+  end function mfree_particles_get_context
 
   ! ==== approximants ===================================================================
 
@@ -1958,16 +2468,24 @@ contains
     st = mfree_mesh_destroy_c(mesh%ptr)
   end function mfree_mesh_destroy
 
-  !> Typed wrapper of mfree_mesh_add_elements (mfree.h).
+  !> conn(nodes per element, nelem), any rank; borrowed: contiguous (else MFREE_ERR_ARG).
   integer(c_int) function mfree_mesh_add_elements(mesh, type, nelem, conn, index_base, mem) &
       result(st)
     type(mfree_mesh), intent(in) :: mesh
     integer(c_int), intent(in) :: type
     integer(c_int32_t), intent(in) :: nelem
-    integer(c_int32_t), intent(in), target :: conn(*)
+    integer(c_int32_t), intent(in), target :: conn(..)
     integer(c_int32_t), intent(in) :: index_base
     integer(c_int), intent(in) :: mem
-    st = mfree_mesh_add_elements_c(mesh%ptr, type, nelem, conn, index_base, mem)
+    integer(c_int32_t), allocatable, target :: tmp(:)
+    integer(c_int32_t), pointer :: p(:)
+    type(c_ptr) :: ctx
+    ctx = c_null_ptr
+    st = mfree_mesh_get_context_c(mesh%ptr, ctx)
+    st = check_borrow(ctx, 'mfree_mesh_add_elements', 'conn', is_contiguous(conn), mem)
+    if (st /= MFREE_SUCCESS) return
+    call view_i32(conn, tmp, p)
+    st = mfree_mesh_add_elements_c(mesh%ptr, type, nelem, p, index_base, mem)
   end function mfree_mesh_add_elements
 
   !> Typed wrapper of mfree_mesh_setup (mfree.h).
@@ -1983,19 +2501,53 @@ contains
     st = mfree_mesh_get_size_c(mesh%ptr, nelem)
   end function mfree_mesh_get_size
 
-  !> x(dim, npts) and w(npts) are optional: call without them for the count first.
+  !> x(dim, npts) and w(npts) are optional: call without them for the count first; with
+  !> them, each must be contiguous and hold dim*npts, npts values (else MFREE_ERR_ARG).
   integer(c_int) function mfree_mesh_get_quadrature(mesh, ngauss, npts, x, w) result(st)
     type(mfree_mesh), intent(in) :: mesh
     integer(c_int32_t), intent(in) :: ngauss
     integer(c_int32_t), intent(out) :: npts
-    real(c_double), intent(out), optional, target :: x(*), w(*)
-    type(c_ptr) :: px, pw
+    real(c_double), intent(out), optional, target :: x(..), w(:)
+    type(c_ptr) :: px, pw, ctx, ps
+    integer(c_int32_t) :: dim
+    character(len=*), parameter :: fn = 'mfree_mesh_get_quadrature'
     px = c_null_ptr
     pw = c_null_ptr
-    if (present(x)) px = c_loc(x)
-    if (present(w)) pw = c_loc(w)
+    st = mfree_mesh_get_quadrature_c(mesh%ptr, ngauss, npts, px, pw)
+    if (st /= MFREE_SUCCESS .or. .not. (present(x) .or. present(w))) return
+    ctx = c_null_ptr
+    ps = c_null_ptr
+    st = mfree_mesh_get_context_c(mesh%ptr, ctx)
+    if (st == MFREE_SUCCESS) st = mfree_mesh_get_particles_c(mesh%ptr, ps)
+    if (st == MFREE_SUCCESS) st = mfree_particles_get_dimension_c(ps, dim)
+    if (st /= MFREE_SUCCESS) return
+    if (present(x)) then
+      st = check_out(ctx, fn, 'x', is_contiguous(x), size(x, kind=c_int64_t), &
+                     int(dim, c_int64_t) * npts)
+      if (st /= MFREE_SUCCESS) return
+      px = out_loc(x)
+    end if
+    if (present(w)) then
+      st = check_out(ctx, fn, 'w', is_contiguous(w), size(w, kind=c_int64_t), int(npts, c_int64_t))
+      if (st /= MFREE_SUCCESS) return
+      pw = out_loc(w)
+    end if
     st = mfree_mesh_get_quadrature_c(mesh%ptr, ngauss, npts, px, pw)
   end function mfree_mesh_get_quadrature
+
+  !> Typed wrapper of mfree_mesh_get_context (mfree.h).
+  integer(c_int) function mfree_mesh_get_context(mesh, ctx) result(st)
+    type(mfree_mesh), intent(in) :: mesh
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_mesh_get_context_c(mesh%ptr, ctx%ptr)
+  end function mfree_mesh_get_context
+
+  !> Typed wrapper of mfree_mesh_get_particles (mfree.h).
+  integer(c_int) function mfree_mesh_get_particles(mesh, ps) result(st)
+    type(mfree_mesh), intent(in) :: mesh
+    type(mfree_particles), intent(out) :: ps
+    st = mfree_mesh_get_particles_c(mesh%ptr, ps%ptr)
+  end function mfree_mesh_get_particles
 
   !> Typed wrapper of mfree_approximant_set_mesh (mfree.h).
   integer(c_int) function mfree_approximant_set_mesh(a, mesh) result(st)
@@ -2033,30 +2585,365 @@ contains
     st = mfree_approximant_set_fallback_c(a%ptr, policy)
   end function mfree_approximant_set_fallback
 
-  !> Typed wrapper of mfree_approximant_set_points_array (mfree.h).
-  integer(c_int) function mfree_approximant_set_points_array(a, npts, x, layout, ld, h, &
-                                                             h_stride, mem) result(st)
+  !> Typed wrapper of mfree_approximant_set_points (mfree.h).
+  integer(c_int) function mfree_approximant_set_points_i64(a, npts, x, layout, ld, h, &
+                                                           h_stride, mem) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int32_t), intent(in) :: npts
-    real(c_double), intent(in), target :: x(*), h(*)
+    real(c_double), intent(in), target :: x(..), h(..)
     integer(c_int), intent(in) :: layout, mem
     integer(c_int64_t), intent(in) :: ld, h_stride
-    st = mfree_approximant_set_points_c(a%ptr, npts, x, layout, ld, h, h_stride, mem)
-  end function mfree_approximant_set_points_array
+    real(c_double), allocatable, target :: tx(:), th(:)
+    real(c_double), pointer :: px(:), ph(:)
+    character(len=*), parameter :: fn = 'mfree_approximant_set_points'
+    st = check_borrow(ctx_of_approximant(a), fn, 'x', is_contiguous(x), mem)
+    if (st == MFREE_SUCCESS) st = check_borrow(ctx_of_approximant(a), fn, 'h', is_contiguous(h), mem)
+    if (st /= MFREE_SUCCESS) return
+    call view_dbl(x, tx, px)
+    call view_dbl(h, th, ph)
+    st = mfree_approximant_set_points_c(a%ptr, npts, px, layout, ld, ph, h_stride, mem)
+  end function mfree_approximant_set_points_i64
 
-  !> Typed wrapper of mfree_approximant_set_points_scalar (mfree.h).
-  integer(c_int) function mfree_approximant_set_points_scalar(a, npts, x, layout, ld, h, &
-                                                              h_stride, mem) result(st)
+  !> Typed wrapper of mfree_approximant_set_points (mfree.h).
+  integer(c_int) function mfree_approximant_set_points_i32(a, npts, x, layout, ld, h, &
+                                                           h_stride, mem) result(st)
     type(mfree_approximant), intent(in) :: a
     integer(c_int32_t), intent(in) :: npts
-    real(c_double), intent(in), target :: x(*)
-    real(c_double), intent(in), target :: h
+    real(c_double), intent(in), target :: x(..), h(..)
     integer(c_int), intent(in) :: layout, mem
-    integer(c_int64_t), intent(in) :: ld, h_stride
-    real(c_double), pointer :: p(:)
-    call c_f_pointer(c_loc(h), p, [1])
-    st = mfree_approximant_set_points_c(a%ptr, npts, x, layout, ld, p, h_stride, mem)
-  end function mfree_approximant_set_points_scalar
+    integer(c_int32_t), intent(in) :: ld, h_stride
+    st = mfree_approximant_set_points_i64(a, npts, x, layout, int(ld, c_int64_t), h, &
+                                          int(h_stride, c_int64_t), mem)
+  end function mfree_approximant_set_points_i32
+
+  !> Doubles apply writes for op on ncomp components with layout olayout/old (0 when the
+  !> arguments are invalid: the C call then reports them).
+  integer(c_int) function apply_need(a, op, ncomp, olayout, old, need) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: op, olayout
+    integer(c_int32_t), intent(in) :: ncomp
+    integer(c_int64_t), intent(in) :: old
+    integer(c_int64_t), intent(out) :: need
+    integer(c_int32_t) :: dim, n, ng, nsites
+    integer(c_int64_t) :: oc
+    need = 0
+    st = approximant_sizes(a, dim, n, ng)
+    if (st == MFREE_SUCCESS) st = mfree_approximant_get_num_sites_c(a%ptr, nsites)
+    if (st /= MFREE_SUCCESS) return
+    select case (op)
+    case (MFREE_OP_VALUE, MFREE_OP_LAPLACIAN)
+      oc = ncomp
+    case (MFREE_OP_GRADIENT)
+      oc = int(ncomp, c_int64_t) * dim
+    case (MFREE_OP_DIVERGENCE)
+      oc = 1
+    case (MFREE_OP_HESSIAN)
+      oc = int(ncomp, c_int64_t) * (dim * (dim + 1) / 2)
+    case default
+      return
+    end select
+    if (nsites <= 0 .or. oc <= 0) return
+    if (olayout == MFREE_LAYOUT_AOS .and. old >= oc) then
+      need = (nsites - 1) * old + oc
+    else if (olayout == MFREE_LAYOUT_SOA .and. old >= nsites) then
+      need = (oc - 1) * old + nsites
+    end if
+  end function apply_need
+
+  !> The checks and the call shared by apply and apply_add.
+  integer(c_int) function apply_common(a, fn, op, ncomp, u, ulayout, uld, out, olayout, old, &
+                                       add) result(st)
+    type(mfree_approximant), intent(in) :: a
+    character(len=*), intent(in) :: fn
+    integer(c_int), intent(in) :: op, ulayout, olayout
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(in), target :: u(..)
+    integer(c_int64_t), intent(in) :: uld, old
+    real(c_double), intent(inout), target :: out(..)
+    logical, intent(in) :: add
+    integer(c_int64_t) :: need
+    real(c_double), pointer :: po(:), pu(:)
+    real(c_double), allocatable, target :: tu(:)
+    st = apply_need(a, op, ncomp, olayout, old, need)
+    if (st == MFREE_SUCCESS) st = check_out(ctx_of_approximant(a), fn, 'out', is_contiguous(out), &
+                                            size(out, kind=c_int64_t), need)
+    if (st /= MFREE_SUCCESS) return
+    po => empty_dbl
+    if (size(out) > 0) call c_f_pointer(c_loc(out), po, [size(out)])
+    call view_dbl(u, tu, pu)
+    if (add) then
+      st = mfree_approximant_apply_add_c(a%ptr, op, ncomp, pu, ulayout, uld, po, olayout, old)
+    else
+      st = mfree_approximant_apply_c(a%ptr, op, ncomp, pu, ulayout, uld, po, olayout, old)
+    end if
+  end function apply_common
+
+  !> out = op(u). For u(ncomp,n) use MFREE_LAYOUT_AOS with uld = ncomp (or the leading
+  !> extent of a larger array, e.g. 3 for v(3,n) in 2D); MFREE_OP_GRADIENT writes
+  !> direction d of component c at c*dim + d, i.e. out(d, c, i) for out(dim, ncomp, n)
+  !> with old = dim*ncomp. out (any rank) must be contiguous and large enough for what
+  !> the layout addresses (else MFREE_ERR_ARG, nothing written); uld and old of either
+  !> integer kind (both the same).
+  integer(c_int) function mfree_approximant_apply_i64(a, op, ncomp, u, ulayout, uld, out, &
+                                                      olayout, old) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: op, ulayout, olayout
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(in), target :: u(..)
+    integer(c_int64_t), intent(in) :: uld, old
+    real(c_double), intent(out), target :: out(..)
+    st = apply_common(a, 'mfree_approximant_apply', op, ncomp, u, ulayout, uld, out, olayout, &
+                      old, .false.)
+  end function mfree_approximant_apply_i64
+
+  !> Typed wrapper of mfree_approximant_apply (mfree.h).
+  integer(c_int) function mfree_approximant_apply_i32(a, op, ncomp, u, ulayout, uld, out, &
+                                                      olayout, old) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: op, ulayout, olayout
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(in), target :: u(..)
+    integer(c_int32_t), intent(in) :: uld, old
+    real(c_double), intent(out), target :: out(..)
+    st = apply_common(a, 'mfree_approximant_apply', op, ncomp, u, ulayout, int(uld, c_int64_t), &
+                      out, olayout, int(old, c_int64_t), .false.)
+  end function mfree_approximant_apply_i32
+
+  !> Typed wrapper of mfree_approximant_apply_add (mfree.h).
+  integer(c_int) function mfree_approximant_apply_add_i64(a, op, ncomp, u, ulayout, uld, out, &
+                                                          olayout, old) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: op, ulayout, olayout
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(in), target :: u(..)
+    integer(c_int64_t), intent(in) :: uld, old
+    real(c_double), intent(inout), target :: out(..)
+    st = apply_common(a, 'mfree_approximant_apply_add', op, ncomp, u, ulayout, uld, out, &
+                      olayout, old, .true.)
+  end function mfree_approximant_apply_add_i64
+
+  !> Typed wrapper of mfree_approximant_apply_add (mfree.h).
+  integer(c_int) function mfree_approximant_apply_add_i32(a, op, ncomp, u, ulayout, uld, out, &
+                                                          olayout, old) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: op, ulayout, olayout
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(in), target :: u(..)
+    integer(c_int32_t), intent(in) :: uld, old
+    real(c_double), intent(inout), target :: out(..)
+    st = apply_common(a, 'mfree_approximant_apply_add', op, ncomp, u, ulayout, &
+                      int(uld, c_int64_t), out, olayout, int(old, c_int64_t), .true.)
+  end function mfree_approximant_apply_add_i32
+
+  !> MFREE_SUCCESS when an output of one value per site (nsites, contiguous) fits.
+  integer(c_int) function check_sites(a, fn, what, contig, have, extra) result(st)
+    type(mfree_approximant), intent(in) :: a
+    character(len=*), intent(in) :: fn, what
+    logical, intent(in) :: contig
+    integer(c_int64_t), intent(in) :: have
+    integer(c_int32_t), intent(in) :: extra
+    integer(c_int32_t) :: nsites
+    st = mfree_approximant_get_num_sites_c(a%ptr, nsites)
+    if (st /= MFREE_SUCCESS) return
+    st = check_out(ctx_of_approximant(a), fn, what, contig, have, int(nsites + extra, c_int64_t))
+  end function check_sites
+
+  !> One table as 0-based CSR; any of rowptr (nsites + 1), cols and vals (nnz each) may be
+  !> omitted (not all); each present one must be contiguous and large enough.
+  integer(c_int) function mfree_approximant_assemble_csr(a, deriv, component, rowptr, cols, &
+                                                         vals) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int), intent(in) :: deriv
+    integer(c_int32_t), intent(in) :: component
+    integer(c_int64_t), intent(out), optional, target :: rowptr(:)
+    integer(c_int32_t), intent(out), optional, target :: cols(:)
+    real(c_double), intent(out), optional, target :: vals(:)
+    type(c_ptr) :: pr, pc, pv
+    integer(c_int64_t) :: nnz
+    character(len=*), parameter :: fn = 'mfree_approximant_assemble_csr'
+    pr = c_null_ptr
+    pc = c_null_ptr
+    pv = c_null_ptr
+    st = mfree_approximant_get_nnz_c(a%ptr, nnz)
+    if (st /= MFREE_SUCCESS) return
+    if (present(rowptr)) then
+      st = check_sites(a, fn, 'rowptr', is_contiguous(rowptr), size(rowptr, kind=c_int64_t), 1)
+      if (st /= MFREE_SUCCESS) return
+      pr = c_loc(rowptr)
+    end if
+    if (present(cols)) then
+      st = check_out(ctx_of_approximant(a), fn, 'cols', is_contiguous(cols), &
+                     size(cols, kind=c_int64_t), nnz)
+      if (st /= MFREE_SUCCESS) return
+      pc = c_loc(cols)
+    end if
+    if (present(vals)) then
+      st = check_out(ctx_of_approximant(a), fn, 'vals', is_contiguous(vals), &
+                     size(vals, kind=c_int64_t), nnz)
+      if (st /= MFREE_SUCCESS) return
+      pv = c_loc(vals)
+    end if
+    st = mfree_approximant_assemble_csr_c(a%ptr, deriv, component, pr, pc, pv)
+  end function mfree_approximant_assemble_csr
+
+  !> Per-site outputs: nsites values each (else MFREE_ERR_ARG).
+  integer(c_int) function mfree_approximant_get_site_status(a, status, nfailed) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out), optional, target :: status(:)
+    integer(c_int32_t), intent(out), optional, target :: nfailed
+    type(c_ptr) :: pstat, pf
+    pstat = c_null_ptr
+    pf = c_null_ptr
+    if (present(status)) then
+      st = check_sites(a, 'mfree_approximant_get_site_status', 'status', is_contiguous(status), &
+                       size(status, kind=c_int64_t), 0)
+      if (st /= MFREE_SUCCESS) return
+      pstat = out_loc(status)
+    end if
+    if (present(nfailed)) pf = c_loc(nfailed)
+    st = mfree_approximant_get_site_status_c(a%ptr, pstat, pf)
+  end function mfree_approximant_get_site_status
+
+  !> Typed wrapper of mfree_approximant_get_neighbor_counts (mfree.h).
+  integer(c_int) function mfree_approximant_get_neighbor_counts(a, counts) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out) :: counts(:)
+    st = check_sites(a, 'mfree_approximant_get_neighbor_counts', 'counts', &
+                     is_contiguous(counts), size(counts, kind=c_int64_t), 0)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_approximant_get_neighbor_counts_c(a%ptr, counts)
+  end function mfree_approximant_get_neighbor_counts
+
+  !> Typed wrapper of mfree_approximant_get_condition (mfree.h).
+  integer(c_int) function mfree_approximant_get_condition(a, cond) result(st)
+    type(mfree_approximant), intent(in) :: a
+    real(c_double), intent(out) :: cond(:)
+    st = check_sites(a, 'mfree_approximant_get_condition', 'cond', is_contiguous(cond), &
+                     size(cond, kind=c_int64_t), 0)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_approximant_get_condition_c(a%ptr, cond)
+  end function mfree_approximant_get_condition
+
+  !> Typed wrapper of mfree_approximant_get_site_order (mfree.h).
+  integer(c_int) function mfree_approximant_get_site_order(a, order) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out) :: order(:)
+    st = check_sites(a, 'mfree_approximant_get_site_order', 'order', is_contiguous(order), &
+                     size(order, kind=c_int64_t), 0)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_approximant_get_site_order_c(a%ptr, order)
+  end function mfree_approximant_get_site_order
+
+  !> Per-pair gradients into gi(ld, npairs) and, optionally, gj(ld, npairs), ld >= dim
+  !> (e.g. a legacy code's dwdx(3, max_interaction)): gi(:, k) is particle pair_i(k)'s
+  !> row at pair_j(k), per unit volume (for plain SPH exactly the code's dwdx(:, k)), gj
+  !> the other side (mfree.h). Arrays that are not contiguous or have fewer than npairs
+  !> columns give MFREE_ERR_ARG and nothing is written.
+  integer(c_int) function mfree_approximant_get_pair_gradients(a, gi, gj) result(st)
+    type(mfree_approximant), intent(in) :: a
+    real(c_double), intent(out), target :: gi(:, :)
+    real(c_double), intent(out), optional, target :: gj(:, :)
+    type(c_ptr) :: pj
+    character(len=*), parameter :: fn = 'mfree_approximant_get_pair_gradients'
+    st = check_pair_array(a, fn, 'gi', is_contiguous(gi), size(gi, 1, kind=c_int64_t), &
+                          size(gi, 2, kind=c_int64_t))
+    if (st /= MFREE_SUCCESS) return
+    pj = c_null_ptr
+    if (present(gj)) then
+      st = check_pair_array(a, fn, 'gj', is_contiguous(gj), size(gj, 1, kind=c_int64_t), &
+                            size(gj, 2, kind=c_int64_t))
+      if (st /= MFREE_SUCCESS) return
+      if (size(gi, 1) /= size(gj, 1)) then
+        st = wrapper_error(ctx_of_approximant(a), MFREE_ERR_ARG, fn // &
+                           ': gi and gj have different leading extents')
+        return
+      end if
+      pj = out_loc(gj)
+    end if
+    st = mfree_approximant_get_pair_gradients_c(a%ptr, out_loc(gi), pj, &
+                                                size(gi, 1, kind=c_int64_t), &
+                                                size(gi, kind=c_int64_t))
+  end function mfree_approximant_get_pair_gradients
+
+  !> The antisymmetrised per-pair gradient g(ld, npairs) (j side = -g), as above.
+  integer(c_int) function mfree_approximant_get_pair_gradients_antisymmetric(a, g) result(st)
+    type(mfree_approximant), intent(in) :: a
+    real(c_double), intent(out), target :: g(:, :)
+    st = check_pair_array(a, 'mfree_approximant_get_pair_gradients_antisymmetric', 'g', &
+                          is_contiguous(g), size(g, 1, kind=c_int64_t), size(g, 2, kind=c_int64_t))
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_approximant_get_pair_gradients_antisymmetric_c(a%ptr, out_loc(g), &
+                                                              size(g, 1, kind=c_int64_t), &
+                                                              size(g, kind=c_int64_t))
+  end function mfree_approximant_get_pair_gradients_antisymmetric
+
+  !> A pair-gradient array (ld, ncol): contiguous, ld >= dim, ncol >= npairs.
+  integer(c_int) function check_pair_array(a, fn, what, contig, ld, ncol) result(st)
+    type(mfree_approximant), intent(in) :: a
+    character(len=*), intent(in) :: fn, what
+    logical, intent(in) :: contig
+    integer(c_int64_t), intent(in) :: ld, ncol
+    integer(c_int32_t) :: dim, n, ng
+    integer(c_int64_t) :: np
+    type(c_ptr) :: ps
+    st = approximant_sizes(a, dim, n, ng)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_approximant_get_particles_c(a%ptr, ps)
+    if (st == MFREE_SUCCESS) st = mfree_particles_get_num_pairs_c(ps, np)
+    if (st /= MFREE_SUCCESS) return
+    if (ld < dim) then
+      st = wrapper_error(ctx_of_approximant(a), MFREE_ERR_ARG, fn // ': ' // what // ' has ' // &
+                         int_str(ld) // ' rows, below the dimension ' // int_str(int(dim, c_int64_t)))
+      return
+    end if
+    st = check_out(ctx_of_approximant(a), fn, what // ' columns', contig, ncol, np)
+  end function check_pair_array
+
+  !> Typed wrapper of mfree_approximant_get_correction_size (mfree.h).
+  integer(c_int) function mfree_approximant_get_correction_size(a, ncoef) result(st)
+    type(mfree_approximant), intent(in) :: a
+    integer(c_int32_t), intent(out) :: ncoef
+    st = mfree_approximant_get_correction_size_c(a%ptr, ncoef)
+  end function mfree_approximant_get_correction_size
+
+  !> Per-particle correction data c(ld, n_owned), ld >= ncoef (layout in mfree.h; a
+  !> matrix M of particle i is reshape(c(1:dim*dim, i), [dim, dim]), so that the
+  !> corrected gradient is matmul(M, dwdx)). MFREE_ERR_ARG, nothing written, when c is
+  !> not contiguous or too small.
+  integer(c_int) function mfree_approximant_get_correction(a, c) result(st)
+    type(mfree_approximant), intent(in) :: a
+    real(c_double), intent(out), target :: c(:, :)
+    integer(c_int32_t) :: nsites, nc
+    character(len=*), parameter :: fn = 'mfree_approximant_get_correction'
+    st = mfree_approximant_get_correction_size_c(a%ptr, nc)
+    if (st == MFREE_SUCCESS) st = mfree_approximant_get_num_sites_c(a%ptr, nsites)
+    if (st /= MFREE_SUCCESS) return
+    if (size(c, 1) < nc) then
+      st = wrapper_error(ctx_of_approximant(a), MFREE_ERR_ARG, fn // ': c has ' // &
+                         int_str(size(c, 1, kind=c_int64_t)) // ' rows, ' // &
+                         int_str(int(nc, c_int64_t)) // ' are needed')
+      return
+    end if
+    st = check_out(ctx_of_approximant(a), fn, 'c columns', is_contiguous(c), &
+                   size(c, 2, kind=c_int64_t), int(nsites, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_approximant_get_correction_c(a%ptr, out_loc(c), size(c, 1, kind=c_int64_t), &
+                                            size(c, kind=c_int64_t))
+  end function mfree_approximant_get_correction
+
+  !> The context (borrowed: do not destroy it) and the particle set (borrowed) of a.
+  integer(c_int) function mfree_approximant_get_context(a, ctx) result(st)
+    type(mfree_approximant), intent(in) :: a
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_approximant_get_context_c(a%ptr, ctx%ptr)
+  end function mfree_approximant_get_context
+
+  !> Typed wrapper of mfree_approximant_get_particles (mfree.h).
+  integer(c_int) function mfree_approximant_get_particles(a, ps) result(st)
+    type(mfree_approximant), intent(in) :: a
+    type(mfree_particles), intent(out) :: ps
+    st = mfree_approximant_get_particles_c(a%ptr, ps%ptr)
+  end function mfree_approximant_get_particles
 
   !> Typed wrapper of mfree_approximant_setup (mfree.h).
   integer(c_int) function mfree_approximant_setup(a) result(st)
@@ -2069,34 +2956,6 @@ contains
     type(mfree_approximant), intent(in) :: a
     st = mfree_approximant_update_c(a%ptr)
   end function mfree_approximant_update
-
-  !> out = op(u). For u(ncomp,n) use MFREE_LAYOUT_AOS with uld = ncomp (or the leading
-  !> extent of a larger array, e.g. 3 for v(3,n) in 2D); MFREE_OP_GRADIENT writes
-  !> direction d of component c at c*dim + d, i.e. out(d, c, i) for out(dim, ncomp, n)
-  !> with old = dim*ncomp.
-  integer(c_int) function mfree_approximant_apply(a, op, ncomp, u, ulayout, uld, out, &
-                                                  olayout, old) result(st)
-    type(mfree_approximant), intent(in) :: a
-    integer(c_int), intent(in) :: op, ulayout, olayout
-    integer(c_int32_t), intent(in) :: ncomp
-    real(c_double), intent(in) :: u(*)
-    integer(c_int64_t), intent(in) :: uld, old
-    real(c_double), intent(out) :: out(*)
-    st = mfree_approximant_apply_c(a%ptr, op, ncomp, u, ulayout, uld, out, olayout, old)
-  end function mfree_approximant_apply
-
-  !> Typed wrapper of mfree_approximant_apply_add (mfree.h).
-  integer(c_int) function mfree_approximant_apply_add(a, op, ncomp, u, ulayout, uld, out, &
-                                                      olayout, old) result(st)
-    type(mfree_approximant), intent(in) :: a
-    integer(c_int), intent(in) :: op, ulayout, olayout
-    integer(c_int32_t), intent(in) :: ncomp
-    real(c_double), intent(in) :: u(*)
-    integer(c_int64_t), intent(in) :: uld, old
-    real(c_double), intent(inout) :: out(*)
-    st = mfree_approximant_apply_add_c(a%ptr, op, ncomp, u, ulayout, uld, out, olayout, &
-                                       old)
-  end function mfree_approximant_apply_add
 
   !> Typed wrapper of mfree_approximant_get_num_sites (mfree.h).
   integer(c_int) function mfree_approximant_get_num_sites(a, nsites) result(st)
@@ -2112,25 +2971,6 @@ contains
     st = mfree_approximant_get_nnz_c(a%ptr, nnz)
   end function mfree_approximant_get_nnz
 
-  !> One table as 0-based CSR; any of rowptr, cols, vals may be omitted (not all).
-  integer(c_int) function mfree_approximant_assemble_csr(a, deriv, component, rowptr, cols, &
-                                                         vals) result(st)
-    type(mfree_approximant), intent(in) :: a
-    integer(c_int), intent(in) :: deriv
-    integer(c_int32_t), intent(in) :: component
-    integer(c_int64_t), intent(out), optional, target :: rowptr(*)
-    integer(c_int32_t), intent(out), optional, target :: cols(*)
-    real(c_double), intent(out), optional, target :: vals(*)
-    type(c_ptr) :: pr, pc, pv
-    pr = c_null_ptr
-    pc = c_null_ptr
-    pv = c_null_ptr
-    if (present(rowptr)) pr = c_loc(rowptr)
-    if (present(cols)) pc = c_loc(cols)
-    if (present(vals)) pv = c_loc(vals)
-    st = mfree_approximant_assemble_csr_c(a%ptr, deriv, component, pr, pc, pv)
-  end function mfree_approximant_assemble_csr
-
   !> Typed wrapper of mfree_approximant_check_reproduction (mfree.h).
   integer(c_int) function mfree_approximant_check_reproduction(a, order, fn_err, deriv_err) &
       result(st)
@@ -2139,40 +2979,6 @@ contains
     real(c_double), intent(out) :: fn_err, deriv_err
     st = mfree_approximant_check_reproduction_c(a%ptr, order, fn_err, deriv_err)
   end function mfree_approximant_check_reproduction
-
-  !> Typed wrapper of mfree_approximant_get_site_status (mfree.h).
-  integer(c_int) function mfree_approximant_get_site_status(a, status, nfailed) result(st)
-    type(mfree_approximant), intent(in) :: a
-    integer(c_int32_t), intent(out), optional, target :: status(*)
-    integer(c_int32_t), intent(out), optional, target :: nfailed
-    type(c_ptr) :: pstat, pf
-    pstat = c_null_ptr
-    pf = c_null_ptr
-    if (present(status)) pstat = c_loc(status)
-    if (present(nfailed)) pf = c_loc(nfailed)
-    st = mfree_approximant_get_site_status_c(a%ptr, pstat, pf)
-  end function mfree_approximant_get_site_status
-
-  !> Typed wrapper of mfree_approximant_get_neighbor_counts (mfree.h).
-  integer(c_int) function mfree_approximant_get_neighbor_counts(a, counts) result(st)
-    type(mfree_approximant), intent(in) :: a
-    integer(c_int32_t), intent(out) :: counts(*)
-    st = mfree_approximant_get_neighbor_counts_c(a%ptr, counts)
-  end function mfree_approximant_get_neighbor_counts
-
-  !> Typed wrapper of mfree_approximant_get_condition (mfree.h).
-  integer(c_int) function mfree_approximant_get_condition(a, cond) result(st)
-    type(mfree_approximant), intent(in) :: a
-    real(c_double), intent(out) :: cond(*)
-    st = mfree_approximant_get_condition_c(a%ptr, cond)
-  end function mfree_approximant_get_condition
-
-  !> Typed wrapper of mfree_approximant_get_site_order (mfree.h).
-  integer(c_int) function mfree_approximant_get_site_order(a, order) result(st)
-    type(mfree_approximant), intent(in) :: a
-    integer(c_int32_t), intent(out) :: order(*)
-    st = mfree_approximant_get_site_order_c(a%ptr, order)
-  end function mfree_approximant_get_site_order
 
   ! ==== sparse matrices ================================================================
 
@@ -2336,13 +3142,29 @@ contains
     st = mfree_matrix_get_symmetric_c(A%ptr, symmetric)
   end function mfree_matrix_get_symmetric
 
-  !> Typed wrapper of mfree_matrix_apply (mfree.h).
+  !> y = A x; y must be contiguous and hold nrows values (else MFREE_ERR_ARG).
   integer(c_int) function mfree_matrix_apply(A, x, y) result(st)
     type(mfree_matrix), intent(in) :: A
     real(c_double), intent(in) :: x(*)
-    real(c_double), intent(out) :: y(*)
+    real(c_double), intent(out), target :: y(:)
+    integer(c_int32_t), target :: nrows
+    type(c_ptr) :: ctx
+    st = mfree_matrix_get_size_c(A%ptr, c_loc(nrows), c_null_ptr, c_null_ptr)
+    if (st /= MFREE_SUCCESS) return
+    ctx = c_null_ptr
+    st = mfree_matrix_get_context_c(A%ptr, ctx)
+    st = check_out(ctx, 'mfree_matrix_apply', 'y', is_contiguous(y), size(y, kind=c_int64_t), &
+                   int(nrows, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
     st = mfree_matrix_apply_c(A%ptr, x, y)
   end function mfree_matrix_apply
+
+  !> Typed wrapper of mfree_matrix_get_context (mfree.h).
+  integer(c_int) function mfree_matrix_get_context(A, ctx) result(st)
+    type(mfree_matrix), intent(in) :: A
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_matrix_get_context_c(A%ptr, ctx%ptr)
+  end function mfree_matrix_get_context
 
   ! ==== assembly =======================================================================
 
@@ -2565,12 +3387,28 @@ contains
     st = mfree_assembler_assemble_matrix_c(as%ptr, K%ptr)
   end function mfree_assembler_assemble_matrix
 
-  !> Typed wrapper of mfree_assembler_assemble_rhs (mfree.h).
+  !> f must be contiguous and hold ndofs values (else MFREE_ERR_ARG).
   integer(c_int) function mfree_assembler_assemble_rhs(as, f) result(st)
     type(mfree_assembler), intent(in) :: as
-    real(c_double), intent(out) :: f(*)
+    real(c_double), intent(out), target :: f(:)
+    integer(c_int32_t), target :: ndofs
+    type(c_ptr) :: ctx
+    st = mfree_assembler_get_size_c(as%ptr, c_loc(ndofs), c_null_ptr)
+    if (st /= MFREE_SUCCESS) return
+    ctx = c_null_ptr
+    st = mfree_assembler_get_context_c(as%ptr, ctx)
+    st = check_out(ctx, 'mfree_assembler_assemble_rhs', 'f', is_contiguous(f), &
+                   size(f, kind=c_int64_t), int(ndofs, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
     st = mfree_assembler_assemble_rhs_c(as%ptr, f)
   end function mfree_assembler_assemble_rhs
+
+  !> Typed wrapper of mfree_assembler_get_context (mfree.h).
+  integer(c_int) function mfree_assembler_get_context(as, ctx) result(st)
+    type(mfree_assembler), intent(in) :: as
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_assembler_get_context_c(as%ptr, ctx%ptr)
+  end function mfree_assembler_get_context
 
   ! ==== semi-discrete particle systems =================================================
 
@@ -2705,14 +3543,100 @@ contains
     st = mfree_system_get_size_c(sys%ptr, neq)
   end function mfree_system_get_size
 
-  !> Typed wrapper of mfree_system_rhs (mfree.h).
+  !> MFREE_SUCCESS when an output of a system (per: values per particle, 0: neq values)
+  !> is contiguous and large enough.
+  integer(c_int) function check_system_out(sys, fn, what, contig, have, per) result(st)
+    type(mfree_system), intent(in) :: sys
+    character(len=*), intent(in) :: fn, what
+    logical, intent(in) :: contig
+    integer(c_int64_t), intent(in) :: have
+    integer, intent(in) :: per
+    integer(c_int32_t), target :: dim, n
+    integer(c_int32_t) :: neq
+    integer(c_int64_t) :: need
+    type(c_ptr) :: ctx
+    if (per == 0) then
+      st = mfree_system_get_size_c(sys%ptr, neq)
+      need = neq
+    else
+      st = mfree_system_get_dimension_c(sys%ptr, c_loc(dim), c_loc(n))
+      select case (per)
+      case (-1)  ! dim per particle
+        need = int(dim, c_int64_t) * n
+      case (-2)  ! stress components per particle
+        need = int(merge(1, merge(3, 6, dim == 2), dim == 1), c_int64_t) * n
+      case default
+        need = int(per, c_int64_t) * n
+      end select
+    end if
+    if (st /= MFREE_SUCCESS) return
+    ctx = c_null_ptr
+    st = mfree_system_get_context_c(sys%ptr, ctx)
+    st = check_out(ctx, fn, what, contig, have, need)
+  end function check_system_out
+
+  !> ydot must be contiguous and hold neq values (else MFREE_ERR_ARG).
   integer(c_int) function mfree_system_rhs(sys, t, y, ydot) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: t
     real(c_double), intent(in) :: y(*)
-    real(c_double), intent(out) :: ydot(*)
+    real(c_double), intent(out), target :: ydot(:)
+    st = check_system_out(sys, 'mfree_system_rhs', 'ydot', is_contiguous(ydot), &
+                          size(ydot, kind=c_int64_t), 0)
+    if (st /= MFREE_SUCCESS) return
     st = mfree_system_rhs_c(sys%ptr, t, y, ydot)
   end function mfree_system_rhs
+
+  !> p must be contiguous and hold n values (else MFREE_ERR_ARG).
+  integer(c_int) function mfree_system_get_pressure(sys, y, p) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: y(*)
+    real(c_double), intent(out), target :: p(:)
+    st = check_system_out(sys, 'mfree_system_get_pressure', 'p', is_contiguous(p), &
+                          size(p, kind=c_int64_t), 1)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_system_get_pressure_c(sys%ptr, y, p)
+  end function mfree_system_get_pressure
+
+  !> vhat(dim, n), contiguous (else MFREE_ERR_ARG).
+  integer(c_int) function mfree_system_get_velocity(sys, y, vhat) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: y(*)
+    real(c_double), intent(out), target :: vhat(..)
+    real(c_double), pointer :: pv(:)
+    st = check_system_out(sys, 'mfree_system_get_velocity', 'vhat', is_contiguous(vhat), &
+                          size(vhat, kind=c_int64_t), -1)
+    if (st /= MFREE_SUCCESS) return
+    pv => empty_dbl
+    if (size(vhat) > 0) call c_f_pointer(c_loc(vhat), pv, [size(vhat)])
+    st = mfree_system_get_velocity_c(sys%ptr, y, pv)
+  end function mfree_system_get_velocity
+
+  !> Integrate y (neq values, contiguous: else MFREE_ERR_ARG) from t to t_end (both updated
+  !> in place); progress (optional) is called after every accepted step; nsteps
+  !> (optional) receives the number of steps.
+  integer(c_int) function mfree_system_integrate(sys, scheme, y, t, t_end, cfl, dt_max, &
+                                                 progress, user, nsteps) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int), intent(in) :: scheme
+    real(c_double), intent(inout), target :: y(:)
+    real(c_double), intent(inout) :: t
+    real(c_double), intent(in) :: t_end, cfl, dt_max
+    procedure(mfree_progress_fn), optional :: progress
+    type(c_ptr), intent(in), optional :: user
+    integer(c_int64_t), intent(out), optional, target :: nsteps
+    type(c_funptr) :: fp
+    type(c_ptr) :: pn
+    st = check_system_out(sys, 'mfree_system_integrate', 'y', is_contiguous(y), &
+                          size(y, kind=c_int64_t), 0)
+    if (st /= MFREE_SUCCESS) return
+    fp = c_null_funptr
+    pn = c_null_ptr
+    if (present(progress)) fp = c_funloc(progress)
+    if (present(nsteps)) pn = c_loc(nsteps)
+    st = mfree_system_integrate_c(sys%ptr, scheme, y, t, t_end, cfl, dt_max, fp, &
+                                  user_ptr(user), pn)
+  end function mfree_system_integrate
 
   !> consistent: 0 lumped, nonzero consistent velocity block. M null: created.
   integer(c_int) function mfree_system_assemble_mass(sys, y, consistent, M) result(st)
@@ -2730,44 +3654,6 @@ contains
     type(mfree_matrix), intent(inout) :: S
     st = mfree_system_assemble_interpolation_c(sys%ptr, y, S%ptr)
   end function mfree_system_assemble_interpolation
-
-  !> Typed wrapper of mfree_system_get_pressure (mfree.h).
-  integer(c_int) function mfree_system_get_pressure(sys, y, p) result(st)
-    type(mfree_system), intent(in) :: sys
-    real(c_double), intent(in) :: y(*)
-    real(c_double), intent(out) :: p(*)
-    st = mfree_system_get_pressure_c(sys%ptr, y, p)
-  end function mfree_system_get_pressure
-
-  !> Typed wrapper of mfree_system_get_velocity (mfree.h).
-  integer(c_int) function mfree_system_get_velocity(sys, y, vhat) result(st)
-    type(mfree_system), intent(in) :: sys
-    real(c_double), intent(in) :: y(*)
-    real(c_double), intent(out) :: vhat(*)
-    st = mfree_system_get_velocity_c(sys%ptr, y, vhat)
-  end function mfree_system_get_velocity
-
-  !> Integrate y from t to t_end (both updated in place); progress (optional) is called
-  !> after every accepted step; nsteps (optional) receives the number of steps.
-  integer(c_int) function mfree_system_integrate(sys, scheme, y, t, t_end, cfl, dt_max, &
-                                                 progress, user, nsteps) result(st)
-    type(mfree_system), intent(in) :: sys
-    integer(c_int), intent(in) :: scheme
-    real(c_double), intent(inout) :: y(*)
-    real(c_double), intent(inout) :: t
-    real(c_double), intent(in) :: t_end, cfl, dt_max
-    procedure(mfree_progress_fn), optional :: progress
-    type(c_ptr), intent(in), optional :: user
-    integer(c_int64_t), intent(out), optional, target :: nsteps
-    type(c_funptr) :: fp
-    type(c_ptr) :: pn
-    fp = c_null_funptr
-    pn = c_null_ptr
-    if (present(progress)) fp = c_funloc(progress)
-    if (present(nsteps)) pn = c_loc(nsteps)
-    st = mfree_system_integrate_c(sys%ptr, scheme, y, t, t_end, cfl, dt_max, fp, &
-                                  user_ptr(user), pn)
-  end function mfree_system_integrate
 
   !> Elastodynamics by collocation on a set-up collocation assembler (kept alive).
   integer(c_int) function mfree_system_create_elastodynamic(ctx, as, density, sys) result(st)
@@ -2804,14 +3690,40 @@ contains
     st = mfree_system_set_load_history_c(sys%ptr, fp, user_ptr(user))
   end function mfree_system_set_load_history
 
-  !> Stress at the particles (1D: sigma(n); 2D: sigma(3, n) as xx, yy, xy) at time t.
+  !> Stress at the particles (1D: sigma(n); 2D: sigma(3, n) as xx, yy, xy) at time t;
+  !> sigma contiguous and large enough (else MFREE_ERR_ARG).
   integer(c_int) function mfree_system_get_stress(sys, t, y, sigma) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: t
     real(c_double), intent(in) :: y(*)
-    real(c_double), intent(out) :: sigma(*)
-    st = mfree_system_get_stress_c(sys%ptr, t, y, sigma)
+    real(c_double), intent(out), target :: sigma(..)
+    real(c_double), pointer :: ps(:)
+    st = check_system_out(sys, 'mfree_system_get_stress', 'sigma', is_contiguous(sigma), &
+                          size(sigma, kind=c_int64_t), -2)
+    if (st /= MFREE_SUCCESS) return
+    ps => empty_dbl
+    if (size(sigma) > 0) call c_f_pointer(c_loc(sigma), ps, [size(sigma)])
+    st = mfree_system_get_stress_c(sys%ptr, t, y, ps)
   end function mfree_system_get_stress
+
+  !> Typed wrapper of mfree_system_get_context (mfree.h).
+  integer(c_int) function mfree_system_get_context(sys, ctx) result(st)
+    type(mfree_system), intent(in) :: sys
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_system_get_context_c(sys%ptr, ctx%ptr)
+  end function mfree_system_get_context
+
+  !> Spatial dimension and number of particles of a system (each optional).
+  integer(c_int) function mfree_system_get_dimension(sys, dim, n) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(out), optional, target :: dim, n
+    type(c_ptr) :: pd, pn
+    pd = c_null_ptr
+    pn = c_null_ptr
+    if (present(dim)) pd = c_loc(dim)
+    if (present(n)) pn = c_loc(n)
+    st = mfree_system_get_dimension_c(sys%ptr, pd, pn)
+  end function mfree_system_get_dimension
 
   !> The user pointer of a callback: c_null_ptr when absent.
   type(c_ptr) function user_ptr(user)

@@ -264,4 +264,28 @@ mfree_status_t mfree_system_get_stress(mfree_system_t *sys, double t, const doub
   });
 }
 
+mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, int32_t *dim, int32_t *n) {
+  return mfree::with_handle(sys, "mfree_system_get_dimension", [&](const mfree::System &base) {
+    MFREE_REQUIRE(dim || n, MFREE_ERR_NULL, "both outputs are NULL");
+    int32_t d = 0, np = 0;
+    if (const auto *f = dynamic_cast<const mfree::FluidSystem *>(&base)) {
+      d = f->dim();
+      np = f->size();
+    } else {
+      const auto &e = kind<mfree::ElasticSystem>(base, "particles");
+      d = e.dim();
+      np = e.num_particles();
+    }
+    if (dim) *dim = d;
+    if (n) *n = np;
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_get_context(const mfree_system_t *sys, mfree_context_t **ctx) {
+  if (!sys || !ctx) return MFREE_ERR_NULL;
+  *ctx = sys->ctx;
+  return MFREE_SUCCESS;
+}
+
 }  // extern "C"

@@ -512,7 +512,6 @@ Report Approximant::compute(const char *what) {
   support_.resize(nsites_);
   cond_.resize(nsites_);
   order_used_.resize(nsites_);
-  const bool have_vol = ps_->has_volumes();
 
   LocalConfig base;
   base.method = method_;
@@ -574,9 +573,6 @@ Report Approximant::compute(const char *what) {
   fs.order = order_used_.data();
   fs.pst = points_ ? nullptr : pst.data();
   fs.order_used = has_order(method_) ? order_ : fixed_order(method_);
-  bool periodic = false;
-  for (int c = 0; c < dim; ++c) periodic = periodic || ps_->periodic(c);
-  const bool gather = ps_->search_convention() == MFREE_SEARCH_GATHER;
   std::atomic<int64_t> nfailed{0};
   parallel_blocks(nsites_, nt, [&](int t, int64_t b, int64_t e) {
     SiteScratch &w = scratch_[t];
@@ -599,20 +595,7 @@ Report Approximant::compute(const char *what) {
       }
       const int64_t k0 = rowptr_[s];
       const int n = static_cast<int>(rowptr_[s + 1] - k0);
-      // x_j - x_s as site_displacement computes it, with the site's data hoisted
-      double xs[3] = {0, 0, 0};
-      for (int c = 0; c < dim; ++c) xs[c] = site_x(s, c);
-      const double hs = site_h(s);
-      for (int q = 0; q < n; ++q) {
-        const int32_t j = cols_[k0 + q];
-        double *d = &w.d[3 * static_cast<size_t>(q)];
-        d[0] = d[1] = d[2] = 0.0;
-        if (periodic) site_displacement(s, j, d);
-        else
-          for (int c = 0; c < dim; ++c) d[c] = ps_->x(j, c) - xs[c];
-        w.v[q] = have_vol ? ps_->volume(j) : 1.0;
-        w.h[q] = gather ? hs : pair_h(s, j);
-      }
+      site_input(s, w.d.data(), w.v.data(), w.h.data());
       LocalInput in;
       in.n = n;
       in.self = self_[s];
@@ -676,6 +659,35 @@ Report Approximant::compute(const char *what) {
   return rep;
 }
 
+const double *Approximant::packed_volumes(int64_t &stride) const {
+  stride = record_length(ps_->dim());
+  return pack_.data() + ps_->dim();
+}
+
+void Approximant::site_input(int32_t s, double *dd, double *v, double *h) const {
+  const int dim = ps_->dim();
+  bool periodic = false;
+  for (int c = 0; c < dim; ++c) periodic = periodic || ps_->periodic(c);
+  const bool gather = ps_->search_convention() == MFREE_SEARCH_GATHER;
+  const bool have_vol = ps_->has_volumes();
+  const int64_t k0 = rowptr_[s];
+  const int n = static_cast<int>(rowptr_[s + 1] - k0);
+  // x_j - x_s as site_displacement computes it, with the site's data hoisted
+  double xs[3] = {0, 0, 0};
+  for (int c = 0; c < dim; ++c) xs[c] = site_x(s, c);
+  const double hs = site_h(s);
+  for (int q = 0; q < n; ++q) {
+    const int32_t j = cols_[k0 + q];
+    double *d = dd + 3 * static_cast<size_t>(q);
+    d[0] = d[1] = d[2] = 0.0;
+    if (periodic) site_displacement(s, j, d);
+    else
+      for (int c = 0; c < dim; ++c) d[c] = ps_->x(j, c) - xs[c];
+    v[q] = have_vol ? ps_->volume(j) : 1.0;
+    h[q] = gather ? hs : pair_h(s, j);
+  }
+}
+
 Report Approximant::setup() {
   if (method_ == MFREE_METHOD_MPFEM) {
     Report rep = compute_mpfem();
@@ -698,6 +710,7 @@ Report Approximant::setup() {
   build_pattern();
   Report rep = compute("setup");
   setup_done_ = true;
+  set_setups_ = ps_->setup_count();
   return rep;
 }
 

@@ -76,6 +76,15 @@ class Approximant {
   void export_csr(int deriv, int component, int64_t *rowptr, int32_t *cols, double *vals) const;
   void check_reproduction(int order, double &fn_err, double &deriv_err) const;
 
+  // Pair-list hosts (pairs.cpp). For every pair of the particle set's pair list, in its
+  // order: the gradient of particle i's row at j and of j's row at i, per unit volume
+  // (gi[k*ld + c], gj[k*ld + c]; gj may be NULL), or with antisym their antisymmetric
+  // mean (gi only). The caller checks the buffers.
+  void pair_gradients(double *gi, double *gj, int64_t ld, bool antisym) const;
+  // Per-site correction data (layout in mfree.h): doubles per site, and the records.
+  int correction_size() const;
+  void correction(double *c, int64_t ld) const;
+
   const HVec<int32_t> &site_status() const { return status_; }
   const HVec<int32_t> &site_support() const { return support_; }
   const HVec<double> &site_cond() const { return cond_; }
@@ -97,6 +106,13 @@ class Approximant {
   int32_t site_particle(int32_t s) const { return points_ ? -1 : s; }
   void site_displacement(int32_t s, int32_t j, double *d) const;
   double pair_h(int32_t s, int32_t j) const;
+  // The general path's input of site s: displacements x_j - x_s (3 per neighbour),
+  // volumes and pair supports of its row.
+  void site_input(int32_t s, double *d, double *v, double *h) const;
+  // Pair-list checks shared by pair_gradients and correction (pairs.cpp).
+  void check_pairs_ready(const char *what) const;
+  // The volumes of the last setup/update: particle j's is vol[j * stride].
+  const double *packed_volumes(int64_t &stride) const;
 
   const ParticleSet *ps_;
   int method_;
@@ -119,6 +135,7 @@ class Approximant {
   Csr point_nbr_;  // neighbours of the points among the particles
 
   bool setup_done_ = false;
+  int64_t set_setups_ = -1;  // the particle set's setup_count() the pattern was built on
   int32_t nsites_ = 0;
   // tables and per-site data come from the context's allocator hook (alloc.hpp)
   HVec<int64_t> rowptr_ = HVec<int64_t>(1, 0);

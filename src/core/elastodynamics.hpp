@@ -34,6 +34,8 @@ class ElasticSystem : public System {
                    mfree_progress_fn progress, void *user, int64_t &nsteps) override;
 
   int stress_components() const { return dim_ == 1 ? 1 : (dim_ == 2 ? 3 : 6); }
+  int dim() const { return dim_; }
+  int32_t num_particles() const { return nc_ > 0 ? nd_ / nc_ : 0; }
   // Stress at the particles from the displacements of y (boundary unknowns enforced);
   // collocation systems only (the Galerkin trial tables live in the assembler).
   void stress(double t, const double *y, double *sigma) const;

@@ -95,6 +95,11 @@ int shepard(Site &s, bool write) {
   }
   if (!(S > 0.0)) return MFREE_FAIL_NEIGHBORS;
   const double iS = 1.0 / S;
+  if (s.out.coef) {  // the sum and its gradient, after what precedes them in the record
+    double *c = s.out.coef + (s.cfg.method == MFREE_METHOD_KB_METHOD1 ? dim * dim : 0);
+    c[0] = S;
+    for (int a = 0; a < dim; ++a) c[1 + a] = gS[a];
+  }
   double *phi = s.w.q.data();
   double *gphi = s.w.sh.data();
   double *hphi = s.w.sh.data() + 3 * n;
@@ -265,6 +270,11 @@ int mls_fixed(Site &s, const Basis &B, bool rkpm) {
   const Eigen::Matrix<double, L, D> gsol = ldlt.solve(rhs);
   VecL gi[D];
   for (int i = 0; i < dim; ++i) gi[i] = gsol.col(i);
+  if (s.out.coef)  // gamma, then its derivatives along each axis
+    for (int a = 0; a < L; ++a) {
+      s.out.coef[a] = g(a);
+      for (int i = 0; i < dim; ++i) s.out.coef[(1 + i) * L + a] = gi[i](a);
+    }
   for (int j = 0; j < n; ++j) {
     const double gp = dot(g, j), o = omega(j);
     if (s.cfg.want_value) s.out.phi[j] = o * gp;
@@ -518,6 +528,7 @@ int run(Site &s, int order) {
         for (int j = 0; j < n; ++j) den += s.gw(j)[c] * s.in.vol[j] * s.d(j)[c];
         if (!(std::fabs(den) > 0.0)) return MFREE_FAIL_SINGULAR;
         const double beta = 1.0 / den;
+        if (s.out.coef) s.out.coef[c] = beta;
         for (int j = 0; j < n; ++j) s.out.grad[j * dim + c] = beta * s.gw(j)[c] * s.in.vol[j];
       }
       close_difference(s);
@@ -553,6 +564,9 @@ int run(Site &s, int order) {
       double C[16];
       const int st = correction(s, m, p, q, C);
       if (st) return st;
+      if (s.out.coef && !m3)  // C column by column: corrected gradient = C grad
+        for (int a = 0; a < dim; ++a)
+          for (int b = 0; b < dim; ++b) s.out.coef[a + b * dim] = C[a * m + b];
       for (int j = 0; j < n; ++j) {
         double f[4];
         for (int a = 0; a < m; ++a) {

@@ -35,6 +35,9 @@ struct LocalInput {
 // Outputs: rows phi[n], grad[n*dim], hess[n*nh] (only the wanted ones are written).
 struct LocalOutput {
   double *phi = nullptr, *grad = nullptr, *hess = nullptr;
+  // When set, the site's correction data (the layout of mfree_approximant_get_correction)
+  // for Shepard, MLS/RKPM, Johnson-Beissel, Randles-Libersky and KB Method 1.
+  double *coef = nullptr;
   int status = 0;       // 0 or MFREE_FAIL_*
   double cond = 1.0;    // condition estimate of the local system
   int order_used = 0;   // order actually built (after fallback), -1 failed

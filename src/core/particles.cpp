@@ -190,6 +190,8 @@ void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int3
   }
   host_base_ = base;
   host_rows_ = rows;
+  pairs_ = PairList();  // the CSR lists replace a pair list
+  pair_off_.clear();
   setup_done_ = false;
 }
 
@@ -341,7 +343,7 @@ Report ParticleSet::setup() {
   if (!pos_.set()) throw Error(MFREE_ERR_STATE, "positions are not set");
   if (!host_neighbors() && !h_.set())
     throw Error(MFREE_ERR_STATE, "support sizes are not set (needed by the neighbour search)");
-  if (host_neighbors()) {
+  if (host_neighbors() && !has_pairs()) {
     // The host's rowptr has the owned count of set_neighbors time; a later
     // set_num_ghost would make us read past it.
     if (host_rows_ != num_owned())
@@ -370,7 +372,9 @@ Report ParticleSet::setup() {
       check_halo([&](int32_t i) { return kappa_ * (gather ? h_(i) : std::max(h_(i), hmax)); },
                  "search radius");
     }
-    if (host_neighbors()) {
+    if (has_pairs()) {
+      rows_from_pairs(pair_rows_, pair_off_next_);
+    } else if (host_neighbors()) {
       const int32_t rows = num_owned();
       out.rowptr.assign(static_cast<size_t>(rows) + 1, 0);
       out.cols.reserve(static_cast<size_t>(host_rowptr_[rows] - host_base_));
@@ -397,9 +401,15 @@ Report ParticleSet::setup() {
     if (nbr_.rowptr.size() != static_cast<size_t>(num_owned()) + 1) setup_done_ = false;
     throw;
   }
-  if (host_neighbors()) nbr_ = std::move(out);
+  if (has_pairs()) {
+    std::swap(nbr_, pair_rows_);
+    pair_off_.swap(pair_off_next_);
+  } else if (host_neighbors()) {
+    nbr_ = std::move(out);
+  }
   order_rows_by_id(nbr_);
   setup_done_ = true;
+  ++setups_;
   return rep;
 }
 

@@ -68,12 +68,18 @@ class ParticleSet {
   // Global ids (NULL: none) and the host's halo width (0: none declared).
   void set_global_ids(const int64_t *ids, int mem);
   void set_halo_width(double w);
+  // A host half pair list (each unordered pair once, any order; pairs.cpp): the rows
+  // are built from it at setup, in O(npairs), without a search.
+  void set_pairs(int64_t npairs, const int32_t *pi, const int32_t *pj, int32_t base, int mem);
 
   // Validate (and for a search, rebuild the lists). Negative failures throw.
   Report setup();
   Report update();
 
   bool is_setup() const { return setup_done_; }
+  // Successful setups so far: objects built on the set tell whether their pattern is
+  // from the current lists.
+  int64_t setup_count() const { return setups_; }
   const Csr &neighbors() const { return nbr_; }
   const std::vector<int32_t> &site_status() const { return site_status_; }
 
@@ -95,7 +101,17 @@ class ParticleSet {
   bool periodic(int c) const { return periodic_[c]; }
   double box_lo(int c) const { return lo_[c]; }
   double box_hi(int c) const { return hi_[c]; }
-  bool host_neighbors() const { return host_rowptr_ != nullptr; }
+  bool host_neighbors() const { return host_rowptr_ != nullptr || pairs_.set; }
+  bool has_pairs() const { return pairs_.set; }
+  int64_t num_pairs() const { return pairs_.n; }
+  int32_t pair_base() const { return pairs_.base; }
+  // Pair k joins particles pair_first()[k] - base and pair_second()[k] - base.
+  const int32_t *pair_first() const { return pairs_.i; }
+  const int32_t *pair_second() const { return pairs_.j; }
+  // After setup, per pair k: where the second particle sits in the first one's row of
+  // neighbors() (offset within the row, entry 2k), and the first in the second's row
+  // (entry 2k + 1); -1 when that particle has no row (a ghost or an isolated particle).
+  const std::vector<int32_t> &pair_offsets() const { return pair_off_; }
   bool has_global_ids() const { return gid_ != nullptr; }
   const int64_t *global_ids() const { return gid_; }
   double halo_width() const { return halo_; }
@@ -125,6 +141,10 @@ class ParticleSet {
   // Mark particles whose borrowed data are invalid; returns the report.
   Report validate();
   void check_host_csr(const int64_t *rowptr, const int32_t *cols, int32_t base) const;
+  // pairs.cpp: range and self-pair checks; the rows (and pair offsets) from the pairs,
+  // duplicates rejected.
+  void check_pairs(int64_t npairs, const int32_t *pi, const int32_t *pj, int32_t base) const;
+  void rows_from_pairs(Csr &out, std::vector<int32_t> &offsets);
 
   int dim_;
   int32_t n_;
@@ -149,9 +169,23 @@ class ParticleSet {
   std::vector<int64_t> gid_own_, gid_check_;
   void check_global_ids(const int64_t *ids);
   double halo_ = 0.0;
+  struct PairList {
+    bool set = false;
+    const int32_t *i = nullptr, *j = nullptr;
+    int64_t n = 0;
+    int32_t base = 0;
+    std::vector<int32_t> own_i, own_j;
+  } pairs_;
+  std::vector<int32_t> pair_off_, pair_off_next_;
+  // rows_from_pairs' work arrays, kept so that a setup every step allocates nothing
+  std::vector<int64_t> pair_start_, pair_fill_;
+  std::vector<int32_t> pair_tmp_col_;
+  std::vector<int64_t> pair_tmp_id_;
 
   bool setup_done_ = false;
+  int64_t setups_ = 0;
   Csr nbr_;
+  Csr pair_rows_;  // the next rows built from pairs (storage reused, swapped with nbr_)
   std::vector<int32_t> site_status_;
   // The statuses before the running setup/update, kept as a member (sized at setup) so
   // that update allocates nothing.

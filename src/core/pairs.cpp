@@ -1,0 +1,297 @@
+// Half pair lists (each unordered pair once, as legacy SPH hydrocodes keep them): rows
+// built from the pairs, per-pair gradients read back in the host's pair order, and the
+// per-site correction data for hosts that apply the correction themselves.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "approximant.hpp"
+#include "parallel.hpp"
+
+namespace mfree {
+
+namespace {
+
+// Particle p (0-based) and pair k in the host's numbering.
+std::string host_particle(int32_t p, int32_t base) { return std::to_string(int64_t{p} + base); }
+std::string host_pair(int64_t k, int32_t base) { return std::to_string(k + base); }
+
+}  // namespace
+
+void ParticleSet::check_pairs(int64_t npairs, const int32_t *pi, const int32_t *pj,
+                              int32_t base) const {
+  if (npairs > 0 && (!pi || !pj)) throw Error(MFREE_ERR_NULL, "pair_i or pair_j is NULL");
+  // the common case in one branch-free pass; the failing pair is named by a second one
+  const int64_t lo = base, hi = int64_t{base} + n_;
+  bool bad = false;
+  for (int64_t k = 0; k < npairs; ++k) {
+    const int64_t a = pi[k], b = pj[k];
+    bad |= (a < lo) | (a >= hi) | (b < lo) | (b >= hi) | (a == b);
+  }
+  if (!bad) return;
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi - 1) + "]";
+  for (int64_t k = 0; k < npairs; ++k) {
+    const int64_t a = pi[k], b = pj[k];
+    const std::string at = "pair " + host_pair(k, base) + (base ? " (1-based)" : "");
+    if (a < lo || a >= hi)
+      throw Error(MFREE_ERR_INPUT, at + ": pair_i = " + std::to_string(a) + " is outside " + range);
+    if (b < lo || b >= hi)
+      throw Error(MFREE_ERR_INPUT, at + ": pair_j = " + std::to_string(b) + " is outside " + range);
+    if (a == b)
+      throw Error(MFREE_ERR_INPUT,
+                  at + " joins particle " + std::to_string(a) + " with itself (self pair)");
+  }
+}
+
+void ParticleSet::set_pairs(int64_t npairs, const int32_t *pi, const int32_t *pj, int32_t base,
+                            int mem) {
+  if (mem != MFREE_COPY && mem != MFREE_BORROW)
+    throw Error(MFREE_ERR_ARG, "mem must be MFREE_COPY or MFREE_BORROW, got " + std::to_string(mem));
+  if (base != 0 && base != 1)
+    throw Error(MFREE_ERR_ARG, "index base must be 0 or 1, got " + std::to_string(base));
+  if (npairs < 0)
+    throw Error(MFREE_ERR_ARG, "pair count " + std::to_string(npairs) + " is negative");
+  check_pairs(npairs, pi, pj, base);
+  PairList p;
+  p.set = true;
+  p.n = npairs;
+  p.base = base;
+  if (mem == MFREE_COPY) {
+    p.own_i.assign(pi, pi + npairs);
+    p.own_j.assign(pj, pj + npairs);
+    p.i = p.own_i.data();
+    p.j = p.own_j.data();
+  } else {
+    p.i = pi;
+    p.j = pj;
+  }
+  pairs_ = std::move(p);
+  host_rowptr_ = nullptr;  // a pair list replaces CSR lists
+  host_cols_ = nullptr;
+  host_rowptr_own_.clear();
+  host_cols_own_.clear();
+  setup_done_ = false;
+}
+
+// Two counting passes, O(npairs + n), no search and no sort: the first puts each pair
+// in both particles' rows in pair order; the second reads those rows particle by
+// particle and appends the particle to the rows of its neighbours, so every row comes
+// out in ascending order (the lists are symmetric: the transpose of the first pass is
+// the neighbour lists again). Pairs with an isolated particle (nonzero status) are left
+// out; the rows are those of the owned particles.
+void ParticleSet::rows_from_pairs(Csr &out, std::vector<int32_t> &offsets) {
+  const int64_t P = pairs_.n;
+  const int32_t *pi = pairs_.i, *pj = pairs_.j, base = pairs_.base;
+  check_pairs(P, pi, pj, base);  // borrowed lists may have changed since set_pairs
+  const int32_t n = n_, owned = num_owned();
+  const int32_t *st = site_status_.data();
+  // start[p]: where row p of the first pass begins (start[n] = all entries)
+  pair_start_.assign(static_cast<size_t>(n) + 1, 0);
+  int64_t *start = pair_start_.data();
+  for (int64_t k = 0; k < P; ++k) {
+    const int32_t a = pi[k] - base, b = pj[k] - base;
+    if (st[a] | st[b]) continue;
+    ++start[a + 1];
+    ++start[b + 1];
+  }
+  for (int32_t p = 0; p < n; ++p) start[p + 1] += start[p];
+  const int64_t total = start[n];
+  pair_fill_.assign(start, start + n);
+  int64_t *fill = pair_fill_.data();
+  pair_tmp_col_.resize(static_cast<size_t>(total));
+  pair_tmp_id_.resize(static_cast<size_t>(total));
+  int32_t *tc = pair_tmp_col_.data();
+  int64_t *tid = pair_tmp_id_.data();
+  for (int64_t k = 0; k < P; ++k) {
+    const int32_t a = pi[k] - base, b = pj[k] - base;
+    if (st[a] | st[b]) continue;
+    const int64_t u = fill[a]++, v = fill[b]++;
+    tc[u] = b;
+    tid[u] = 2 * k;  // entry 2k: pair k in its first particle's row
+    tc[v] = a;
+    tid[v] = 2 * k + 1;
+  }
+  // The final rows have the sizes of the first pass's; only owned particles get one.
+  out.rowptr.resize(static_cast<size_t>(owned) + 1);
+  std::copy(start, start + owned + 1, out.rowptr.data());
+  const int64_t nnz = start[owned];
+  out.cols.resize(static_cast<size_t>(nnz));
+  offsets.assign(static_cast<size_t>(2 * P), -1);
+  int32_t *cl = out.cols.data();
+  std::copy(start, start + owned, fill);
+  for (int32_t r = 0; r < n; ++r)
+    for (int64_t u = start[r]; u < start[r + 1]; ++u) {
+      const int32_t c = tc[u];
+      if (c >= owned) continue;  // a ghost has no row
+      const int64_t q = fill[c]++;
+      if (q > start[c] && cl[q - 1] == r) {
+        // rows come out sorted: a repeated pair shows as two equal neighbours
+        int64_t first = -1, second = -1;
+        for (int64_t k = 0; k < P && second < 0; ++k) {
+          const int32_t a = pi[k] - base, b = pj[k] - base;
+          if ((a == c && b == r) || (a == r && b == c)) (first < 0 ? first : second) = k;
+        }
+        throw Error(MFREE_ERR_INPUT,
+                    "pairs " + host_pair(first, base) + " and " + host_pair(second, base) +
+                        (base ? " (1-based)" : "") + " both join particles " +
+                        host_particle(std::min(c, r), base) + " and " +
+                        host_particle(std::max(c, r), base) + " (duplicate pair)");
+      }
+      cl[q] = r;
+      offsets[static_cast<size_t>(tid[u] ^ 1)] = static_cast<int32_t>(q - start[c]);
+    }
+}
+
+}  // namespace mfree
+
+namespace mfree {
+
+void Approximant::check_pairs_ready(const char *what) const {
+  if (!setup_done_) throw Error(MFREE_ERR_STATE, std::string(what) + ": the approximant is not set up");
+  if (points_)
+    throw Error(MFREE_ERR_UNSUPPORTED, std::string(what) + ": the sites are host points, not the particles");
+  if (method_ == MFREE_METHOD_MPFEM)
+    throw Error(MFREE_ERR_UNSUPPORTED, std::string(what) + ": not defined for MPFEM");
+  if (!ps_->is_setup() || set_setups_ != ps_->setup_count())
+    throw Error(MFREE_ERR_STATE, std::string(what) +
+                                     ": the particle set changed since this approximant's setup "
+                                     "(set it up, then the approximant)");
+}
+
+void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisym) const {
+  check_pairs_ready("pair gradients");
+  if (!ps_->has_pairs())
+    throw Error(MFREE_ERR_STATE, "the particle set has no pair list (mfree_particles_set_pairs)");
+  const bool sph = method_ == MFREE_METHOD_SPH || method_ == MFREE_METHOD_SPH_SYMMETRIC;
+  if (!sph && !(flags_ & MFREE_DERIV_GRADIENT))
+    throw Error(MFREE_ERR_STATE, "the gradient table was not built (mfree_approximant_set_derivatives)");
+  const int dim = ps_->dim();
+  const int64_t P = ps_->num_pairs();
+  const int32_t *pi = ps_->pair_first(), *pj = ps_->pair_second(), base = ps_->pair_base();
+  const int32_t *off = ps_->pair_offsets().data();
+  const auto &pst = ps_->site_status();
+  int64_t vstride = 0;
+  const double *vol = packed_volumes(vstride);
+  const int64_t *rp = rowptr_.data();
+  const int32_t *cl = cols_.data();
+  const double *G = grad_.data();
+  const int32_t owned = nsites_;
+  // The table entry of particle j in the row of site s (its offset in the set's row is a
+  // hint: the same unless the kernel's support dropped entries before it), or -1.
+  auto find = [&](int32_t s, int32_t j, int32_t hint) -> int64_t {
+    const int64_t b = rp[s], e = rp[s + 1];
+    if (hint >= 0 && b + hint < e && cl[b + hint] == j) return b + hint;
+    for (int64_t q = b; q < e; ++q)
+      if (cl[q] == j) return q;
+    return -1;
+  };
+  // One side of pair (s, j): the gradient of s's row at j per unit volume; false when s
+  // has no row (a ghost, an isolated particle or a failed site).
+  auto side = [&](int32_t s, int32_t j, int32_t hint, double *g) -> bool {
+    g[0] = g[1] = g[2] = 0.0;
+    if (pst[s] != 0 || pst[j] != 0) return false;
+    if (sph) {  // the kernel gradient itself, for ghosts too: nothing to correct
+      double d[3] = {0, 0, 0};
+      ps_->displacement(j, s, d);  // x_j - x_s
+      double r2 = 0.0;
+      for (int c = 0; c < dim; ++c) r2 += d[c] * d[c];
+      const double r = std::sqrt(r2);
+      if (r > 0.0) {
+        double w, dw, d2w;
+        kernel_->eval(r, pair_h(s, j), w, dw, d2w);
+        for (int c = 0; c < dim; ++c) g[c] = -dw * d[c] / r;
+      }
+      return true;
+    }
+    if (s >= owned || status_[s] != 0) return false;
+    const int64_t q = find(s, j, hint);
+    if (q >= 0) {
+      const double iv = 1.0 / vol[j * vstride];
+      for (int c = 0; c < dim; ++c) g[c] = G[q * dim + c] * iv;
+    }
+    return true;
+  };
+  parallel_blocks(P, num_threads(P), [&](int, int64_t b, int64_t e) {
+    for (int64_t k = b; k < e; ++k) {
+      const int32_t i = pi[k] - base, j = pj[k] - base;
+      double a[3], c[3];
+      const bool ha = side(i, j, off[2 * k], a), hc = side(j, i, off[2 * k + 1], c);
+      double *oi = gi + k * ld;
+      if (!antisym) {
+        for (int d = 0; d < dim; ++d) oi[d] = a[d];
+        if (gj) {
+          double *oj = gj + k * ld;
+          for (int d = 0; d < dim; ++d) oj[d] = c[d];
+        }
+      } else if (ha && hc) {
+        for (int d = 0; d < dim; ++d) oi[d] = 0.5 * (a[d] - c[d]);
+      } else {  // one side known: the pair takes it (the other is its negative)
+        for (int d = 0; d < dim; ++d) oi[d] = ha ? a[d] : -c[d];
+      }
+    }
+  });
+}
+
+int Approximant::correction_size() const {
+  const int dim = ps_->dim();
+  switch (method_) {
+    case MFREE_METHOD_SHEPARD:
+      return 1 + dim;
+    case MFREE_METHOD_JOHNSON_BEISSEL:
+      return dim;
+    case MFREE_METHOD_RANDLES_LIBERSKY:
+      return dim * dim;
+    case MFREE_METHOD_KB_METHOD1:
+      return dim * dim + 1 + dim;
+    case MFREE_METHOD_MLS:
+    case MFREE_METHOD_RKPM:
+      if (order_ <= 2) return (1 + dim) * basis_size(dim, order_);
+      throw Error(MFREE_ERR_UNSUPPORTED, "correction data of MLS/RKPM are defined up to order 2");
+    default:
+      throw Error(MFREE_ERR_UNSUPPORTED,
+                  "correction data are defined for Shepard, MLS/RKPM, Johnson-Beissel, "
+                  "Randles-Libersky and KB Method 1");
+  }
+}
+
+void Approximant::correction(double *out, int64_t ld) const {
+  check_pairs_ready("correction data");
+  const int m = correction_size();
+  const int dim = ps_->dim();
+  LocalConfig cfg;
+  cfg.method = method_;
+  cfg.dim = dim;
+  cfg.order = order_;
+  cfg.want_value = false;
+  cfg.want_grad = true;
+  cfg.want_hess = false;
+  cfg.kernel = kernel_.get();
+  const int want_order = has_order(method_) ? order_ : fixed_order(method_);
+  const int nt = num_threads(nnz());
+  parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
+    const size_t row = static_cast<size_t>(std::max(maxrow_, 1));
+    std::vector<double> d(3 * row), v(row), h(row), g(3 * row);  // (a call, not a step)
+    LocalWork work;
+    for (int64_t s = b; s < e; ++s) {
+      double *c = out + s * ld;
+      std::fill(c, c + m, 0.0);
+      if (status_[s] != 0 || order_used_[s] != want_order) continue;  // failed, or fell back
+      const int32_t site = static_cast<int32_t>(s);
+      site_input(site, d.data(), v.data(), h.data());
+      LocalInput in;
+      in.n = static_cast<int>(rowptr_[s + 1] - rowptr_[s]);
+      in.self = self_[s];
+      in.hs = site_h(site);
+      in.d = d.data();
+      in.vol = v.data();
+      in.h = h.data();
+      LocalOutput o;
+      o.grad = g.data();
+      o.coef = c;
+      compute_site(cfg, in, work, o);
+      if (o.status) std::fill(c, c + m, 0.0);
+    }
+  });
+}
+
+}  // namespace mfree
