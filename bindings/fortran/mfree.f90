@@ -510,6 +510,7 @@ module mfree
       type(c_ptr), value :: nfailed
     end function mfree_particles_get_site_status_c
 
+    ! -- pair lists, per-pair gradients, correction data
     integer(c_int) function mfree_particles_set_pairs_c(ps, npairs, pair_i, pair_j, &
                                                        index_base, mem) &
         bind(C, name="mfree_particles_set_pairs")

@@ -158,26 +158,101 @@ void Approximant::check_pairs_ready(const char *what) const {
                                      "(set it up, then the approximant)");
 }
 
+namespace {
+
+// One pair's two sides to the caller's records: a and c are the gradients of the first
+// and second particle's rows (ha, hc: whether the row exists).
+inline void write_pair(int dim, bool antisym, const double *a, bool ha, const double *c, bool hc,
+                       double *oi, double *oj) {
+  if (!antisym) {
+    for (int d = 0; d < dim; ++d) oi[d] = a[d];
+    if (oj)
+      for (int d = 0; d < dim; ++d) oj[d] = c[d];
+  } else if (ha && hc) {
+    for (int d = 0; d < dim; ++d) oi[d] = 0.5 * (a[d] - c[d]);
+  } else {  // one side known: the pair takes it (the other is its negative)
+    for (int d = 0; d < dim; ++d) oi[d] = ha ? a[d] : -c[d];
+  }
+}
+
+}  // namespace
+
 void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisym) const {
   check_pairs_ready("pair gradients");
   if (!ps_->has_pairs())
     throw Error(MFREE_ERR_STATE, "the particle set has no pair list (mfree_particles_set_pairs)");
   const bool sph = method_ == MFREE_METHOD_SPH || method_ == MFREE_METHOD_SPH_SYMMETRIC;
-  if (!sph && !(flags_ & MFREE_DERIV_GRADIENT))
+  if (!(flags_ & MFREE_DERIV_GRADIENT))
     throw Error(MFREE_ERR_STATE, "the gradient table was not built (mfree_approximant_set_derivatives)");
   const int dim = ps_->dim();
   const int64_t P = ps_->num_pairs();
   const int32_t *pi = ps_->pair_first(), *pj = ps_->pair_second(), base = ps_->pair_base();
   const int32_t *off = ps_->pair_offsets().data();
-  const auto &pst = ps_->site_status();
   int64_t vstride = 0;
   const double *vol = packed_volumes(vstride);
   const int64_t *rp = rowptr_.data();
   const int32_t *cl = cols_.data();
   const double *G = grad_.data();
   const int32_t owned = nsites_;
-  // The table entry of particle j in the row of site s (its offset in the set's row is a
-  // hint: the same unless the kernel's support dropped entries before it), or -1.
+  // SPH's kernel gradient is antisymmetric when h_ij is: one side gives the other,
+  // exactly, also for a pair whose particles have no rows (ghosts).
+  const bool sym_h = ps_->search_convention() != MFREE_SEARCH_GATHER;
+  // The common case: every row is the set's row (the pair offsets) plus the site itself
+  // appended, i.e. the kernel's support dropped no pair and no site failed; then the
+  // offset gives the table entry directly, and a particle without a row has offset -1.
+  const bool direct = static_cast<int64_t>(cols_.size()) == ps_->neighbors().nnz() + owned;
+  const auto &pst = ps_->site_status();
+  // grad_s W(x_s - x_j, h_sj) from the kernel (SPH needs no row)
+  auto kernel_gradient = [&](int32_t s, int32_t j, double *g) {
+    double d[3] = {0, 0, 0};
+    ps_->displacement(j, s, d);  // x_j - x_s
+    double r2 = 0.0;
+    for (int c = 0; c < dim; ++c) r2 += d[c] * d[c];
+    const double r = std::sqrt(r2);
+    if (r > 0.0) {
+      double w, dw, d2w;
+      kernel_->eval(r, pair_h(s, j), w, dw, d2w);
+      for (int c = 0; c < dim; ++c) g[c] = -dw * d[c] / r;
+    }
+  };
+  const int nt = num_threads(P);
+  if (sph && sym_h) {
+    // the kernel gradient, computed as the host computes its dwdx (the table's entries
+    // differ from it in the last bits near the support's edge), and exactly antisymmetric
+    parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
+      for (int64_t k = b; k < e; ++k) {
+        const int32_t i = pi[k] - base, j = pj[k] - base;
+        double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+        const bool ok = pst[i] == 0 && pst[j] == 0;
+        if (ok) kernel_gradient(i, j, a);
+        for (int d = 0; d < dim; ++d) c[d] = -a[d];
+        write_pair(dim, antisym, a, ok, c, ok, gi + k * ld, gj ? gj + k * ld : nullptr);
+      }
+    });
+    return;
+  }
+  if (direct && !sph) {
+    parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
+      for (int64_t k = b; k < e; ++k) {
+        const int32_t i = pi[k] - base, j = pj[k] - base;
+        const int32_t oa = off[2 * k], oc = off[2 * k + 1];
+        double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+        const bool ha = oa >= 0, hc = oc >= 0;
+        if (ha) {
+          const double *g = G + (rp[i] + oa) * dim, iv = 1.0 / vol[j * vstride];
+          for (int d = 0; d < dim; ++d) a[d] = g[d] * iv;
+        }
+        if (hc) {
+          const double *g = G + (rp[j] + oc) * dim, iv = 1.0 / vol[i * vstride];
+          for (int d = 0; d < dim; ++d) c[d] = g[d] * iv;
+        }
+        write_pair(dim, antisym, a, ha, c, hc, gi + k * ld, gj ? gj + k * ld : nullptr);
+      }
+    });
+    return;
+  }
+  // The general case: rows the kernel's support filtered, failed sites, or SPH with a
+  // support of the row's own particle (gather): each side looked up, or for SPH computed.
   auto find = [&](int32_t s, int32_t j, int32_t hint) -> int64_t {
     const int64_t b = rp[s], e = rp[s + 1];
     if (hint >= 0 && b + hint < e && cl[b + hint] == j) return b + hint;
@@ -185,22 +260,11 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
       if (cl[q] == j) return q;
     return -1;
   };
-  // One side of pair (s, j): the gradient of s's row at j per unit volume; false when s
-  // has no row (a ghost, an isolated particle or a failed site).
   auto side = [&](int32_t s, int32_t j, int32_t hint, double *g) -> bool {
     g[0] = g[1] = g[2] = 0.0;
     if (pst[s] != 0 || pst[j] != 0) return false;
     if (sph) {  // the kernel gradient itself, for ghosts too: nothing to correct
-      double d[3] = {0, 0, 0};
-      ps_->displacement(j, s, d);  // x_j - x_s
-      double r2 = 0.0;
-      for (int c = 0; c < dim; ++c) r2 += d[c] * d[c];
-      const double r = std::sqrt(r2);
-      if (r > 0.0) {
-        double w, dw, d2w;
-        kernel_->eval(r, pair_h(s, j), w, dw, d2w);
-        for (int c = 0; c < dim; ++c) g[c] = -dw * d[c] / r;
-      }
+      kernel_gradient(s, j, g);
       return true;
     }
     if (s >= owned || status_[s] != 0) return false;
@@ -211,23 +275,12 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
     }
     return true;
   };
-  parallel_blocks(P, num_threads(P), [&](int, int64_t b, int64_t e) {
+  parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
     for (int64_t k = b; k < e; ++k) {
       const int32_t i = pi[k] - base, j = pj[k] - base;
       double a[3], c[3];
       const bool ha = side(i, j, off[2 * k], a), hc = side(j, i, off[2 * k + 1], c);
-      double *oi = gi + k * ld;
-      if (!antisym) {
-        for (int d = 0; d < dim; ++d) oi[d] = a[d];
-        if (gj) {
-          double *oj = gj + k * ld;
-          for (int d = 0; d < dim; ++d) oj[d] = c[d];
-        }
-      } else if (ha && hc) {
-        for (int d = 0; d < dim; ++d) oi[d] = 0.5 * (a[d] - c[d]);
-      } else {  // one side known: the pair takes it (the other is its negative)
-        for (int d = 0; d < dim; ++d) oi[d] = ha ? a[d] : -c[d];
-      }
+      write_pair(dim, antisym, a, ha, c, hc, gi + k * ld, gj ? gj + k * ld : nullptr);
     }
   });
 }
