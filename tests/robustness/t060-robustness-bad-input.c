@@ -280,6 +280,87 @@ static void my_free(void *user, void *p, int64_t bytes) { (void)user, (void)byte
 
 /* --- the rows ------------------------------------------------------------------ */
 
+/* Pair lists, pair gradients, correction data, and the relations wrappers use. */
+static void rows_pairs(void) {
+  mfree_context_t *c = NULL;
+  mfree_particles_t *pp = NULL;
+  int64_t n64 = 0;
+  int32_t i32 = 0, d32 = 0;
+  int32_t pi[3] = {0, 1, 2}, pj[3] = {1, 2, 3}, self_i[1] = {4}, self_j[1] = {4}, far[1] = {N};
+  double g[2 * 8], cor[9 * N];
+  ROW0(MFREE_ERR_NULL, mfree_particles_get_context(NULL, &c));
+  ROW0(MFREE_ERR_NULL, mfree_particles_get_context(F.ps, NULL));
+  ROW0(MFREE_SUCCESS, mfree_particles_get_context(F.ps, &c));
+  ROW0(MFREE_ERR_NULL, mfree_approximant_get_context(NULL, &c));
+  ROW0(MFREE_ERR_NULL, mfree_approximant_get_context(F.a, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_mesh_get_context(NULL, &c));
+  ROW0(MFREE_ERR_NULL, mfree_matrix_get_context(NULL, &c));
+  ROW0(MFREE_ERR_NULL, mfree_matrix_get_context(F.A, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_assembler_get_context(NULL, &c));
+  ROW0(MFREE_ERR_NULL, mfree_assembler_get_context(F.as, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_system_get_context(NULL, &c));
+  ROW0(MFREE_ERR_NULL, mfree_system_get_context(F.sys, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_approximant_get_particles(NULL, &pp));
+  ROW0(MFREE_ERR_NULL, mfree_approximant_get_particles(F.a, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_mesh_get_particles(NULL, &pp));
+  ROW0(MFREE_ERR_NULL, mfree_system_get_dimension(NULL, &d32, &i32));
+  ROW(MFREE_ERR_NULL, mfree_system_get_dimension(F.sys, NULL, NULL));
+  ROW(MFREE_SUCCESS, mfree_system_get_dimension(F.sys, &d32, &i32));
+  /* set_pairs on the set-up lattice: every failure leaves it as it was */
+  ROW0(MFREE_ERR_NULL, mfree_particles_set_pairs(NULL, 3, pi, pj, 0, MFREE_COPY));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_pairs(F.ps, -1, pi, pj, 0, MFREE_COPY));
+  ROW(MFREE_ERR_NULL, mfree_particles_set_pairs(F.ps, 3, NULL, pj, 0, MFREE_COPY));
+  ROW(MFREE_ERR_NULL, mfree_particles_set_pairs(F.ps, 3, pi, NULL, 0, MFREE_COPY));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_pairs(F.ps, 3, pi, pj, 2, MFREE_COPY));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_pairs(F.ps, 3, pi, pj, 0, (mfree_mem_t)7));
+  ROW(MFREE_ERR_INPUT, mfree_particles_set_pairs(F.ps, 1, far, pj, 0, MFREE_COPY));
+  ROW(MFREE_ERR_INPUT, mfree_particles_set_pairs(F.ps, 3, pi, pj, 1, MFREE_COPY)); /* 0, 1-based */
+  ROW(MFREE_ERR_INPUT, mfree_particles_set_pairs(F.ps, 1, self_i, self_j, 0, MFREE_BORROW));
+  ROW0(MFREE_ERR_NULL, mfree_particles_get_num_pairs(NULL, &n64));
+  ROW(MFREE_ERR_NULL, mfree_particles_get_num_pairs(F.ps, NULL));
+  ROW(MFREE_ERR_STATE, mfree_particles_get_num_pairs(F.ps, &n64));
+  /* pair gradients: no pair list, not set up, NULL */
+  ROW0(MFREE_ERR_NULL, mfree_approximant_get_pair_gradients(NULL, g, g, 2, 16));
+  ROW(MFREE_ERR_STATE, mfree_approximant_get_pair_gradients(F.a, g, NULL, 2, 16));
+  ROW(MFREE_ERR_STATE, mfree_approximant_get_pair_gradients(F.a_new, g, NULL, 2, 16));
+  ROW0(MFREE_ERR_NULL, mfree_approximant_get_pair_gradients_antisymmetric(NULL, g, 2, 16));
+  ROW(MFREE_ERR_STATE, mfree_approximant_get_pair_gradients_antisymmetric(F.a, g, 2, 16));
+  /* correction data of the set-up MLS (9 doubles per particle in 2D) */
+  ROW0(MFREE_ERR_NULL, mfree_approximant_get_correction_size(NULL, &i32));
+  ROW(MFREE_ERR_NULL, mfree_approximant_get_correction_size(F.a, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_approximant_get_correction(NULL, cor, 9, 9 * N));
+  ROW(MFREE_ERR_NULL, mfree_approximant_get_correction(F.a, NULL, 9, 9 * N));
+  ROW(MFREE_ERR_ARG, mfree_approximant_get_correction(F.a, cor, 8, 9 * N));
+  ROW(MFREE_ERR_ARG, mfree_approximant_get_correction(F.a, cor, 9, 9 * N - 1));
+  ROW(MFREE_ERR_ARG, mfree_approximant_get_correction(F.a, cor, 9, -1));
+  ROW(MFREE_ERR_STATE, mfree_approximant_get_correction(F.a_new, cor, 9, 9 * N));
+  ROW(MFREE_SUCCESS, mfree_approximant_get_correction(F.a, cor, 9, 9 * N));
+  /* a pair-list set of its own, for the buffer checks of the pair gradients */
+  mfree_particles_t *ps = NULL;
+  mfree_approximant_t *ap = NULL, *sph = NULL;
+  if (mfree_particles_create(F.ctx, 2, N, &ps) == MFREE_SUCCESS &&
+      mfree_particles_set_positions(ps, F.x, MFREE_LAYOUT_AOS, 2, MFREE_BORROW) == MFREE_SUCCESS &&
+      mfree_particles_set_support(ps, &F.h, 0, MFREE_COPY) == MFREE_SUCCESS &&
+      mfree_particles_set_pairs(ps, 3, pi, pj, 0, MFREE_COPY) == MFREE_SUCCESS &&
+      mfree_approximant_create(F.ctx, ps, MFREE_METHOD_SPH, &sph) == MFREE_SUCCESS &&
+      mfree_approximant_create(F.ctx, ps, MFREE_METHOD_SHEPARD, &ap) == MFREE_SUCCESS &&
+      mfree_particles_setup(ps) >= MFREE_SUCCESS && mfree_approximant_setup(ap) >= MFREE_SUCCESS) {
+    ROW(MFREE_ERR_ARG, mfree_approximant_get_pair_gradients(ap, g, g + 8, 2, 5));
+    ROW(MFREE_ERR_ARG, mfree_approximant_get_pair_gradients(ap, g, NULL, 1, 16));
+    ROW(MFREE_ERR_ARG, mfree_approximant_get_pair_gradients(ap, g, NULL, 2, -3));
+    ROW(MFREE_ERR_NULL, mfree_approximant_get_pair_gradients(ap, NULL, NULL, 2, 16));
+    ROW(MFREE_ERR_ARG, mfree_approximant_get_pair_gradients_antisymmetric(ap, g, 2, 5));
+    ROW(MFREE_SUCCESS, mfree_approximant_get_pair_gradients(ap, g, g + 8, 2, 6));
+    ROW(MFREE_ERR_UNSUPPORTED, mfree_approximant_get_correction_size(sph, &i32));
+  } else {
+    logf_("  rows_pairs: could not build the pair-list set%s\n", "", 0, 0, 0);
+  }
+  mfree_approximant_destroy(&sph);
+  mfree_approximant_destroy(&ap);
+  mfree_particles_destroy(&ps);
+}
+
+
 static void rows_version_context(void) {
   int32_t i32 = 0;
   char buf[8];
@@ -1018,6 +1099,7 @@ static void test_bad_input_matrix(void **state) {
   rows_matrix();
   rows_assembler();
   rows_system();
+  rows_pairs();
 
   fflush(stdout);
   fflush(stderr);
