@@ -2,8 +2,10 @@
 // built from the pairs, per-pair gradients read back in the host's pair order, and the
 // per-site correction data for hosts that apply the correction themselves.
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include "approximant.hpp"
 #include "parallel.hpp"
@@ -98,19 +100,20 @@ void ParticleSet::rows_from_pairs(Csr &out, std::vector<int32_t> &offsets) {
   const int64_t total = start[n];
   pair_fill_.assign(start, start + n);
   int64_t *fill = pair_fill_.data();
+  // Rows come out sorted: a repeated pair shows as two equal neighbours c, r.
+  auto duplicate = [&](int32_t c, int32_t r) {
+    int64_t first = -1, second = -1;
+    for (int64_t k = 0; k < P && second < 0; ++k) {
+      const int32_t a = pi[k] - base, b = pj[k] - base;
+      if ((a == c && b == r) || (a == r && b == c)) (first < 0 ? first : second) = k;
+    }
+    throw Error(MFREE_ERR_INPUT, "pairs " + host_pair(first, base) + " and " + host_pair(second, base) +
+                                     (base ? " (1-based)" : "") + " both join particles " +
+                                     host_particle(std::min(c, r), base) + " and " +
+                                     host_particle(std::max(c, r), base) + " (duplicate pair)");
+  };
   pair_tmp_col_.resize(static_cast<size_t>(total));
-  pair_tmp_id_.resize(static_cast<size_t>(total));
   int32_t *tc = pair_tmp_col_.data();
-  int64_t *tid = pair_tmp_id_.data();
-  for (int64_t k = 0; k < P; ++k) {
-    const int32_t a = pi[k] - base, b = pj[k] - base;
-    if (st[a] | st[b]) continue;
-    const int64_t u = fill[a]++, v = fill[b]++;
-    tc[u] = b;
-    tid[u] = 2 * k;  // entry 2k: pair k in its first particle's row
-    tc[v] = a;
-    tid[v] = 2 * k + 1;
-  }
   // The final rows have the sizes of the first pass's; only owned particles get one.
   out.rowptr.resize(static_cast<size_t>(owned) + 1);
   std::copy(start, start + owned + 1, out.rowptr.data());
@@ -118,28 +121,35 @@ void ParticleSet::rows_from_pairs(Csr &out, std::vector<int32_t> &offsets) {
   out.cols.resize(static_cast<size_t>(nnz));
   offsets.assign(static_cast<size_t>(2 * P), -1);
   int32_t *cl = out.cols.data();
-  std::copy(start, start + owned, fill);
-  for (int32_t r = 0; r < n; ++r)
-    for (int64_t u = start[r]; u < start[r + 1]; ++u) {
-      const int32_t c = tc[u];
-      if (c >= owned) continue;  // a ghost has no row
-      const int64_t q = fill[c]++;
-      if (q > start[c] && cl[q - 1] == r) {
-        // rows come out sorted: a repeated pair shows as two equal neighbours
-        int64_t first = -1, second = -1;
-        for (int64_t k = 0; k < P && second < 0; ++k) {
-          const int32_t a = pi[k] - base, b = pj[k] - base;
-          if ((a == c && b == r) || (a == r && b == c)) (first < 0 ? first : second) = k;
-        }
-        throw Error(MFREE_ERR_INPUT,
-                    "pairs " + host_pair(first, base) + " and " + host_pair(second, base) +
-                        (base ? " (1-based)" : "") + " both join particles " +
-                        host_particle(std::min(c, r), base) + " and " +
-                        host_particle(std::max(c, r), base) + " (duplicate pair)");
-      }
-      cl[q] = r;
-      offsets[static_cast<size_t>(tid[u] ^ 1)] = static_cast<int32_t>(q - start[c]);
+  // Entry ids 2k (pair k in its first particle's row) and 2k + 1, 32-bit when they fit.
+  auto passes = [&](auto *tid) {
+    for (int64_t k = 0; k < P; ++k) {
+      const int32_t a = pi[k] - base, b = pj[k] - base;
+      if (st[a] | st[b]) continue;
+      const int64_t u = fill[a]++, v = fill[b]++;
+      tc[u] = b;
+      tid[u] = static_cast<std::remove_pointer_t<decltype(tid)>>(2 * k);
+      tc[v] = a;
+      tid[v] = static_cast<std::remove_pointer_t<decltype(tid)>>(2 * k + 1);
     }
+    std::copy(start, start + owned, fill);
+    for (int32_t r = 0; r < n; ++r)
+      for (int64_t u = start[r]; u < start[r + 1]; ++u) {
+        const int32_t c = tc[u];
+        if (c >= owned) continue;  // a ghost has no row
+        const int64_t q = fill[c]++;
+        if (q > start[c] && cl[q - 1] == r) duplicate(c, r);
+        cl[q] = r;
+        offsets[static_cast<size_t>(tid[u] ^ 1)] = static_cast<int32_t>(q - start[c]);
+      }
+  };
+  if (2 * P <= INT32_MAX) {
+    pair_tmp_id32_.resize(static_cast<size_t>(total));
+    passes(pair_tmp_id32_.data());
+  } else {
+    pair_tmp_id_.resize(static_cast<size_t>(total));
+    passes(pair_tmp_id_.data());
+  }
 }
 
 }  // namespace mfree
@@ -238,12 +248,14 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
         const int32_t oa = off[2 * k], oc = off[2 * k + 1];
         double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
         const bool ha = oa >= 0, hc = oc >= 0;
+        // 1/V_j and 1/V_i from one division
+        const double vi = vol[i * vstride], vj = vol[j * vstride], ivv = 1.0 / (vi * vj);
         if (ha) {
-          const double *g = G + (rp[i] + oa) * dim, iv = 1.0 / vol[j * vstride];
+          const double *g = G + (rp[i] + oa) * dim, iv = vi * ivv;
           for (int d = 0; d < dim; ++d) a[d] = g[d] * iv;
         }
         if (hc) {
-          const double *g = G + (rp[j] + oc) * dim, iv = 1.0 / vol[i * vstride];
+          const double *g = G + (rp[j] + oc) * dim, iv = vj * ivv;
           for (int d = 0; d < dim; ++d) c[d] = g[d] * iv;
         }
         write_pair(dim, antisym, a, ha, c, hc, gi + k * ld, gj ? gj + k * ld : nullptr);

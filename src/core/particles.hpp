@@ -181,6 +181,7 @@ class ParticleSet {
   std::vector<int64_t> pair_start_, pair_fill_;
   std::vector<int32_t> pair_tmp_col_;
   std::vector<int64_t> pair_tmp_id_;
+  std::vector<int32_t> pair_tmp_id32_;
 
   bool setup_done_ = false;
   int64_t setups_ = 0;
