@@ -210,7 +210,9 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
   // The common case: every row is the set's row (the pair offsets) plus the site itself
   // appended, i.e. the kernel's support dropped no pair and no site failed; then the
   // offset gives the table entry directly, and a particle without a row has offset -1.
-  const bool direct = static_cast<int64_t>(cols_.size()) == ps_->neighbors().nnz() + owned;
+  // (With global ids the rows are in id order, not the order the offsets refer to.)
+  const bool direct = static_cast<int64_t>(cols_.size()) == ps_->neighbors().nnz() + owned &&
+                      !ps_->has_global_ids();
   const auto &pst = ps_->site_status();
   // grad_s W(x_s - x_j, h_sj) from the kernel (SPH needs no row)
   auto kernel_gradient = [&](int32_t s, int32_t j, double *g) {

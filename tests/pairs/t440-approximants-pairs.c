@@ -499,11 +499,46 @@ static void test_correction_layout(void **state) {
   free_cloud(&c);
 }
 
+/* With global ids the rows run in id order, not in the order of the pair offsets: the
+ * pair gradients are looked up, and equal those without ids up to the summation order. */
+static void test_global_ids(void **state) {
+  (void)state;
+  cloud_t c;
+  make_cloud(&c, 6);
+  mfree_context_t *ctx = NULL;
+  assert_ok(ctx, mfree_context_create(&ctx));
+  int64_t ids[NMAX];
+  for (int p = 0; p < c.n; ++p) ids[p] = 1000 + (int64_t)(c.n - p) * 7; /* reversed */
+  double *g0 = malloc(sizeof(double) * 4 * c.np), *g1 = malloc(sizeof(double) * 4 * c.np);
+  for (int with_ids = 0; with_ids < 2; ++with_ids) {
+    mfree_particles_t *ps = cloud_set(ctx, &c);
+    if (with_ids) assert_ok(ctx, mfree_particles_set_global_ids(ps, ids, MFREE_COPY));
+    assert_ok(ctx, mfree_particles_set_pairs(ps, c.np, c.pi, c.pj, 0, MFREE_BORROW));
+    assert_ok(ctx, mfree_particles_setup(ps));
+    mfree_approximant_t *a = make_approx(ctx, ps, MFREE_METHOD_RANDLES_LIBERSKY);
+    double *g = with_ids ? g1 : g0;
+    assert_ok(ctx, mfree_approximant_get_pair_gradients(a, g, g + 2 * c.np, 2, 2 * c.np));
+    mfree_approximant_destroy(&a);
+    mfree_particles_destroy(&ps);
+  }
+  double worst = 0.0, big = 0.0;
+  for (int64_t k = 0; k < 4 * c.np; ++k) {
+    worst = fmax(worst, fabs(g1[k] - g0[k]));
+    big = fmax(big, fabs(g0[k]));
+  }
+  print_message("RL pair gradients with and without global ids: %.2e relative\n", worst / big);
+  assert_true(worst <= 1e-12 * big);
+  free(g0);
+  free(g1);
+  mfree_context_destroy(&ctx);
+  free_cloud(&c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sph_is_dwdx),       cmocka_unit_test(test_linear_fields),
       cmocka_unit_test(test_pairs_equal_csr),   cmocka_unit_test(test_correction_layout),
-      cmocka_unit_test(test_momentum),
+      cmocka_unit_test(test_momentum),          cmocka_unit_test(test_global_ids),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
