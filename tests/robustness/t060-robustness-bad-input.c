@@ -316,6 +316,20 @@ static void rows_pairs(void) {
   ROW(MFREE_ERR_INPUT, mfree_particles_set_pairs(F.ps, 1, far, pj, 0, MFREE_COPY));
   ROW(MFREE_ERR_INPUT, mfree_particles_set_pairs(F.ps, 3, pi, pj, 1, MFREE_COPY)); /* 0, 1-based */
   ROW(MFREE_ERR_INPUT, mfree_particles_set_pairs(F.ps, 1, self_i, self_j, 0, MFREE_BORROW));
+  /* global ids and halo width: failures leave the lattice without ids */
+  int64_t gid[N], gid_neg[N], gid_dup[N];
+  for (int p = 0; p < N; ++p) gid[p] = gid_neg[p] = gid_dup[p] = 10 + p;
+  gid_neg[3] = -1;
+  gid_dup[5] = gid_dup[4];
+  ROW0(MFREE_ERR_NULL, mfree_particles_set_global_ids(NULL, gid, MFREE_COPY));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_global_ids(F.ps, gid, (mfree_mem_t)7));
+  ROW(MFREE_ERR_INPUT, mfree_particles_set_global_ids(F.ps, gid_neg, MFREE_COPY));
+  ROW(MFREE_ERR_INPUT, mfree_particles_set_global_ids(F.ps, gid_dup, MFREE_COPY));
+  ROW0(MFREE_ERR_NULL, mfree_particles_get_global_ids(NULL, gid));
+  ROW(MFREE_ERR_STATE, mfree_particles_get_global_ids(F.ps, gid));
+  ROW0(MFREE_ERR_NULL, mfree_particles_set_halo_width(NULL, 1.0));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_halo_width(F.ps, -1.0));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_halo_width(F.ps, NAN));
   ROW0(MFREE_ERR_NULL, mfree_particles_get_num_pairs(NULL, &n64));
   ROW(MFREE_ERR_NULL, mfree_particles_get_num_pairs(F.ps, NULL));
   ROW(MFREE_ERR_STATE, mfree_particles_get_num_pairs(F.ps, &n64));
