@@ -122,8 +122,14 @@ void ParticleSet::rows_from_pairs(Csr &out, std::vector<int32_t> &offsets) {
   offsets.assign(static_cast<size_t>(2 * P), -1);
   int32_t *cl = out.cols.data();
   // Entry ids 2k (pair k in its first particle's row) and 2k + 1, 32-bit when they fit.
+  // (Both passes scatter: the rows they write to are fetched a few entries ahead.)
+  constexpr int64_t ahead = 16;
   auto passes = [&](auto *tid) {
     for (int64_t k = 0; k < P; ++k) {
+      if (k + ahead < P) {
+        __builtin_prefetch(tc + fill[pi[k + ahead] - base], 1);
+        __builtin_prefetch(tc + fill[pj[k + ahead] - base], 1);
+      }
       const int32_t a = pi[k] - base, b = pj[k] - base;
       if (st[a] | st[b]) continue;
       const int64_t u = fill[a]++, v = fill[b]++;
@@ -135,6 +141,11 @@ void ParticleSet::rows_from_pairs(Csr &out, std::vector<int32_t> &offsets) {
     std::copy(start, start + owned, fill);
     for (int32_t r = 0; r < n; ++r)
       for (int64_t u = start[r]; u < start[r + 1]; ++u) {
+        if (u + ahead < total) {
+          const int32_t ca = tc[u + ahead];
+          if (ca < owned) __builtin_prefetch(cl + fill[ca], 1);
+          __builtin_prefetch(offsets.data() + (tid[u + ahead] ^ 1), 1);
+        }
         const int32_t c = tc[u];
         if (c >= owned) continue;  // a ghost has no row
         const int64_t q = fill[c]++;
@@ -245,7 +256,15 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
   }
   if (direct && !sph) {
     parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
+      // the j side's row is far from the i side's in the tables: its entry is fetched a
+      // few pairs ahead (the i sides run through their rows in order)
+      constexpr int64_t ahead = 16;
       for (int64_t k = b; k < e; ++k) {
+        if (k + ahead < e) {
+          const int64_t ka = k + ahead;
+          const int32_t ja = pj[ka] - base, oca = off[2 * ka + 1];
+          if (oca >= 0) __builtin_prefetch(G + (rp[ja] + oca) * dim);
+        }
         const int32_t i = pi[k] - base, j = pj[k] - base;
         const int32_t oa = off[2 * k], oc = off[2 * k + 1];
         double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
