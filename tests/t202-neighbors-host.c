@@ -2,7 +2,8 @@
  * t202: host-supplied neighbour lists (mfree_particles_set_neighbors).
  *
  * Valid CSR lists, 0- or 1-based, copied or borrowed, are returned as given (0-based,
- * rows sorted as get_neighbors promises); every malformed list is refused with the
+ * rows sorted as get_neighbors promises); every malformed list (a column out of range or
+ * twice in a row, rowptr not monotone or not starting at the base) is refused with the
  * documented status and a message and leaves the previous lists in force; a borrowed
  * list that turns invalid is caught by setup; invalid particle data isolate particles in
  * host lists too; calls before setup are state errors.
@@ -283,14 +284,32 @@ static void test_invalid_lists(void **s) {
   REFUSED(mfree_particles_set_neighbors(ps, rp, cl, 0, (mfree_mem_t)0), MFREE_ERR_ARG, "mem");
   REFUSED(mfree_particles_set_neighbors(ps, rp, cl, 0, (mfree_mem_t)3), MFREE_ERR_ARG, "mem");
 
+  /* a column twice in a row would count that neighbour twice in every sum: refused,
+   * copied or borrowed (a borrowed list that turns so is caught by setup) */
+  RESET(1);
+  cl[1] = N; /* row 0 = {1, 8, 8} (1-based) */
+  REFUSED(mfree_particles_set_neighbors(ps, rp, cl, 1, MFREE_COPY), MFREE_ERR_INPUT, "twice");
+  RESET(0);
+  cl[8] = 3; /* row 3 = {0, 3, 4, 3} */
+  REFUSED(mfree_particles_set_neighbors(ps, rp, cl, 0, MFREE_BORROW), MFREE_ERR_INPUT, "twice");
+  {
+    mfree_particles_t *pb = new_set();
+    RESET(0);
+    assert_ok(ctx, mfree_particles_set_neighbors(pb, rp, cl, 0, MFREE_BORROW));
+    assert_ok(ctx, mfree_particles_setup(pb));
+    cl[10] = 7; /* row 5 = {7, 7} */
+    assert_error(ctx, mfree_particles_setup(pb), MFREE_ERR_INPUT, "twice");
+    mfree_particles_destroy(&pb);
+  }
+
   /* The boundaries are valid: column base + n - 1, empty rows, NULL cols with nnz 0. */
   RESET(1);
-  cl[1] = N; /* row 0 = {1, 8, 8} (1-based): the largest index, twice */
+  cl[1] = N, cl[2] = 2; /* row 0 = {1, 8, 2} (1-based): the largest index, unsorted */
   assert_ok(ctx, mfree_particles_set_neighbors(ps, rp, cl, 1, MFREE_COPY));
   assert_ok(ctx, mfree_particles_setup(ps));
   lists_t l;
   get_lists(ps, &l);
-  assert_int_equal(l.cols[1], N - 1);
+  assert_int_equal(l.cols[1], 1);
   assert_int_equal(l.cols[2], N - 1);
   const int64_t empty[ROWS + 1] = {1, 1, 1, 1, 1, 1, 1};
   assert_ok(ctx, mfree_particles_set_neighbors(ps, empty, NULL, 1, MFREE_BORROW));

@@ -53,6 +53,8 @@ mfree_status_t apply_impl(const mfree_approximant_t *a, const char *fn, mfree_op
     MFREE_REQUIRE(out || ap.num_sites() == 0, MFREE_ERR_NULL, "output pointer is NULL");
     check_layout(ulayout, uld, ncomp, n, "u");
     check_layout(olayout, old, ocomp, ap.num_sites(), "out");
+    mfree::check_extent(n, ncomp, ulayout, uld, "u");
+    mfree::check_extent(ap.num_sites(), ocomp, olayout, old, "out");
     ap.apply(op, ncomp, u, ulayout, uld, out, olayout, old, add);
     return MFREE_SUCCESS;
   });

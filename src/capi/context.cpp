@@ -9,16 +9,35 @@ void release(mfree_context_t *c) {
   if (c && c->refs.fetch_sub(1, std::memory_order_acq_rel) == 1) delete c;
 }
 
+namespace {
+// Store the last error under the context's lock and pass the handler the caller's own
+// copy of the message: another thread may overwrite the context's copy meanwhile.
+void store_error(mfree_context_t *ctx, mfree_status_t status, const std::string *message) {
+  {
+    const std::lock_guard<std::mutex> lock(ctx->error_lock);
+    ctx->last_code = status;
+    try {
+      if (message) ctx->last_message = *message;
+      else ctx->last_message.clear();
+    } catch (...) {  // no memory for the text: keep the code, drop the stale text
+      ctx->last_message.clear();
+    }
+  }
+  if (ctx->handler) ctx->handler(ctx->handler_user, status, message ? message->c_str() : "");
+}
+}  // namespace
+
 mfree_status_t record(mfree_context_t *ctx, mfree_status_t status, const char *fn,
                       const std::string &msg) {
   if (!ctx) return status;
+  std::string text;
   try {
-    ctx->last_code = status;
-    ctx->last_message = std::string(fn) + ": " + msg;
+    text = std::string(fn) + ": " + msg;
   } catch (...) {
-    ctx->last_code = status;
+    store_error(ctx, status, nullptr);
+    return status;
   }
-  if (ctx->handler) ctx->handler(ctx->handler_user, status, ctx->last_message.c_str());
+  store_error(ctx, status, &text);
   return status;
 }
 
@@ -46,6 +65,7 @@ mfree_status_t mfree_context_get_last_error(const mfree_context_t *ctx, mfree_st
                                             char *message, int64_t len) {
   if (!ctx) return MFREE_ERR_NULL;
   if (message && len < 1) return MFREE_ERR_ARG;
+  const std::lock_guard<std::mutex> lock(ctx->error_lock);
   if (code) *code = ctx->last_code;
   if (message) {
     const size_t n = std::min<size_t>(ctx->last_message.size(), static_cast<size_t>(len - 1));
@@ -58,13 +78,13 @@ mfree_status_t mfree_context_get_last_error(const mfree_context_t *ctx, mfree_st
 mfree_status_t mfree_context_set_error(mfree_context_t *ctx, mfree_status_t code,
                                        const char *message) {
   if (!ctx) return MFREE_ERR_NULL;
+  std::string text;
   try {
-    ctx->last_code = code;
-    ctx->last_message = message ? message : "";
+    text = message ? message : "";
   } catch (...) {
     return MFREE_ERR_ALLOC;
   }
-  if (ctx->handler) ctx->handler(ctx->handler_user, code, ctx->last_message.c_str());
+  mfree::store_error(ctx, code, &text);
   return code;
 }
 

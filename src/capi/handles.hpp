@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <string>
 
@@ -19,6 +20,9 @@
 
 struct mfree_context {
   std::atomic<int> refs{1};
+  // Objects sharing a context may fail on several threads at once (apply is reentrant):
+  // the last error is written and read under this lock.
+  mutable std::mutex error_lock;
   mfree_status_t last_code = MFREE_SUCCESS;
   std::string last_message;
   mfree_error_handler_t handler = nullptr;

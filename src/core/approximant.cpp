@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cfloat>
 #include <cmath>
 #include <sstream>
 #include <type_traits>
@@ -149,46 +150,56 @@ void Approximant::set_points(int32_t npts, const double *x, int layout, int64_t 
   if (particles_only(method_))
     throw Error(MFREE_ERR_UNSUPPORTED, std::string(method_name(method_)) +
                                            " is defined at the particles only");
-  // Reuse the particle-set validation on a scratch set of the points.
-  ParticleSet tmp(ps_->dim(), npts);
-  tmp.set_positions(x, layout, ld, mem);
-  tmp.set_support(h, h_stride, mem);
-  (void)tmp;
-  npts_ = npts;
-  points_ = true;
+  if (mem != MFREE_COPY && mem != MFREE_BORROW)
+    throw Error(MFREE_ERR_ARG, "mem must be MFREE_COPY or MFREE_BORROW, got " + std::to_string(mem));
+  // Reuse the particle-set validation on a scratch set of the points, borrowing them
+  // (a copy there would hold the points' memory twice).
+  {
+    ParticleSet tmp(ps_->dim(), npts);
+    tmp.set_positions(x, layout, ld, MFREE_BORROW);
+    tmp.set_support(h, h_stride, MFREE_BORROW);
+  }
+  // The new arrays are made aside and swapped in (nothing throws after the first
+  // change): running out of memory leaves the approximant as it was.
+  VectorArray px;
+  ScalarArray ph;
+  px.ptr = x;
+  px.ld = ld;
+  px.layout = layout;
+  ph.ptr = h;
+  ph.stride = h_stride;
   if (mem == MFREE_COPY) {
-    px_.own.assign(static_cast<size_t>(npts) * dim() + 1, 0.0);
-    VectorArray src;
-    src.ptr = x;
-    src.ld = ld;
-    src.layout = layout;
-    for (int32_t i = 0; i < npts; ++i)
-      for (int c = 0; c < dim(); ++c) px_.own[static_cast<size_t>(i) * dim() + c] = src(i, c);
-    px_.ptr = px_.own.data();
-    px_.ld = dim();
-    px_.layout = MFREE_LAYOUT_AOS;
+    const int d = dim();
+    px.own.assign(static_cast<size_t>(npts) * d + 1, 0.0);
     const int32_t nh = h_stride == 0 ? 1 : npts;
-    ph_.own.assign(static_cast<size_t>(std::max(nh, 1)), 1.0);
-    for (int32_t i = 0; i < nh; ++i) ph_.own[i] = h[i * h_stride];
-    ph_.ptr = ph_.own.data();
-    ph_.stride = h_stride == 0 ? 0 : 1;
+    ph.own.assign(static_cast<size_t>(std::max(nh, 1)), 1.0);
+    for (int32_t i = 0; i < npts; ++i)
+      for (int c = 0; c < d; ++c) px.own[static_cast<size_t>(i) * d + c] = px(i, c);
+    for (int32_t i = 0; i < nh; ++i) ph.own[i] = h[i * h_stride];
+    px.ptr = px.own.data();
+    px.ld = d;
+    px.layout = MFREE_LAYOUT_AOS;
+    ph.ptr = ph.own.data();
+    ph.stride = h_stride == 0 ? 0 : 1;
   } else {
-    px_.own.clear();
-    px_.ptr = x;
-    px_.ld = ld;
-    px_.layout = layout;
-    ph_.own.clear();
-    ph_.ptr = h;
-    ph_.stride = h_stride;
-    if (!px_.ptr) {
-      px_.own.assign(1, 0.0);
-      px_.ptr = px_.own.data();
+    if (!px.ptr) {
+      px.own.assign(1, 0.0);
+      px.ptr = px.own.data();
     }
-    if (!ph_.ptr) {
-      ph_.own.assign(1, 1.0);
-      ph_.ptr = ph_.own.data();
+    if (!ph.ptr) {
+      ph.own.assign(1, 1.0);
+      ph.ptr = ph.own.data();
     }
   }
+  px_.own.swap(px.own);
+  px_.ptr = px.ptr;
+  px_.ld = px.ld;
+  px_.layout = px.layout;
+  ph_.own.swap(ph.own);
+  ph_.ptr = ph.ptr;
+  ph_.stride = ph.stride;
+  npts_ = npts;
+  points_ = true;
   setup_done_ = false;
 }
 
@@ -512,6 +523,7 @@ Report Approximant::compute(const char *what) {
   support_.resize(nsites_);
   cond_.resize(nsites_);
   order_used_.resize(nsites_);
+  find_bad_particles();
 
   LocalConfig base;
   base.method = method_;
@@ -580,17 +592,13 @@ Report Approximant::compute(const char *what) {
     if (fast.ok()) fast.run(ft, b, e, w.fast, fs);
     int64_t bad = 0;
     for (int32_t s = static_cast<int32_t>(b); s < e; ++s) {
-      if (fast.ok() && status_[s] != kFastPending) {
-        bad += status_[s] != 0;
-        continue;
-      }
+      if (fast.ok() && status_[s] != kFastPending) continue;
       const int32_t me = site_particle(s);
       if (me >= 0 && pst[me] != 0) {
         status_[s] = pst[me];
         support_[s] = 0;
         cond_[s] = 1.0;
         order_used_[s] = -1;
-        ++bad;
         continue;
       }
       const int64_t k0 = rowptr_[s];
@@ -634,8 +642,8 @@ Report Approximant::compute(const char *what) {
       support_[s] = out.support;
       cond_[s] = out.cond;
       order_used_[s] = out.order_used;
-      bad += out.status != 0;
     }
+    bad = screen_sites(b, e);
     if (bad) nfailed += bad;
   });
 
@@ -650,8 +658,11 @@ Report Approximant::compute(const char *what) {
     else if (status_[s] == MFREE_FAIL_SINGULAR)
       msg << " has a singular local system (condition estimate " << cond_[s]
           << "; collinear, coincident or too few neighbours)";
+    else if (status_[s] == MFREE_FAIL_NONFINITE)
+      msg << " has a non-finite value in its data, a neighbour's, or its shape functions "
+             "(a support too small for the coordinates' range?)";
     else
-      msg << " has invalid particle data";
+      msg << " has invalid particle data (a support or volume <= 0)";
     const int64_t nf = nfailed;
     msg << " (" << nf << (nf == 1 ? " site" : " sites") << " failed; their rows are zero)";
     rep.fail(static_cast<mfree_status_t>(status_[s]), msg.str());
@@ -691,6 +702,7 @@ void Approximant::site_input(int32_t s, double *dd, double *v, double *h) const 
 Report Approximant::setup() {
   if (method_ == MFREE_METHOD_MPFEM) {
     Report rep = compute_mpfem();
+    record_set_state();
     setup_done_ = true;
     return rep;
   }
@@ -709,17 +721,122 @@ Report Approximant::setup() {
   pack();
   build_pattern();
   Report rep = compute("setup");
+  record_set_state();
   setup_done_ = true;
-  set_setups_ = ps_->setup_count();
   return rep;
 }
 
 Report Approximant::update() {
   if (!setup_done_) throw Error(MFREE_ERR_STATE, "update called before setup");
+  check_set_unchanged();
   if (method_ == MFREE_METHOD_MPFEM) return compute_mpfem();
   validate_config();
   pack();
   return compute("update");
+}
+
+namespace {
+// A 64-bit digest of the rows (order-sensitive; entries mixed independently so that the
+// pass runs at memory speed, in blocks for the threads, combined in block order).
+uint64_t rows_hash(const Csr &g) {
+  auto mix = [](uint64_t v) {
+    v ^= v >> 33;
+    v *= 0xff51afd7ed558ccdULL;
+    v ^= v >> 33;
+    v *= 0xc4ceb9fe1a85ec53ULL;
+    return v ^ (v >> 33);
+  };
+  const int64_t rows = static_cast<int64_t>(g.rowptr.size()) - 1;
+  const int nt = std::min(num_threads(g.nnz()), 64);
+  uint64_t part[64] = {0};
+  const int64_t *rp = g.rowptr.data();
+  const int32_t *cl = g.cols.data();
+  parallel_blocks(rows, nt, [&](int t, int64_t b, int64_t e) {
+    uint64_t h = 0;
+    for (int64_t i = b; i < e; ++i) {
+      h += mix(static_cast<uint64_t>(rp[i + 1]) * 0x9e3779b97f4a7c15ULL + static_cast<uint64_t>(i));
+      for (int64_t k = rp[i]; k < rp[i + 1]; ++k)
+        h += mix((static_cast<uint64_t>(k) << 32) ^ static_cast<uint32_t>(cl[k]));
+    }
+    part[t] = h;
+  });
+  uint64_t h = mix(static_cast<uint64_t>(rows));
+  for (int t = 0; t < nt; ++t) h = mix(h ^ part[t]);
+  return h;
+}
+}  // namespace
+
+void Approximant::record_set_state() {
+  set_setups_ = ps_->setup_count();
+  set_owned_ = ps_->num_owned();
+  // points: their pattern comes from their own search, not from the set's rows
+  set_rows_hash_ = points_ ? 0 : rows_hash(ps_->neighbors());
+}
+
+void Approximant::check_set_unchanged() {
+  if (!ps_->is_setup())
+    throw Error(MFREE_ERR_STATE, "the particle set was changed (a set_* call) and is not set up: "
+                                 "set it up, then call mfree_approximant_setup, not update");
+  if (ps_->setup_count() == set_setups_) return;
+  if (ps_->num_owned() != set_owned_)
+    throw Error(MFREE_ERR_STATE, "the particle set now has " + std::to_string(ps_->num_owned()) +
+                                     " owned particles, " + std::to_string(set_owned_) +
+                                     " at this approximant's setup (ghost count changed): call "
+                                     "mfree_approximant_setup, not update");
+  if (!points_ && rows_hash(ps_->neighbors()) != set_rows_hash_)
+    throw Error(MFREE_ERR_STATE, "the particle set was set up again with other neighbour lists "
+                                 "since this approximant's setup (its pattern would be stale): "
+                                 "call mfree_approximant_setup, not update");
+  set_setups_ = ps_->setup_count();  // set up again with the same rows: still good
+}
+
+void Approximant::find_bad_particles() {
+  const int32_t n = ps_->size();
+  pbad_.resize(static_cast<size_t>(n));  // (same size on update: no allocation)
+  int32_t *bad = pbad_.data();
+  parallel_blocks(n, num_threads(n), [&](int, int64_t b, int64_t e) {
+    for (int64_t i = b; i < e; ++i) bad[i] = ps_->data_status(static_cast<int32_t>(i));
+  });
+}
+
+int64_t Approximant::screen_sites(int64_t b, int64_t e) {
+  const int dim = ps_->dim(), nh = hessian_size(dim);
+  const int32_t *bad = pbad_.data();
+  int64_t failed = 0;
+  for (int64_t s = b; s < e; ++s) {
+    int32_t cls = 0;
+    const int32_t me = site_particle(static_cast<int32_t>(s));
+    if (me >= 0) {
+      cls = bad[me];
+    } else {
+      for (int c = 0; c < dim && !cls; ++c)
+        if (!std::isfinite(px_(static_cast<int32_t>(s), c))) cls = MFREE_FAIL_NONFINITE;
+      const double hs = ph_(static_cast<int32_t>(s));
+      if (!cls && !std::isfinite(hs)) cls = MFREE_FAIL_NONFINITE;
+      if (!cls && !(hs > 0.0)) cls = MFREE_FAIL_INVALID_DATA;
+    }
+    const int64_t k0 = rowptr_[s], k1 = rowptr_[s + 1];
+    for (int64_t k = k0; k < k1 && !cls; ++k) cls = bad[cols_[k]];
+    if (!cls && status_[s] == 0) {
+      bool finite = true;
+      if (!val_.empty())
+        for (int64_t k = k0; k < k1; ++k) finite &= std::fabs(val_[k]) <= DBL_MAX;
+      if (!grad_.empty())
+        for (int64_t k = k0 * dim; k < k1 * dim; ++k) finite &= std::fabs(grad_[k]) <= DBL_MAX;
+      if (!hess_.empty())
+        for (int64_t k = k0 * nh; k < k1 * nh; ++k) finite &= std::fabs(hess_[k]) <= DBL_MAX;
+      if (!finite) cls = MFREE_FAIL_NONFINITE;
+    }
+    if (cls) {
+      status_[s] = cls;
+      order_used_[s] = -1;
+      if (!val_.empty()) std::fill(val_.begin() + k0, val_.begin() + k1, 0.0);
+      if (!grad_.empty()) std::fill(grad_.begin() + k0 * dim, grad_.begin() + k1 * dim, 0.0);
+      if (!hess_.empty()) std::fill(hess_.begin() + k0 * nh, hess_.begin() + k1 * nh, 0.0);
+    }
+    failed += status_[s] != 0;
+  }
+  return failed;
 }
 
 void Approximant::export_csr(int deriv, int component, int64_t *rowptr, int32_t *cols,

@@ -101,6 +101,18 @@ class Approximant {
   // from the (possibly borrowed) host arrays at every setup and update.
   void pack();
   Report compute_mpfem();
+  // The data status of every particle now (ParticleSet::data_status) into pbad_: borrowed
+  // data may have turned invalid since the set's last setup or update.
+  void find_bad_particles();
+  // Fail every site of [b, e) whose own data or a neighbour's is invalid now (with the
+  // data's class) or whose row holds a non-finite value (MFREE_FAIL_NONFINITE), and zero
+  // its row: a site reported valid holds finite values only. Returns how many sites of
+  // the range failed in all. Needs find_bad_particles first.
+  int64_t screen_sites(int64_t b, int64_t e);
+  // The particle set's state this approximant was set up on (ghost count, rows); update
+  // throws MFREE_ERR_STATE when the set was set up again since with other ones.
+  void record_set_state();
+  void check_set_unchanged();
   double site_x(int32_t s, int c) const;
   double site_h(int32_t s) const;
   int32_t site_particle(int32_t s) const { return points_ ? -1 : s; }
@@ -157,6 +169,9 @@ class Approximant {
   // 32-byte records x y z vol, see record_length in approximant.cpp) and host points
   // (dim coordinates, support)
   HVec<double> pack_, spack_;
+  HVec<int32_t> pbad_;  // find_bad_particles
+  uint64_t set_rows_hash_ = 0;  // (with set_setups_: record_set_state)
+  int32_t set_owned_ = 0;
 };
 
 // Neighbours among the particles of ps for each host point (site support hp, the set's

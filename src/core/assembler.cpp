@@ -148,6 +148,7 @@ void Assembler::read_points(int32_t npts, const double *x, int layout, int64_t l
                             std::vector<double> &out) const {
   if (layout != MFREE_LAYOUT_AOS && layout != MFREE_LAYOUT_SOA) throw Error(MFREE_ERR_ARG, "unknown layout");
   if (ld < (layout == MFREE_LAYOUT_AOS ? dim_ : npts)) throw Error(MFREE_ERR_ARG, "leading dimension too small");
+  check_extent(npts, dim_, layout, ld, "the points");
   VectorArray v;
   v.ptr = x;
   v.ld = ld;

@@ -43,6 +43,7 @@ FluidSystem::FluidSystem(int dim, int32_t n) : dim_(dim), n_(n), ps_(dim, n) {
 void FluidSystem::set_fluid(const double *rho0, int64_t stride, double kappa, double gamma, double mu) {
   if (!rho0) throw Error(MFREE_ERR_NULL, "rest density is NULL");
   if (stride < 0) throw Error(MFREE_ERR_ARG, "negative stride");
+  check_stride(n_, stride, "rest density");
   if (!(std::isfinite(kappa) && kappa > 0.0) || !(std::isfinite(gamma) && gamma >= 1.0) ||
       !(std::isfinite(mu) && mu >= 0.0))
     throw Error(MFREE_ERR_ARG, "needs kappa > 0, gamma >= 1, mu >= 0");
@@ -61,6 +62,7 @@ void FluidSystem::set_fluid(const double *rho0, int64_t stride, double kappa, do
 void FluidSystem::set_masses(const double *m, int64_t stride) {
   if (!m && n_ > 0) throw Error(MFREE_ERR_NULL, "masses are NULL");
   if (stride < 0) throw Error(MFREE_ERR_ARG, "negative stride");
+  check_stride(n_, stride, "mass");
   std::vector<double> v(n_);
   for (int32_t i = 0; i < n_; ++i) {
     v[i] = m[i * stride];

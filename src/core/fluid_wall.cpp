@@ -61,6 +61,7 @@ void FluidSystem::set_dummy_particles(int32_t n, const double *x, const double *
   if (n < 0) throw Error(MFREE_ERR_ARG, "negative dummy particle count " + std::to_string(n));
   if (n > 0 && (!x || !vol)) throw Error(MFREE_ERR_NULL, "dummy positions or volumes are NULL");
   if (stride < 0) throw Error(MFREE_ERR_ARG, "negative stride");
+  check_stride(n, stride, "dummy volume");
   if (static_cast<int64_t>(n_) + n > INT32_MAX) throw Error(MFREE_ERR_ARG, "too many particles with the dummies");
   std::vector<double> xd(static_cast<size_t>(n) * dim_), vd(n);
   for (int32_t w = 0; w < n; ++w) {

@@ -947,6 +947,11 @@ Report Approximant::compute_mpfem() {
     support_[s] = static_cast<int32_t>(rnode.size());
     close_row();
   }
+  find_bad_particles();
+  nfailed = screen_sites(0, nsites_);
+  first_bad = -1;
+  for (int32_t s = 0; s < nsites_ && first_bad < 0; ++s)
+    if (status_[s]) first_bad = s;
 
   Report rep;
   if (nfailed) {
@@ -955,6 +960,8 @@ Report Approximant::compute_mpfem() {
     if (status_[first_bad] == MFREE_FAIL_NEIGHBORS)
       msg << ": its kernel support (half width R h = " << K.radius() * site_h(first_bad)
           << ") reaches no element";
+    else if (status_[first_bad] == MFREE_FAIL_NONFINITE)
+      msg << " has a non-finite value in its data or its shape functions";
     else
       msg << " has invalid particle data";
     msg << " (" << nfailed << (nfailed == 1 ? " site" : " sites") << " failed; their rows are zero)";

@@ -36,7 +36,7 @@ class Mesh {
     int32_t n = 0;
     int base = 0;
     const int32_t *ptr = nullptr;
-    std::vector<int32_t> own;
+    HVec<int32_t> own;  // (from the context's hook, like every copy of host data)
   };
   void check_block(const Block &b, int32_t first) const;
   const ParticleSet *ps_;

@@ -39,6 +39,24 @@ void ParticleSet::set_num_ghost(int32_t g) {
   setup_done_ = false;
 }
 
+void check_extent(int64_t n, int64_t ncomp, int layout, int64_t ld, const char *what) {
+  // Largest element index an int64 byte offset can reach: beyond it, i * ld wraps.
+  const int64_t lim = INT64_MAX / static_cast<int64_t>(sizeof(double));
+  const int64_t items = layout == MFREE_LAYOUT_AOS ? n : ncomp;  // how many times ld is stepped
+  const int64_t inner = layout == MFREE_LAYOUT_AOS ? ncomp : n;  // entries within one step
+  if (items <= 1 || inner <= 0) return;
+  if (ld > (lim - (inner - 1)) / (items - 1))
+    throw Error(MFREE_ERR_ARG, std::string("leading dimension ") + std::to_string(ld) + " of " + what +
+                                   " is too large: the last entry's offset overflows a 64-bit index");
+}
+
+void check_stride(int64_t n, int64_t stride, const char *what) {
+  const int64_t lim = INT64_MAX / static_cast<int64_t>(sizeof(double));
+  if (n > 1 && stride > lim / (n - 1))
+    throw Error(MFREE_ERR_ARG, std::string(what) + " stride " + std::to_string(stride) +
+                                   " is too large: the last entry's offset overflows a 64-bit index");
+}
+
 void ParticleSet::set_positions(const double *x, int layout, int64_t ld, int mem) {
   check_mem(mem);
   if (layout != MFREE_LAYOUT_AOS && layout != MFREE_LAYOUT_SOA)
@@ -48,6 +66,7 @@ void ParticleSet::set_positions(const double *x, int layout, int64_t ld, int mem
     throw Error(MFREE_ERR_ARG, "leading dimension " + std::to_string(ld) + " is below " +
                                    std::to_string(need) +
                                    (layout == MFREE_LAYOUT_AOS ? " (dim)" : " (n)"));
+  check_extent(n_, dim_, layout, ld, "the positions");
   if (x == nullptr && n_ > 0) throw Error(MFREE_ERR_NULL, "positions pointer is NULL");
   VectorArray v;
   v.ptr = x;
@@ -60,25 +79,24 @@ void ParticleSet::set_positions(const double *x, int layout, int64_t ld, int mem
         s << "position of particle " << i << ", component " << c << " is " << v(i, c);
         throw Error(MFREE_ERR_INPUT, s.str());
       }
+  // The new array is made aside and swapped in (no exception after the first change):
+  // running out of memory leaves the set as it was.
+  HVec<double> own;
   if (mem == MFREE_COPY) {
-    std::vector<double> own(static_cast<size_t>(n_) * dim_);
+    own.resize(std::max<size_t>(static_cast<size_t>(n_) * dim_, 1));
     for (int32_t i = 0; i < n_; ++i)
       for (int c = 0; c < dim_; ++c) own[static_cast<size_t>(i) * dim_ + c] = v(i, c);
-    pos_.own.swap(own);
-    pos_.ptr = pos_.own.data();
-    pos_.ld = dim_;
-    pos_.layout = MFREE_LAYOUT_AOS;
-  } else {
-    pos_.own.clear();
-    pos_.ptr = x;
-    pos_.ld = ld;
-    pos_.layout = layout;
+    v.ptr = own.data();
+    v.ld = dim_;
+    v.layout = MFREE_LAYOUT_AOS;
+  } else if (x == nullptr) {
+    own.assign(1, 0.0);  // a zero-particle set still needs a non-NULL marker that positions were given
+    v.ptr = own.data();
   }
-  // A zero-particle set still needs a non-NULL marker that positions were given.
-  if (pos_.ptr == nullptr) {
-    pos_.own.assign(1, 0.0);
-    pos_.ptr = pos_.own.data();
-  }
+  pos_.own.swap(own);
+  pos_.ptr = v.ptr;
+  pos_.ld = v.ld;
+  pos_.layout = v.layout;
   setup_done_ = false;
 }
 
@@ -87,6 +105,7 @@ void ParticleSet::set_scalar(ScalarArray &a, const double *v, int64_t stride, in
   check_mem(mem);
   if (stride < 0)
     throw Error(MFREE_ERR_ARG, std::string(what) + " stride " + std::to_string(stride) + " is negative");
+  check_stride(n_, stride, what);
   if (v == nullptr && (n_ > 0 || stride == 0))
     throw Error(MFREE_ERR_NULL, std::string(what) + " pointer is NULL");
   const int32_t count = stride == 0 ? 1 : n_;
@@ -95,21 +114,22 @@ void ParticleSet::set_scalar(ScalarArray &a, const double *v, int64_t stride, in
     if (!std::isfinite(val) || val <= 0.0)
       throw Error(MFREE_ERR_INPUT, fmt_index(what, i, val) + " must be finite and > 0");
   }
+  // made aside and swapped in, as set_positions
+  HVec<double> own;
+  const double *ptr = v;
+  int64_t st = stride;
   if (mem == MFREE_COPY) {
-    std::vector<double> own(count > 0 ? count : 1, 1.0);
+    own.assign(count > 0 ? count : 1, 1.0);
     for (int32_t i = 0; i < count; ++i) own[i] = v[i * stride];
-    a.own.swap(own);
-    a.ptr = a.own.data();
-    a.stride = stride == 0 ? 0 : 1;
-  } else {
-    a.own.clear();
-    a.ptr = v;
-    a.stride = stride;
-    if (a.ptr == nullptr) {  // n = 0 with a NULL array: still counts as set
-      a.own.assign(1, 1.0);
-      a.ptr = a.own.data();
-    }
+    ptr = own.data();
+    st = stride == 0 ? 0 : 1;
+  } else if (v == nullptr) {  // n = 0 with a NULL array: still counts as set
+    own.assign(1, 1.0);
+    ptr = own.data();
   }
+  a.own.swap(own);
+  a.ptr = ptr;
+  a.stride = st;
   setup_done_ = false;
 }
 
@@ -143,6 +163,9 @@ void ParticleSet::set_periodic(const double *lo, const double *hi, const int32_t
       throw Error(MFREE_ERR_INPUT, "box bounds must be finite");
     if (periodic[c] && !(hi[c] > lo[c]))
       throw Error(MFREE_ERR_ARG, "box axis " + std::to_string(c) + " has hi <= lo");
+    if (periodic[c] && !std::isfinite(hi[c] - lo[c]))
+      throw Error(MFREE_ERR_INPUT, "box axis " + std::to_string(c) +
+                                       ": the period hi - lo overflows to infinity");
   }
   for (int c = 0; c < dim_; ++c) {
     lo_[c] = lo[c];
@@ -167,6 +190,17 @@ void ParticleSet::check_host_csr(const int64_t *rowptr, const int32_t *cols, int
       throw Error(MFREE_ERR_INPUT, "neighbour column " + std::to_string(cols[k]) + " at position " +
                                        std::to_string(k) + " is outside [" + std::to_string(base) +
                                        ", " + std::to_string(base + n_) + ")");
+  // A column twice in a row would count that neighbour twice in every sum over the row
+  // (rows need not be sorted: last row seen per column).
+  std::vector<int32_t> seen(static_cast<size_t>(n_), -1);
+  for (int32_t i = 0; i < rows; ++i)
+    for (int64_t k = rowptr[i] - base; k < rowptr[i + 1] - base; ++k) {
+      int32_t &last = seen[static_cast<size_t>(cols[k] - base)];
+      if (last == i)
+        throw Error(MFREE_ERR_INPUT, "neighbour column " + std::to_string(cols[k]) +
+                                         " appears twice in row " + std::to_string(i));
+      last = i;
+    }
 }
 
 void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int32_t base, int mem) {
@@ -175,19 +209,20 @@ void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int3
   if (!rowptr) throw Error(MFREE_ERR_NULL, "neighbour rowptr is NULL");
   check_host_csr(rowptr, cols, base);
   const int32_t rows = num_owned();
+  // The copies are made aside and swapped in: running out of memory half way must leave
+  // the previous lists (and the pointers into them) as they were.
+  HVec<int64_t> rp_own;
+  HVec<int32_t> cols_own;
   if (mem == MFREE_COPY) {
-    host_rowptr_own_.assign(rowptr, rowptr + rows + 1);
     const int64_t nnz = rowptr[rows] - base;
-    host_cols_own_.assign(cols, cols + nnz);
-    if (host_cols_own_.empty()) host_cols_own_.push_back(base);  // keep data() non-NULL
-    host_rowptr_ = host_rowptr_own_.data();
-    host_cols_ = host_cols_own_.data();
-  } else {
-    host_rowptr_own_.clear();
-    host_cols_own_.clear();
-    host_rowptr_ = rowptr;
-    host_cols_ = cols;
+    rp_own.assign(rowptr, rowptr + rows + 1);
+    cols_own.assign(cols, cols + nnz);
+    if (cols_own.empty()) cols_own.push_back(base);  // keep data() non-NULL
   }
+  host_rowptr_own_.swap(rp_own);
+  host_cols_own_.swap(cols_own);
+  host_rowptr_ = mem == MFREE_COPY ? host_rowptr_own_.data() : rowptr;
+  host_cols_ = mem == MFREE_COPY ? host_cols_own_.data() : cols;
   host_base_ = base;
   host_rows_ = rows;
   pairs_ = PairList();  // the CSR lists replace a pair list
@@ -262,6 +297,18 @@ void ParticleSet::order_rows_by_id(Csr &rows) const {
         cl[q] = v;
       }
   });
+}
+
+int32_t ParticleSet::data_status(int32_t i) const {
+  for (int c = 0; c < dim_; ++c)
+    if (!std::isfinite(pos_(i, c))) return MFREE_FAIL_NONFINITE;
+  for (const ScalarArray *a : {&h_, &vol_, &mass_, &rho_}) {
+    if (!a->set()) continue;
+    const double v = (*a)(i);
+    if (!std::isfinite(v)) return MFREE_FAIL_NONFINITE;
+    if (v <= 0.0) return MFREE_FAIL_INVALID_DATA;
+  }
+  return 0;
 }
 
 Report ParticleSet::validate() {

@@ -18,7 +18,7 @@ namespace mfree {
 struct ScalarArray {
   const double *ptr = nullptr;
   int64_t stride = 1;  // 0: one value for all
-  std::vector<double> own;
+  HVec<double> own;  // (from the context's hook, like every copy of host data)
   bool set() const { return ptr != nullptr; }
   double operator()(int64_t i) const { return ptr[i * stride]; }
 };
@@ -27,12 +27,18 @@ struct VectorArray {
   const double *ptr = nullptr;
   int64_t ld = 0;
   int layout = MFREE_LAYOUT_AOS;
-  std::vector<double> own;
+  HVec<double> own;
   bool set() const { return ptr != nullptr; }
   double operator()(int64_t i, int c) const {
     return layout == MFREE_LAYOUT_AOS ? ptr[i * ld + c] : ptr[c * ld + i];
   }
 };
+
+// MFREE_ERR_ARG when the last of n items (ncomp components each, layout and leading
+// dimension ld) or of n scalars (stride) lies beyond what a 64-bit byte offset reaches:
+// the index would wrap and read elsewhere. `what` names the array in the message.
+void check_extent(int64_t n, int64_t ncomp, int layout, int64_t ld, const char *what);
+void check_stride(int64_t n, int64_t stride, const char *what);
 
 // CSR adjacency, 0-based, one row per owned particle.
 struct Csr {
@@ -80,6 +86,9 @@ class ParticleSet {
   // Successful setups so far: objects built on the set tell whether their pattern is
   // from the current lists.
   int64_t setup_count() const { return setups_; }
+  // The status particle i's data would get now (0, MFREE_FAIL_NONFINITE or
+  // MFREE_FAIL_INVALID_DATA), re-read from the possibly borrowed arrays.
+  int32_t data_status(int32_t i) const;
   const Csr &neighbors() const { return nbr_; }
   const std::vector<int32_t> &site_status() const { return site_status_; }
 
@@ -160,8 +169,8 @@ class ParticleSet {
   const int32_t *host_cols_ = nullptr;
   int32_t host_base_ = 0;
   int32_t host_rows_ = 0;  // owned count when the host lists were set
-  std::vector<int64_t> host_rowptr_own_;
-  std::vector<int32_t> host_cols_own_;
+  HVec<int64_t> host_rowptr_own_;
+  HVec<int32_t> host_cols_own_;
 
   // global ids: n values, borrowed or in gid_own_; gid_check_ is the duplicate check's
   // sorted copy, kept so that a repeated setup with borrowed ids allocates nothing

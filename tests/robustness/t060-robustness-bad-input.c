@@ -13,6 +13,7 @@
  * A last check reads mfree.h and fails when a public function has no row here, so that
  * a new function comes with its bad-input rows. */
 #define _POSIX_C_SOURCE 200809L /* dup, dup2, fileno */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -442,6 +443,7 @@ static void rows_particles(void) {
   const double one = 1.0, zero = 0.0, neg = -1.0, nan_ = NAN, inf_ = INFINITY;
   const double lo[2] = {0, 0}, hi[2] = {1, 1}, hiflip[2] = {-1, 1}, lonan[2] = {NAN, 0};
   const int32_t per[2] = {1, 0};
+  const double lohuge[2] = {-DBL_MAX, 0}, hihuge[2] = {DBL_MAX, 1};
   int32_t i32, st[N];
   int64_t i64, rowptr[N + 1];
   int32_t cols[4 * N];
@@ -467,6 +469,9 @@ static void rows_particles(void) {
   ROW(MFREE_ERR_ARG, mfree_particles_set_positions(F.fresh, F.x, MFREE_LAYOUT_AOS, 1, MFREE_COPY));
   ROW(MFREE_ERR_ARG, mfree_particles_set_positions(F.fresh, F.x, MFREE_LAYOUT_AOS, -2, MFREE_COPY));
   ROW(MFREE_ERR_ARG, mfree_particles_set_positions(F.fresh, F.x, MFREE_LAYOUT_SOA, N - 1, MFREE_COPY));
+  /* a leading dimension whose last entry's offset wraps a 64-bit index */
+  ROW(MFREE_ERR_ARG, mfree_particles_set_positions(F.ps, F.x, MFREE_LAYOUT_AOS, INT64_MAX, MFREE_BORROW));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_positions(F.ps, F.x, MFREE_LAYOUT_SOA, INT64_MAX / 2, MFREE_COPY));
   ROW(MFREE_ERR_ARG, mfree_particles_set_positions(F.fresh, F.x, MFREE_LAYOUT_AOS, 2, (mfree_mem_t)0));
   ROW(MFREE_ERR_ARG, mfree_particles_set_positions(F.fresh, F.x, MFREE_LAYOUT_AOS, 2, (mfree_mem_t)7));
   ROW(MFREE_ERR_INPUT, mfree_particles_set_positions(F.ps, xbad, MFREE_LAYOUT_AOS, 2, MFREE_COPY));
@@ -492,6 +497,8 @@ static void rows_particles(void) {
   ROW0(MFREE_ERR_NULL, mfree_particles_set_support(NULL, &one, 0, MFREE_COPY));
   ROW(MFREE_ERR_NULL, mfree_particles_set_support(F.ps, NULL, 0, MFREE_COPY));
   ROW(MFREE_ERR_ARG, mfree_particles_set_support(F.ps, &one, -1, MFREE_COPY));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_support(F.ps, &one, INT64_MAX, MFREE_COPY));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_volumes(F.ps, &one, INT64_MAX / 4, MFREE_BORROW));
   ROW(MFREE_ERR_INPUT, mfree_particles_set_support(F.ps, &zero, 0, MFREE_COPY));
   ROW(MFREE_ERR_INPUT, mfree_particles_set_support(F.ps, &neg, 0, MFREE_COPY));
   ROW(MFREE_ERR_INPUT, mfree_particles_set_support(F.ps, &nan_, 0, MFREE_COPY));
@@ -510,6 +517,8 @@ static void rows_particles(void) {
   /* a box is an argument (MFREE_ERR_ARG), not data */
   ROW(MFREE_ERR_ARG, mfree_particles_set_periodic(F.fresh, lo, hiflip, per));
   ROW(MFREE_ERR_INPUT, mfree_particles_set_periodic(F.fresh, lonan, hi, per)); /* NaN: data */
+  /* a period hi - lo that overflows to infinity */
+  ROW(MFREE_ERR_INPUT, mfree_particles_set_periodic(F.ps, lohuge, hihuge, per));
 
   /* host neighbour lists: row i = {i}, malformed variants */
   for (int i = 0; i <= N; ++i) rowptr[i] = i;
@@ -530,6 +539,12 @@ static void rows_particles(void) {
   rowptr[0] = 1; /* rowptr[0] != base */
   ROW(MFREE_ERR_INPUT, mfree_particles_set_neighbors(F.fresh, rowptr, cols, 0, MFREE_COPY));
   rowptr[0] = 0;
+  for (int i = 1; i <= N; ++i) rowptr[i] = i + 1; /* row 0 = {0, 0}: a column twice */
+  for (int i = 0; i <= N; ++i) cols[i] = i > 0 ? i - 1 : 0;
+  ROW(MFREE_ERR_INPUT, mfree_particles_set_neighbors(F.fresh, rowptr, cols, 0, MFREE_COPY));
+  ROW(MFREE_ERR_INPUT, mfree_particles_set_neighbors(F.fresh, rowptr, cols, 0, MFREE_BORROW));
+  for (int i = 0; i <= N; ++i) rowptr[i] = i;
+  for (int i = 0; i < N; ++i) cols[i] = i;
 
   ROW0(MFREE_ERR_NULL, mfree_particles_setup(NULL));
   ROW0(MFREE_ERR_NULL, mfree_particles_update(NULL));
@@ -656,6 +671,7 @@ static void rows_approximant(void) {
   ROW(MFREE_ERR_ARG, mfree_approximant_set_points(F.a_new, 1, pts, MFREE_LAYOUT_AOS, 2, &ph, -1, MFREE_COPY));
   ROW(MFREE_ERR_ARG, mfree_approximant_set_points(F.a_new, 1, pts, MFREE_LAYOUT_AOS, 2, &ph, 0, (mfree_mem_t)0));
   ROW(MFREE_ERR_INPUT, mfree_approximant_set_points(F.a_new, 2, pts, MFREE_LAYOUT_AOS, 2, &ph, 0, MFREE_COPY));
+  ROW(MFREE_ERR_ARG, mfree_approximant_set_points(F.a, 2, pts, MFREE_LAYOUT_AOS, INT64_MAX, &ph, 0, MFREE_COPY));
   ROW(MFREE_ERR_INPUT, mfree_approximant_set_points(F.a_new, 1, pts, MFREE_LAYOUT_AOS, 2, &zero, 0, MFREE_COPY));
   {
     mfree_approximant_t *rl = NULL;
@@ -687,6 +703,9 @@ static void rows_approximant(void) {
   ROW(MFREE_ERR_ARG, mfree_approximant_apply(F.a, MFREE_OP_VALUE, 1, F.u, (mfree_layout_t)0, 1, out, MFREE_LAYOUT_AOS, 1));
   ROW(MFREE_ERR_ARG, mfree_approximant_apply(F.a, MFREE_OP_VALUE, 1, F.u, MFREE_LAYOUT_AOS, 1, out, (mfree_layout_t)5, 1));
   ROW(MFREE_ERR_ARG, mfree_approximant_apply(F.a, MFREE_OP_VALUE, 1, F.u, MFREE_LAYOUT_AOS, 0, out, MFREE_LAYOUT_AOS, 1));
+  ROW(MFREE_ERR_ARG, mfree_approximant_apply(F.a, MFREE_OP_VALUE, 1, F.u, MFREE_LAYOUT_AOS, INT64_MAX, out, MFREE_LAYOUT_AOS, 1));
+  ROW(MFREE_ERR_ARG, mfree_approximant_apply(F.a, MFREE_OP_VALUE, 1, F.u, MFREE_LAYOUT_AOS, 1, out, MFREE_LAYOUT_AOS, INT64_MAX / 8));
+  ROW(MFREE_ERR_ARG, mfree_approximant_apply_add(F.a, MFREE_OP_GRADIENT, 1, F.u, MFREE_LAYOUT_SOA, N, out, MFREE_LAYOUT_SOA, INT64_MAX / 2));
   ROW(MFREE_ERR_ARG, mfree_approximant_apply(F.a, MFREE_OP_VALUE, 1, F.u, MFREE_LAYOUT_SOA, N - 1, out, MFREE_LAYOUT_AOS, 1));
   ROW(MFREE_ERR_ARG, mfree_approximant_apply(F.a, MFREE_OP_GRADIENT, 1, F.u, MFREE_LAYOUT_AOS, 1, out, MFREE_LAYOUT_AOS, 1));
   ROW(MFREE_ERR_ARG, mfree_approximant_apply(F.a, MFREE_OP_GRADIENT, 1, F.u, MFREE_LAYOUT_AOS, 1, out, MFREE_LAYOUT_SOA, N - 1));

@@ -976,6 +976,14 @@ mfree_status_t mfree_suitesparse_solve(mfree_suitesparse_t *s, int32_t nrhs, con
       return record(s->ctx, MFREE_ERR_ARG, fn,
                     "leading dimensions ldb = " + std::to_string(ldb) + ", ldx = " +
                         std::to_string(ldx) + " must be >= max(1, n) = " + std::to_string(need));
+    // the last right-hand side starts at (nrhs - 1) * ld: beyond a 64-bit byte offset
+    // the index would wrap and read or write elsewhere
+    const int64_t lim = INT64_MAX / static_cast<int64_t>(sizeof(double));
+    if (nrhs > 1 && (ldb > (lim - n) / (nrhs - 1) || ldx > (lim - n) / (nrhs - 1)))
+      return record(s->ctx, MFREE_ERR_ARG, fn,
+                    "leading dimensions ldb = " + std::to_string(ldb) + ", ldx = " + std::to_string(ldx) +
+                        " are too large for " + std::to_string(nrhs) +
+                        " right-hand sides: the last one's offset overflows a 64-bit index");
     if (nrhs > 0 && b == x && ldb != ldx)
       return record(s->ctx, MFREE_ERR_ARG, fn, "an in-place solve (b == x) needs ldb == ldx");
     if (nrhs == 0 || n == 0) return MFREE_SUCCESS;
