@@ -825,11 +825,14 @@ Report Approximant::compute_mpfem() {
   int64_t nfailed = 0;
   int32_t first_bad = -1;
   const auto &pst = ps_->site_status();
+  // borrowed data that turned invalid since the set's setup: such a site is not computed
+  // (a NaN support would reach the element grid's index arithmetic)
+  find_bad_particles();
   for (int32_t s = 0; s < nsites_; ++s) {
     const int32_t me = site_particle(s);
     auto close_row = [&]() { rowptr_.push_back(static_cast<int64_t>(cols_.size())); };
-    if (me >= 0 && pst[me] != 0) {
-      status_[s] = pst[me];
+    if (me >= 0 && (pst[me] != 0 || pbad_[me] != 0)) {
+      status_[s] = pst[me] != 0 ? pst[me] : pbad_[me];
       order_used_[s] = -1;
       ++nfailed;
       if (first_bad < 0) first_bad = s;
@@ -947,7 +950,6 @@ Report Approximant::compute_mpfem() {
     support_[s] = static_cast<int32_t>(rnode.size());
     close_row();
   }
-  find_bad_particles();
   nfailed = screen_sites(0, nsites_);
   first_bad = -1;
   for (int32_t s = 0; s < nsites_ && first_bad < 0; ++s)
@@ -976,7 +978,7 @@ Report Approximant::compute_mpfem() {
     int32_t vnode = -1, velem = -1;
     double vw = 0.0;
     for (int32_t P = 0; P < ps_->size(); ++P) {
-      if (geo.node_ptr[P] == geo.node_ptr[P + 1] || pst[P] != 0) continue;
+      if (geo.node_ptr[P] == geo.node_ptr[P + 1] || pst[P] != 0 || pbad_[P] != 0) continue;
       const double h = ps_->h(P), Rh = K.radius() * h;
       bool bad = false;
       if (grid) {

@@ -6,13 +6,15 @@
  *     and the object gives bitwise the results it gave before (a half-updated copy used to
  *     leave rows and columns of different lists: a heap-buffer-overflow at the next setup).
  *     At least one allocation of each copy must go through the hook.
- *  2. For every method but MPFEM (t066 below for MPFEM), NaN / Inf / zero in borrowed
+ *  2. For every method, NaN / Inf / zero in borrowed
  *     positions, supports and volumes, through the documented per-step path
  *     (particles_update + approximant_update) and through approximant_update alone: a
  *     positive status, the particle's own site and every site whose row holds it fail
  *     with the data's class (MFREE_FAIL_NONFINITE, or MFREE_FAIL_INVALID_DATA for a
- *     support of 0), and every other site's rows are finite. Tiny supports (1e-300) at a
- *     particle and at a host point: no non-finite value at a valid site.
+ *     support of 0), and every other site's rows are finite (MPFEM: a mesh node without a
+ *     finite position makes the mesh invalid, MFREE_ERR_INPUT, tables unchanged). Tiny
+ *     supports (1e-300) at a particle (at setup and at an update) and at a host point: no
+ *     non-finite value at a valid site.
  *  3. approximant_update after the particle set changed under it (ghost count, a search
  *     that found other rows, a set_* without setup): MFREE_ERR_STATE and the approximant
  *     unchanged; after a setup of the set with the same rows it updates. */
@@ -182,6 +184,7 @@ typedef struct {
   mfree_context_t *ctx;
   mfree_particles_t *ps;
   mfree_approximant_t *a;
+  mfree_mesh_t *mesh; /* MPFEM: quadrilaterals over the lattice */
   double x[2 * N], h[N], v[N];
 } fix_t;
 
@@ -191,7 +194,10 @@ static int flags_of(int method) { (void)method; return MFREE_DERIV_VALUE | MFREE
 static mfree_status_t build(fix_t *f, int method, double tiny_h_at) {
   memset(f, 0, sizeof *f);
   lattice(f->x, 1.0, 7);
-  for (int p = 0; p < N; ++p) f->h[p] = 1.5 * SP, f->v[p] = SP * SP;
+  /* MPFEM: supports of half a spacing (004 eq 13: each node's support stays inside
+   * its own elements) */
+  const double h = method == MFREE_METHOD_MPFEM ? 0.5 * SP : 1.5 * SP;
+  for (int p = 0; p < N; ++p) f->h[p] = h, f->v[p] = SP * SP;
   if (tiny_h_at >= 0) f->h[(int)tiny_h_at] = 1e-300;
   assert_ok(NULL, mfree_context_create(&f->ctx));
   assert_ok(f->ctx, mfree_particles_create(f->ctx, 2, N, &f->ps));
@@ -200,10 +206,23 @@ static mfree_status_t build(fix_t *f, int method, double tiny_h_at) {
   assert_ok(f->ctx, mfree_particles_set_volumes(f->ps, f->v, 1, MFREE_BORROW));
   assert_ok(f->ctx, mfree_approximant_create(f->ctx, f->ps, (mfree_method_t)method, &f->a));
   mfree_approximant_set_derivatives(f->a, flags_of(method));
+  if (method == MFREE_METHOD_MPFEM) {
+    int32_t conn[4 * (M - 1) * (M - 1)];
+    for (int j = 0; j + 1 < M; ++j)
+      for (int i = 0; i + 1 < M; ++i) {
+        int32_t *c = conn + 4 * (j * (M - 1) + i);
+        c[0] = j * M + i, c[1] = j * M + i + 1, c[2] = (j + 1) * M + i + 1, c[3] = (j + 1) * M + i;
+      }
+    assert_ok(f->ctx, mfree_mesh_create(f->ctx, f->ps, &f->mesh));
+    assert_ok(f->ctx, mfree_mesh_add_elements(f->mesh, MFREE_ELEMENT_QUAD4, (M - 1) * (M - 1), conn, 0,
+                                              MFREE_COPY));
+    assert_ok(f->ctx, mfree_approximant_set_mesh(f->a, f->mesh));
+  }
   return mfree_approximant_setup(f->a);
 }
 
 static void destroy(fix_t *f) {
+  mfree_mesh_destroy(&f->mesh);
   mfree_approximant_destroy(&f->a);
   mfree_particles_destroy(&f->ps);
   mfree_context_destroy(&f->ctx);
@@ -257,11 +276,13 @@ static void test_nonfinite_never_valid(void **state) {
                          {1, 0.0, MFREE_FAIL_INVALID_DATA, "support 0"},
                          {2, NAN, MFREE_FAIL_NONFINITE, "volume NaN"},
                          {2, -1.0, MFREE_FAIL_INVALID_DATA, "volume < 0"}};
-  for (int method = MFREE_METHOD_SPH; method <= MFREE_METHOD_SSPH; ++method) {
+  for (int method = MFREE_METHOD_SPH; method <= MFREE_METHOD_MPFEM; ++method) {
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c)
       for (int path = 0; path < 2; ++path) {
         fix_t f;
-        assert_status(f.ctx, build(&f, method, -1), MFREE_SUCCESS);
+        const mfree_status_t st0 = build(&f, method, -1);
+        assert_true(st0 >= 0);
+        check_sites(&f, method, -1, 0, "setup");
         double *arr = cases[c].array == 0 ? f.x + 2 * K : cases[c].array == 1 ? f.h + K : f.v + K;
         *arr = cases[c].value;
         if (path == 0) {
@@ -271,10 +292,27 @@ static void test_nonfinite_never_valid(void **state) {
         const mfree_status_t st = mfree_approximant_update(f.a);
         char what[96];
         snprintf(what, sizeof what, "%s, %s", cases[c].name, path ? "update alone" : "particles_update + update");
-        if (st != cases[c].cls) fail_msg("method %d, %s: update returned %d, not %d", method, what, st, cases[c].cls);
-        assert_true(check_sites(&f, method, K, cases[c].cls, what) > 0);
+        if (method == MFREE_METHOD_MPFEM && cases[c].array == 0) {
+          /* a mesh node without a finite position: the mesh is invalid (mfree.h,
+           * mfree_mesh_setup), a negative status, and the tables stay as they were */
+          assert_int_equal(st, MFREE_ERR_INPUT);
+          check_sites(&f, method, -1, 0, what);
+        } else {
+          if (st != cases[c].cls) fail_msg("method %d, %s: update returned %d, not %d", method, what, st, cases[c].cls);
+          assert_true(check_sites(&f, method, K, cases[c].cls, what) > 0);
+        }
         destroy(&f);
       }
+    /* a tiny support turning up at the update */
+    for (int path = 0; path < 2; ++path) {
+      fix_t f;
+      assert_true(build(&f, method, -1) >= 0);
+      f.h[K] = 1e-300;
+      if (path == 0) assert_ok(f.ctx, mfree_particles_update(f.ps));
+      assert_true(mfree_approximant_update(f.a) >= 0);
+      check_sites(&f, method, -1, 0, "support 1e-300 at an update");
+      destroy(&f);
+    }
     /* tiny supports at a particle (set up with it) */
     fix_t f;
     const mfree_status_t st = build(&f, method, K);
