@@ -14,8 +14,17 @@
  *    code means and what to do. Besides the statuses a function lists, any function
  *    returns MFREE_ERR_NULL for a NULL handle or required pointer and MFREE_ERR_ALLOC
  *    when memory runs out.
+ *  - The rule that keeps a host safe (docs/robustness.md): after a negative status the
+ *    objects given to the call are unchanged (a failed copy leaves the previous array;
+ *    the one exception is stated at mfree_particles_setup); after a positive status,
+ *    every site reported valid (status 0 in get_site_status) holds finite values, and
+ *    a site whose own data or a neighbour's are invalid, or whose results are not
+ *    finite, fails with MFREE_FAIL_NONFINITE or MFREE_FAIL_INVALID_DATA and an all-zero
+ *    row.
  *  - Messages: the message of the last failure is kept on the context
  *    (mfree_context_get_last_error); the library never prints, aborts or exits.
+ *    Objects sharing a context may fail on several threads at once: the last error is
+ *    written and read under a lock, and the error handler may be called concurrently.
  *  - Types: reals are double, particle indices int32_t, offsets and counts of non-zeros
  *    int64_t.
  *  - Ownership: pointer arguments are borrowed for the call only (read or written
@@ -561,7 +570,8 @@ MFREE_API mfree_status_t mfree_particles_set_num_ghost(mfree_particles_t *ps,
  *                    copied or borrowed according to mem
  * @param[in] layout  MFREE_LAYOUT_AOS (x[i*ld + d], ld >= dim) or
  *                    MFREE_LAYOUT_SOA (x[d*ld + i], ld >= n)
- * @param[in] ld      leading dimension, in doubles (too small: MFREE_ERR_ARG)
+ * @param[in] ld      leading dimension, in doubles (too small, or so large that the last
+ *                    entry's offset overflows a 64-bit index: MFREE_ERR_ARG)
  * @param[in] mem     MFREE_COPY or MFREE_BORROW
  * @return MFREE_SUCCESS, or a failure named with the parameters
  */
@@ -628,7 +638,8 @@ MFREE_API mfree_status_t mfree_particles_set_search(mfree_particles_t *ps,
  * axes; kappa h must stay below half the box length there.
  * @param[in] ps        the set
  * @param[in] lo        dim lower bounds (finite, else MFREE_ERR_INPUT; copied)
- * @param[in] hi        dim upper bounds, hi > lo (else MFREE_ERR_ARG; copied)
+ * @param[in] hi        dim upper bounds, hi > lo (else MFREE_ERR_ARG; copied); a
+ *                      periodic axis whose length hi - lo overflows is MFREE_ERR_INPUT
  * @param[in] periodic  dim flags, nonzero for a periodic axis (copied)
  * @return MFREE_SUCCESS, or a failure named with the parameters
  */
@@ -639,7 +650,8 @@ MFREE_API mfree_status_t mfree_particles_set_periodic(mfree_particles_t *ps,
 /**
  * Host-supplied neighbour lists, one row per owned particle (CSR); mfree then does no
  * search of its own (docs/drop-in-csr.md). Rows need not be sorted nor contain the
- * particle itself. A malformed list is MFREE_ERR_INPUT.
+ * particle itself. A malformed list (a column out of range or twice in a row, rowptr
+ * not monotone) is MFREE_ERR_INPUT.
  * @param[in] ps          the set
  * @param[in] rowptr      n_owned + 1 monotone offsets, rowptr[0] = index_base
  * @param[in] cols        column indices in [index_base, index_base + n)
@@ -968,15 +980,23 @@ MFREE_API mfree_status_t mfree_approximant_set_points(mfree_approximant_t *a, in
  * mfree_approximant_get_site_status; with MFREE_FALLBACK_LOWER_ORDER they first retry
  * lower orders (mfree_approximant_get_site_order).
  * @param[in] a  the approximant
- * @return MFREE_FAIL_SINGULAR or MFREE_FAIL_NEIGHBORS for failed sites; the particle
- *         set's statuses; MFREE_FAIL_SUPPORT (MPFEM)
+ * @return MFREE_FAIL_SINGULAR or MFREE_FAIL_NEIGHBORS for failed sites;
+ *         MFREE_FAIL_NONFINITE for a site whose results are not finite (e.g. a support
+ *         so small that the kernel overflows); the particle set's statuses;
+ *         MFREE_FAIL_SUPPORT (MPFEM)
  */
 MFREE_API mfree_status_t mfree_approximant_setup(mfree_approximant_t *a);
 
 /** Recompute the tables after particles (borrowed positions) moved, keeping the
- * neighbour pattern. Allocates nothing.
+ * neighbour pattern. Allocates nothing. Borrowed data are re-read: a site whose own
+ * data or a neighbour's turned non-finite or out of range fails (MFREE_FAIL_NONFINITE,
+ * MFREE_FAIL_INVALID_DATA) with an all-zero row, also without mfree_particles_update.
  * @param[in] a  the approximant
- * @return MFREE_ERR_STATE before setup; positive statuses as setup */
+ * @return MFREE_ERR_STATE before setup, and when the particle set changed under the
+ *         approximant: a set_* call on the set since its last setup, or a setup of the
+ *         set that found another ghost count or other neighbour lists than the
+ *         approximant's setup saw (call mfree_approximant_setup; the tables are kept
+ *         unchanged meanwhile); positive statuses as setup */
 MFREE_API mfree_status_t mfree_approximant_update(mfree_approximant_t *a);
 
 /**
@@ -990,6 +1010,8 @@ MFREE_API mfree_status_t mfree_approximant_update(mfree_approximant_t *a);
  * @param[out] out      one row per site with the op's output components
  * @param[in]  olayout  layout of out
  * @param[in]  old      leading dimension of out: AOS >= output components, SOA >= sites
+ *                      (uld, old so large that the last entry's offset overflows a
+ *                      64-bit index: MFREE_ERR_ARG)
  * @return MFREE_SUCCESS, or a failure named with the parameters
  */
 MFREE_API mfree_status_t mfree_approximant_apply(const mfree_approximant_t *a, mfree_op_t op,

@@ -222,6 +222,27 @@ class SmallPages {
   SmallPages &operator=(const SmallPages &) = delete;
 };
 
+// The machine's physical memory in bytes (0: unknown), read once.
+inline double physical_memory() {
+#if defined(__linux__)
+  static const double bytes = [] {
+    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    return pages > 0 && size > 0 ? static_cast<double>(pages) * static_cast<double>(size) : 0.0;
+  }();
+  return bytes;
+#else
+  return 0.0;
+#endif
+}
+
+// Whether a request of `bytes` must be refused up front: more than `limit` (default: the
+// physical memory), without a hook installed (with one the host's allocator decides).
+// The kernel's overcommit would otherwise grant it and kill the host when the pages are
+// touched, instead of the call failing with MFREE_ERR_ALLOC.
+inline bool request_too_large(double bytes, double limit = physical_memory()) {
+  return current_alloc_hook() == nullptr && limit > 0.0 && bytes > limit;
+}
+
 template <class T>
 struct HostAllocator {
   using value_type = T;

@@ -275,7 +275,9 @@ void Approximant::pack() {
   // AoS, one record per particle (coordinates, volume, support; record_length): the data
   // of a neighbour come in one cache line
   const size_t S = static_cast<size_t>(record_length(dim));
-  pack_.resize(S * N + (S < static_cast<size_t>(dim) + 2 ? N : 0));  // (+ supports after the records)
+  // (+ supports after the records; + one spare record, so that data() + offset, for the
+  // fields of record 0, stays inside the block when there are no particles)
+  pack_.resize(S * N + (S < static_cast<size_t>(dim) + 2 ? N : 0) + S);
   double *P = pack_.data();
   const PackedSupports ph = packed_supports(P, dim, np);
   double *H = ph.h;
@@ -295,7 +297,7 @@ void Approximant::pack() {
   }
   const size_t M = static_cast<size_t>(npts_);
   const size_t T = static_cast<size_t>(dim) + 1;
-  spack_.resize(T * M);
+  spack_.resize(T * M + T);  // (+ one spare record, as pack_)
   for (int32_t s = 0; s < npts_; ++s) {
     for (int c = 0; c < dim; ++c) spack_[T * s + c] = px_(s, c);
     spack_[T * s + dim] = ph_(s);
@@ -361,6 +363,7 @@ void Approximant::build_pattern() {
   // self), then the rows are moved down to their final offsets.
   const int64_t *srp = src->rowptr.data();
   const int32_t *scl = src->cols.data();
+  check_table_size(src->nnz() + nsites_);
   cols_.resize(static_cast<size_t>(src->nnz()) + static_cast<size_t>(nsites_));
   int32_t *cl = cols_.data();
   int32_t *self = self_.data();
@@ -447,12 +450,29 @@ void Approximant::build_pattern() {
   cols_.resize(static_cast<size_t>(rp[nsites_]));
 }
 
+void Approximant::check_table_size(int64_t nnz) const {
+  // the pattern and every table it will hold, before any of them is allocated
+  const int dim = ps_->dim();
+  const double per = sizeof(int32_t) + sizeof(double) * (((flags_ & MFREE_DERIV_VALUE) ? 1 : 0) +
+                                                         ((flags_ & MFREE_DERIV_GRADIENT) ? dim : 0) +
+                                                         ((flags_ & MFREE_DERIV_HESSIAN) ? hessian_size(dim) : 0));
+  const double bytes = per * static_cast<double>(nnz);
+  if (request_too_large(bytes)) {
+    std::ostringstream s;
+    s << "the shape-function tables of " << nnz << " neighbour pairs would take " << bytes / 1e9
+      << " GB, more than the machine's memory (" << physical_memory() / 1e9
+      << " GB): supports too large for the particle spacing?";
+    throw Error(MFREE_ERR_ALLOC, s.str());
+  }
+}
+
 bool Approximant::share_rows(const Csr &src) {
   const auto &pst = ps_->site_status();
   for (int32_t s = 0; s < nsites_; ++s)
     if (pst[s] != 0) return false;  // failed particles get empty rows: filter
   const int64_t nnz = src.nnz();
   if (static_cast<int64_t>(src.rowptr.size()) != static_cast<int64_t>(nsites_) + 1) return false;
+  check_table_size(nnz);
   cols_.resize(static_cast<size_t>(nnz));
   const int64_t *srp = src.rowptr.data();
   const int32_t *scl = src.cols.data();

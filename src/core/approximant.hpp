@@ -96,6 +96,9 @@ class Approximant {
   // The pattern as a copy of the particle set's rows (src); false when they do not
   // qualify (a failed particle, a row without its site), and nothing is decided.
   bool share_rows(const Csr &src);
+  // MFREE_ERR_ALLOC up front when a pattern of nnz entries and its tables would take
+  // more than the machine's memory (alloc.hpp, request_too_large).
+  void check_table_size(int64_t nnz) const;
   Report compute(const char *what);
   // Particle (and point) data as SoA arrays for the pattern and the fast path, re-read
   // from the (possibly borrowed) host arrays at every setup and update.

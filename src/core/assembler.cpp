@@ -204,10 +204,12 @@ void Assembler::set_quadrature_cells(const double *lo, const double *hi, const i
 void Assembler::set_quadrature_points(int32_t npts, const double *x, int layout, int64_t ld, const double *w) {
   check_points(npts, x, w, "quadrature");
   if (npts > 0 && !w) throw Error(MFREE_ERR_NULL, "quadrature weights are NULL");
-  std::vector<double> pts;
+  // both copies made before either is replaced: running out of memory leaves the old pair
+  std::vector<double> pts, wts;
   read_points(npts, x, layout, ld, pts);
-  qx_ = std::move(pts);
-  qw_.assign(w, w + npts);
+  wts.assign(w, w + npts);
+  qx_.swap(pts);
+  qw_.swap(wts);
   quad_kind_ = 1;
   setup_done_ = false;
 }

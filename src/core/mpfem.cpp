@@ -174,6 +174,8 @@ void Mesh::connectivity(std::vector<int32_t> &type, std::vector<int32_t> &ptr,
 
 void MeshGeometry::build(const Mesh &m) {
   const ParticleSet &ps = m.particles();
+  // (a mesh may be set up before its particle set, which checks this at its own setup)
+  if (!ps.pos_data()) throw Error(MFREE_ERR_STATE, "the mesh's particle set has no positions");
   dim = m.dim();
   m.connectivity(type, ptr, nodes);
   const int32_t ne = size();

@@ -1288,6 +1288,10 @@ void run_queries(NeighborScratch &sc, const Rule &rule, int32_t nsites, bool sym
     for (int64_t s = b; s < e; ++s) rp[s + 1] = acc += rp[s + 1];
   });
   const int64_t nnz = rp[nsites];
+  if (request_too_large(static_cast<double>(nnz) * sizeof(int32_t)))
+    throw Error(MFREE_ERR_ALLOC, "the neighbour lists would hold " + std::to_string(nnz) +
+                                     " pairs, more than the machine's memory: supports too large "
+                                     "for the particle spacing?");
   out.rowptr.reserve(static_cast<size_t>(nsites) + 1);
   // (a new block gets room for moves: particles drawing closer add a few pairs)
   if (out.cols.capacity() < static_cast<size_t>(nnz)) out.cols.reserve(static_cast<size_t>(nnz + nnz / 16));
@@ -1451,8 +1455,14 @@ void host_order_rows(const CellGrid &grid, const ParticleSet &ps, const std::vec
       if (static_cast<size_t>(end) > have) {
         size_t want = std::max(static_cast<size_t>(end), have + chunk);
         if (want > out.cols.capacity()) {
+          size_t grow = std::max(want, 2 * out.cols.capacity());
+          if (request_too_large(static_cast<double>(grow) * sizeof(int32_t))) grow = want;
+          if (request_too_large(static_cast<double>(grow) * sizeof(int32_t)))
+            throw Error(MFREE_ERR_ALLOC, "the neighbour lists outgrow the machine's memory after " +
+                                             std::to_string(end) + " pairs: supports too large for "
+                                             "the particle spacing?");
           SmallPages small;
-          out.cols.reserve(std::max(want, 2 * out.cols.capacity()));
+          out.cols.reserve(grow);
         }
         want = std::min(want, out.cols.capacity());
         prefault(out.cols.data() + have, (want - have) * sizeof(int32_t));
