@@ -4,73 +4,152 @@
  * derivative flags, fallback, optional host points, and a field; then particles setup,
  * approximant setup, update and every apply operator in both layouts.
  *
- * Oracles besides the sanitizers: no call may return a status outside the documented
- * set, and when setup succeeded on finite data, apply of a finite field must give finite
- * values at every site whose status is 0 (mfree never reports NaN as valid).
+ * Then a program of changes read from the rest of the bytes: particles update,
+ * approximant update, a borrowed position or support changed, a new ghost count with the
+ * set set up again, new host points, apply from two threads at once next to failing
+ * calls on the same context, CSR export.
+ *
+ * Oracles besides the sanitizers (fuzz_util.h): no call may return a status outside the
+ * documented set; after a negative status the tables are bitwise those of before; every
+ * site reported valid holds finite values in every table and in every apply result of a
+ * finite field; two threads applying at once get the result of one.
  *
  * Built with clang -fsanitize=fuzzer,address,undefined when MFREE_FUZZ=ON (preset
  * "fuzz"); in every other build the same function is linked with replay.c, which runs
  * the seed corpus and the regression inputs as a plain test. */
-#include <math.h>
-#include <stdint.h>
-#include <stdlib.h>
-#include <string.h>
+#include <pthread.h>
 
-#include <mfree.h>
+#include "fuzz_util.h"
+
+#define take fz_u8
+#define take16 fz_u16
+#define coord fz_coord
+#define positive fz_positive
+#define valid_status fz_valid_status
+#define CHECK_STATUS FZ_CHECK
+
+enum { MAXN = 48, MAXP = 8, NOPS = 12 };
+
+/* ---- two threads applying one approximant at once, next to failing calls ----------- */
 
 typedef struct {
-  const uint8_t *p;
-  size_t n;
-} bytes_t;
+  const mfree_approximant_t *a;
+  const double *u;
+  double *out;
+  int nsites, wrong;
+} job_t;
 
-static unsigned take(bytes_t *b) {
-  if (b->n == 0) return 0;
-  b->n--;
-  return *b->p++;
+static void *apply_job(void *arg) {
+  job_t *j = arg;
+  for (int r = 0; r < 4; ++r) {
+    /* a failing call on the shared context (leading dimension 0) */
+    j->wrong |= mfree_approximant_apply(j->a, MFREE_OP_VALUE, 1, j->u, MFREE_LAYOUT_AOS, 0, j->out,
+                                        MFREE_LAYOUT_AOS, 1) != MFREE_ERR_ARG;
+    j->wrong |= mfree_approximant_apply(j->a, MFREE_OP_VALUE, 1, j->u, MFREE_LAYOUT_AOS, 3, j->out,
+                                        MFREE_LAYOUT_AOS, 1) != MFREE_SUCCESS;
+  }
+  return NULL;
 }
 
-static unsigned take16(bytes_t *b) { return take(b) | (take(b) << 8); }
+static void threads(const mfree_approximant_t *a, const double *uu, int nsites) {
+  if (nsites <= 0) return;
+  double *ref = calloc((size_t)nsites, sizeof *ref);
+  job_t job[2];
+  pthread_t th[2];
+  int started[2] = {0, 0};
+  if (mfree_approximant_apply(a, MFREE_OP_VALUE, 1, uu, MFREE_LAYOUT_AOS, 3, ref, MFREE_LAYOUT_AOS, 1) != MFREE_SUCCESS) {
+    free(ref);
+    return; /* no value table */
+  }
+  for (int t = 0; t < 2; ++t) {
+    job[t].a = a, job[t].u = uu, job[t].nsites = nsites, job[t].wrong = 0;
+    job[t].out = calloc((size_t)nsites, sizeof(double));
+    started[t] = pthread_create(&th[t], NULL, apply_job, &job[t]) == 0;
+  }
+  for (int t = 0; t < 2; ++t) {
+    if (started[t]) pthread_join(th[t], NULL);
+    FZ_TRAP_IF(job[t].wrong);
+    /* bitwise the result of one thread (NaN compares by bits too) */
+    FZ_TRAP_IF(started[t] && memcmp(job[t].out, ref, sizeof(double) * (size_t)nsites) != 0);
+    free(job[t].out);
+  }
+  free(ref);
+}
 
-/* A coordinate in [0, 1) with rare special values. */
-static double coord(bytes_t *b, double prev) {
-  const unsigned v = take16(b);
-  switch (v) {
-    case 0xFFFF: return NAN;
-    case 0xFFFE: return INFINITY;
-    case 0xFFFD: return prev; /* coincident with the previous particle */
-    case 0xFFFC: return 1e300;
-    default: return v / 65536.0;
+/* ---- a program of changes after the first setup ------------------------------------ */
+
+static void program(fz_bytes_t *b, mfree_context_t *ctx, mfree_particles_t *ps, mfree_approximant_t *a,
+                    int dim, int n, int points, double *x, double *h, const double *uu) {
+  (void)ctx;
+  for (int k = 0; k < NOPS && b->n > 0; ++k) {
+    const int op = (int)(take(b) % 8);
+    fz_tables_t before, after;
+    int32_t owned_before = 0, ng = 0, nn = 0;
+    mfree_particles_get_size(ps, &nn, &ng);
+    owned_before = nn - ng;
+    const int had = fz_tables_get(a, dim, &before);
+    mfree_status_t st = MFREE_SUCCESS;
+    switch (op) {
+      case 0: st = mfree_particles_update(ps); break;
+      case 1: st = mfree_approximant_update(a); break;
+      case 2: /* a borrowed value changes: moved, NaN, Inf, tiny or zero support */
+        if (n > 0) {
+          const int i = (int)(take(b) % (unsigned)n);
+          const unsigned w = take(b);
+          if (w & 1) x[dim * i + (int)((w >> 1) % (unsigned)dim)] = coord(b, x[0]);
+          else h[i] = positive(b, 0.1);
+        }
+        break;
+      case 3: { /* a new ghost count and a new setup of the set: update must notice */
+        const int32_t g = (int32_t)(take(b) % (unsigned)(n + 1));
+        st = mfree_particles_set_num_ghost(ps, g);
+        if (st == MFREE_SUCCESS) st = mfree_particles_setup(ps);
+        FZ_TRAP_IF(!valid_status(st));
+        if (st >= 0 && g != ng) {
+          st = mfree_approximant_update(a);
+          /* never a stale result: an update that succeeds has the sites of the set as it is */
+          int32_t ns = -1;
+          if (st >= 0 && !points) FZ_TRAP_IF(mfree_approximant_get_num_sites(a, &ns) != MFREE_SUCCESS || ns != n - g);
+        }
+        break;
+      }
+      case 4: st = mfree_approximant_setup(a); break;
+      case 5: threads(a, uu, had ? before.nsites : 0); break;
+      case 6: { /* apply_add twice equals apply doubled, on valid sites */
+        if (!had || before.nsites == 0) break;
+        double *o1 = calloc((size_t)before.nsites, sizeof *o1), *o2 = calloc((size_t)before.nsites, sizeof *o2);
+        const mfree_status_t s1 = mfree_approximant_apply(a, MFREE_OP_VALUE, 1, uu, MFREE_LAYOUT_AOS, 3, o1, MFREE_LAYOUT_AOS, 1);
+        const mfree_status_t s2 = mfree_approximant_apply_add(a, MFREE_OP_VALUE, 1, uu, MFREE_LAYOUT_AOS, 3, o2, MFREE_LAYOUT_AOS, 1);
+        FZ_TRAP_IF(!valid_status(s1) || s1 != s2);
+        if (s1 == MFREE_SUCCESS)
+          for (int s = 0; s < before.nsites; ++s) FZ_TRAP_IF(memcmp(&o1[s], &o2[s], sizeof(double)) != 0 && !isnan(o1[s]));
+        free(o1), free(o2);
+        break;
+      }
+      default: { /* a leading dimension that wraps: refused, nothing changed */
+        double o = 0.0;
+        st = mfree_approximant_apply(a, MFREE_OP_VALUE, 1, uu, MFREE_LAYOUT_AOS, INT64_MAX / (1 + take(b)), &o,
+                                     MFREE_LAYOUT_AOS, 1);
+        FZ_TRAP_IF(n > 1 && st == MFREE_SUCCESS);
+      }
+    }
+    FZ_TRAP_IF(!valid_status(st));
+    const int has = fz_tables_get(a, dim, &after);
+    if (has) fz_check_sites(&after);
+    if (st < 0 && had) {
+      FZ_TRAP_IF(!has);
+      fz_tables_same(&before, &after);
+    }
+    (void)owned_before;
+    fz_tables_free(&before);
+    fz_tables_free(&after);
   }
 }
-
-/* A positive quantity around `scale`, sometimes invalid. */
-static double positive(bytes_t *b, double scale) {
-  const unsigned v = take(b);
-  switch (v) {
-    case 0: return 0.0;
-    case 255: return NAN;
-    case 254: return -scale;
-    case 253: return 1e-300;
-    default: return scale * (0.05 + v / 64.0);
-  }
-}
-
-/* The documented statuses: success, misuse -1..-7, data-dependent failures 1..7.
- * MFREE_ERR_INTERNAL (-99) is a bug in mfree. */
-static int valid_status(mfree_status_t st) { return st >= -7 && st <= 7; }
-
-#define CHECK_STATUS(call)                                    \
-  do {                                                        \
-    mfree_status_t st_ = (call);                              \
-    if (!valid_status(st_)) __builtin_trap();                 \
-  } while (0)
-
-enum { MAXN = 48, MAXP = 8 };
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-  bytes_t b = {data, size};
+  fz_bytes_t b = {data, size};
   const int dim = 1 + (int)(take(&b) % 3);
   const int n = (int)(take(&b) % (MAXN + 1));
   const int method = 1 + (int)(take(&b) % 14);       /* 14: unknown */
@@ -156,6 +235,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         for (int d = 0; d < 3; ++d) uu[3 * i + d] = u[i] * (d + 1);
       int32_t nfailed = 0;
       if (mfree_approximant_get_site_status(a, sst, &nfailed) != MFREE_SUCCESS) __builtin_trap();
+      {
+        fz_tables_t t;
+        if (fz_tables_get(a, dim, &t)) fz_check_sites(&t);
+        fz_tables_free(&t);
+      }
       const int nh = dim == 1 ? 1 : dim == 2 ? 3 : 6;
       const struct { mfree_op_t op; int ncomp, ocomp; } ops[5] = {
           {MFREE_OP_VALUE, 2, 2}, {MFREE_OP_GRADIENT, 1, dim}, {MFREE_OP_DIVERGENCE, dim, 1},
@@ -178,6 +262,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       }
       free(sst);
       free(out);
+      program(&b, ctx, ps, a, dim, n, npts >= 0, x, h, uu);
     }
     mfree_approximant_destroy(&a);
   }

@@ -6,9 +6,12 @@
 # 30-minute CI budget. Exits non-zero on any failure.
 #   MFREE_CI_TSAN=1 always runs the tsan stage, 0 never; unset: only when the default and
 #   asan stages took less than MFREE_CI_TSAN_BEFORE seconds (default 1200).
-# Not run here (see ABI.md / README): the libFuzzer campaign (preset fuzz; its corpus and
-# regression inputs are replayed by the test fuzz-replay in both presets) and valgrind
-# (scripts/valgrind.sh).
+# Then the replay of every fuzz corpus and regression input under clang with ASan+UBSan
+# (configure preset fuzz, build and test presets fuzz-replay: the library, the adapters
+# and the replay programs only), which flags what the GCC replay in the default and asan
+# presets does not (e.g. pointer arithmetic on NULL); MFREE_CI_FUZZ_REPLAY=0 skips it.
+# Not run here (see ABI.md / README): the libFuzzer campaign (scripts/fuzz.sh) and
+# valgrind (scripts/valgrind.sh).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -36,5 +39,13 @@ if [[ "$tsan" == 1 ]]; then
   stage tsan
 else
   echo "==== preset tsan skipped ($((SECONDS - start)) s used; MFREE_CI_TSAN=1 forces it)"
+fi
+if [[ "${MFREE_CI_FUZZ_REPLAY:-1}" == 1 ]]; then
+  t0=$SECONDS
+  echo "==== preset fuzz: configure, build the replay programs, replay every corpus"
+  cmake --preset fuzz
+  cmake --build --preset fuzz-replay -j"$jobs"
+  ctest --preset fuzz-replay -j"$jobs"
+  echo "==== preset fuzz (replay) passed in $((SECONDS - t0)) s"
 fi
 echo "==== all tests passed in $((SECONDS - start)) s"

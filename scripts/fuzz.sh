@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# A fuzzing campaign: every libFuzzer harness of fuzz/ in turn for MINUTES minutes each
+# (default 5), under nice -n 19 (a shared machine: one harness at a time, one process).
+#   scripts/fuzz.sh [minutes] [harness...]
+# Builds the fuzz preset (clang, libFuzzer, ASan+UBSan) first. New inputs go to
+# build/fuzz/fuzz/corpus/<harness> (the repository's corpus is read only: copy inputs
+# worth keeping to fuzz/corpus/<harness>); a crash leaves build/fuzz/fuzz/<harness>-crash-*
+# (copy it to fuzz/regressions/<harness>/, fix the bug, commit both). Prints, per
+# harness, the executions, the edges libFuzzer counted and the crashes, and keeps the
+# logs in build/fuzz/campaign/. With COVERAGE=1 it then replays every corpus in a
+# coverage build (build/fuzz-cov: clang source-based coverage, no sanitizers) and prints
+# the region and branch coverage of each harness's target files (llvm-cov).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+minutes=${1:-5}
+shift || true
+harnesses=("$@")
+if ((${#harnesses[@]} == 0)); then
+  harnesses=(particles approximant mpfem assembly system adapters)
+fi
+
+cmake --preset fuzz >/dev/null
+nice -n 19 cmake --build --preset fuzz -j"${MFREE_FUZZ_JOBS:-1}"
+
+out=build/fuzz/campaign
+mkdir -p "$out"
+summary="$out/summary.txt"
+: >"$summary"
+for h in "${harnesses[@]}"; do
+  bin=build/fuzz/fuzz/mfree_fuzz_$h
+  [[ -x "$bin" ]] || { echo "no harness $h (adapters need SuiteSparse and SUNDIALS)"; continue; }
+  work=build/fuzz/fuzz/corpus/$h
+  mkdir -p "$work"
+  log="$out/$h.log"
+  echo "==== $h: $minutes min"
+  set +e
+  ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    nice -n 19 "$bin" -max_total_time=$((minutes * 60)) -timeout=20 -rss_limit_mb=3072 \
+    -print_final_stats=1 -jobs=1 -workers=1 -artifact_prefix="build/fuzz/fuzz/$h-" \
+    "$work" "fuzz/corpus/$h" "fuzz/regressions/$h" >"$log" 2>&1
+  rc=$?
+  set -e
+  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
+  edges=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
+  crashes=$(ls build/fuzz/fuzz/"$h"-crash-* build/fuzz/fuzz/"$h"-leak-* build/fuzz/fuzz/"$h"-timeout-* 2>/dev/null | wc -l)
+  printf '%-12s exit %-3s executions %-10s edges %-6s crash/leak/timeout files %s\n' \
+    "$h" "$rc" "${execs:-?}" "${edges:-?}" "$crashes" | tee -a "$summary"
+done
+
+if [[ "${COVERAGE:-0}" == 1 ]]; then
+  # Source-based coverage of the corpora, per harness and its target files.
+  cov=build/fuzz-cov
+  CC=clang CXX=clang++ cmake -S . -B "$cov" -DCMAKE_BUILD_TYPE=Debug \
+    -DCMAKE_C_FLAGS="-fprofile-instr-generate -fcoverage-mapping" \
+    -DCMAKE_CXX_FLAGS="-fprofile-instr-generate -fcoverage-mapping" \
+    -DCMAKE_EXE_LINKER_FLAGS="-fprofile-instr-generate" -DCMAKE_SHARED_LINKER_FLAGS="-fprofile-instr-generate" \
+    -DCMAKE_DISABLE_FIND_PACKAGE_OpenMP=ON -DMFREE_WITH_FORTRAN=OFF -DMFREE_BUILD_EXAMPLES=OFF \
+    -DMFREE_BUILD_BENCH=OFF -DMFREE_TEST_PACKAGING=OFF >/dev/null
+  llvm_bin=$(dirname "$(readlink -f "$(command -v clang)")")
+  for h in "${harnesses[@]}"; do
+    nice -n 19 cmake --build "$cov" -j"${MFREE_FUZZ_JOBS:-1}" --target "mfree_fuzz_replay_$h" >/dev/null || continue
+    case $h in
+      particles) files="src/core/particles.cpp src/core/neighbors.cpp src/capi/particles.cpp" ;;
+      approximant) files="src/core/approximant.cpp src/core/apply.cpp src/core/local.cpp src/core/shape_fast.cpp src/capi/approximant.cpp" ;;
+      mpfem) files="src/core/mpfem.cpp src/capi/mesh.cpp" ;;
+      assembly) files="src/core/assembler.cpp src/core/matrix.cpp src/capi/assembler.cpp src/capi/matrix.cpp" ;;
+      system) files="src/core/fluid.cpp src/core/fluid_wall.cpp src/core/elastodynamics.cpp src/capi/system.cpp" ;;
+      adapters) files="adapters/suitesparse/src/suitesparse.cpp adapters/sundials/src/sundials.cpp" ;;
+    esac
+    rm -f "$cov"/"$h".prof*
+    find build/fuzz/fuzz/corpus/"$h" fuzz/corpus/"$h" fuzz/regressions/"$h" -type f 2>/dev/null |
+      xargs -r -n 500 env LLVM_PROFILE_FILE="$cov/$h.prof-%p.profraw" nice -n 19 "$cov/fuzz/mfree_fuzz_replay_$h" >/dev/null 2>&1 || true
+    "$llvm_bin/llvm-profdata" merge -o "$cov/$h.profdata" "$cov"/"$h".prof-*.profraw
+    objs=("$cov/fuzz/mfree_fuzz_replay_$h" -object "$cov/src/libmfree.so")
+    [[ $h == adapters ]] && objs+=(-object "$cov/adapters/suitesparse/libmfree_suitesparse.so" -object "$cov/adapters/sundials/libmfree_sundials.so")
+    echo "---- $h: coverage of its target files" | tee -a "$summary"
+    # shellcheck disable=SC2086
+    "$llvm_bin/llvm-cov" report "${objs[@]}" -instr-profile="$cov/$h.profdata" $files | tee -a "$summary"
+  done
+fi
+echo "summary: $summary"
