@@ -8,6 +8,8 @@
  *    non-empty message;
  *  - every object of the fixture is still usable and unchanged: the same sizes, and
  *    bitwise the same apply / matrix-vector / right-hand-side results as before;
+ *  - every site an approximant of the fixture reports valid holds finite values (the
+ *    rule of mfree.h: negative status, nothing changed; positive, valid sites finite);
  *  - nothing was written to stdout or stderr (both are redirected to a file while the
  *    rows run, and the file must stay empty).
  * A last check reads mfree.h and fails when a public function has no row here, so that
@@ -184,6 +186,29 @@ static mfree_status_t make_fixture(void) {
   return MFREE_SUCCESS;
 }
 
+/* The positive half of the rule (mfree.h, docs/robustness.md): every site an approximant
+ * reports valid holds finite values in every table it built. NULL when it holds. */
+static const char *valid_sites_finite(const mfree_approximant_t *a, int dim) {
+  int32_t ns = 0, st[4 * N];
+  int64_t nnz = 0, rp[4 * N + 1];
+  static int32_t cl[16 * N * N];
+  static double v[16 * N * N];
+  if (mfree_approximant_get_num_sites(a, &ns) || ns > 4 * N) return NULL; /* not set up */
+  if (mfree_approximant_get_nnz(a, &nnz) || nnz > 16 * N * N) return "approximant nnz";
+  if (mfree_approximant_get_site_status(a, st, NULL)) return "approximant site status";
+  const int nh = dim == 2 ? 3 : 6;
+  for (int d = 0; d < 3; ++d)
+    for (int c = 0; c < (d == 0 ? 1 : d == 1 ? dim : nh); ++c) {
+      const mfree_deriv_t deriv = d == 0 ? MFREE_DERIV_VALUE : d == 1 ? MFREE_DERIV_GRADIENT : MFREE_DERIV_HESSIAN;
+      if (mfree_approximant_assemble_csr(a, deriv, c, rp, cl, v) != MFREE_SUCCESS) break; /* not built */
+      for (int32_t s = 0; s < ns; ++s)
+        if (st[s] == 0)
+          for (int64_t k = rp[s]; k < rp[s + 1]; ++k)
+            if (!isfinite(v[k])) return "a site reported valid holds a non-finite value";
+    }
+  return NULL;
+}
+
 /* Results of every object; reference on the first call (ref != 0), else compared
  * bitwise. Returns a description of the first difference, or NULL. */
 static const char *health(int ref) {
@@ -254,6 +279,9 @@ static void row(const char *call, mfree_status_t got, mfree_status_t want, mfree
       logf_("  %s\n    no message recorded on the context%s\n", call, "", 0, 0);
   }
   const char *bad = health(0);
+  if (!bad) bad = valid_sites_finite(F.a, 2);
+  if (!bad) bad = valid_sites_finite(F.am, 2);
+  if (!bad) bad = valid_sites_finite(F.a3, 3);
   if (bad) logf_("  %s\n    afterwards: %s\n", call, bad, 0, 0);
 }
 
