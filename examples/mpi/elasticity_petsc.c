@@ -151,6 +151,11 @@ int main(int argc, char **argv) {
   CHECK(mfree_particles_set_volumes(ps, vol, 1, MFREE_BORROW));
   CHECK(mfree_particles_set_support(ps, &h, 0, MFREE_COPY));
   CHECK(mfree_particles_set_num_ghost(ps, n - nowned - ninner));
+  /* global ids: every row and sum in one order, so that the owned rows are those of a
+   * one-rank run bit for bit. Every particle within R of a non-ghost of the set (owned
+   * nodes and the inner layer) is present: the halo width the set can check is R. */
+  CHECK(mfree_particles_set_global_ids(ps, gid, MFREE_BORROW));
+  CHECK(mfree_particles_set_halo_width(ps, R));
   CHECK(mfree_particles_setup(ps));
   CHECK(mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &ap));
   CHECK(mfree_approximant_set_order(ap, 1));
