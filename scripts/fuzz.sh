@@ -6,8 +6,9 @@
 # build/fuzz/fuzz/corpus/<harness> (the repository's corpus is read only: copy inputs
 # worth keeping to fuzz/corpus/<harness>); a crash leaves build/fuzz/fuzz/<harness>-crash-*
 # (copy it to fuzz/regressions/<harness>/, fix the bug, commit both). Prints, per
-# harness, the executions, the edges libFuzzer counted and the crashes, and keeps the
-# logs in build/fuzz/campaign/. With COVERAGE=1 it then replays every corpus in a
+# harness, the executions, the edges libFuzzer counted (whole binary), the edges covered
+# in the harness's target files (libFuzzer's -print_coverage) and the crashes, and keeps
+# the logs in build/fuzz/campaign/. With COVERAGE=1 it then replays every corpus in a
 # coverage build (build/fuzz-cov: clang source-based coverage, no sanitizers) and prints
 # the region and branch coverage of each harness's target files (llvm-cov).
 set -euo pipefail
@@ -19,6 +20,32 @@ harnesses=("$@")
 if ((${#harnesses[@]} == 0)); then
   harnesses=(particles approximant mpfem assembly system adapters)
 fi
+
+# The files each harness targets (its API family), for the coverage figures.
+target_files() {
+  case $1 in
+    particles) echo "src/core/particles.cpp src/core/neighbors.cpp src/capi/particles.cpp" ;;
+    approximant) echo "src/core/approximant.cpp src/core/apply.cpp src/core/local.cpp src/core/shape_fast.cpp src/capi/approximant.cpp" ;;
+    mpfem) echo "src/core/mpfem.cpp src/capi/mesh.cpp" ;;
+    assembly) echo "src/core/assembler.cpp src/core/matrix.cpp src/capi/assembler.cpp src/capi/matrix.cpp" ;;
+    system) echo "src/core/fluid.cpp src/core/fluid_wall.cpp src/core/elastodynamics.cpp src/capi/system.cpp" ;;
+    adapters) echo "adapters/suitesparse/src/suitesparse.cpp adapters/sundials/src/sundials.cpp" ;;
+  esac
+}
+
+# Edges covered / instrumented in the target files, from libFuzzer's -print_coverage=1
+# lines "(UN)COVERED_FUNC: hits: H edges: C/T function file:line".
+edge_coverage() {  # edge_coverage <log> <files...>
+  local log=$1
+  shift
+  awk -v files="$*" '
+    BEGIN { n = split(files, f, " ") }
+    /COVERED_FUNC: hits:/ {
+      split($5, e, "/"); loc = $NF; sub(/:[0-9]+$/, "", loc)
+      for (i = 1; i <= n; ++i) if (index(loc, f[i]) && substr(loc, length(loc) - length(f[i]) + 1) == f[i]) { c += e[1]; t += e[2]; break }
+    }
+    END { if (t > 0) printf "%d/%d (%.1f %%)", c, t, 100 * c / t; else printf "?" }' "$log"
+}
 
 cmake --preset fuzz >/dev/null
 nice -n 19 cmake --build --preset fuzz -j"${MFREE_FUZZ_JOBS:-1}"
@@ -37,15 +64,17 @@ for h in "${harnesses[@]}"; do
   set +e
   ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 UBSAN_OPTIONS=print_stacktrace=1 \
     nice -n 19 "$bin" -max_total_time=$((minutes * 60)) -timeout=20 -rss_limit_mb=3072 \
-    -print_final_stats=1 -jobs=1 -workers=1 -artifact_prefix="build/fuzz/fuzz/$h-" \
+    -print_final_stats=1 -print_coverage=1 -artifact_prefix="build/fuzz/fuzz/$h-" \
     "$work" "fuzz/corpus/$h" "fuzz/regressions/$h" >"$log" 2>&1
   rc=$?
   set -e
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
   edges=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
   crashes=$(ls build/fuzz/fuzz/"$h"-crash-* build/fuzz/fuzz/"$h"-leak-* build/fuzz/fuzz/"$h"-timeout-* 2>/dev/null | wc -l)
-  printf '%-12s exit %-3s executions %-10s edges %-6s crash/leak/timeout files %s\n' \
-    "$h" "$rc" "${execs:-?}" "${edges:-?}" "$crashes" | tee -a "$summary"
+  # shellcheck disable=SC2046
+  tcov=$(edge_coverage "$log" $(target_files "$h"))
+  printf '%-12s exit %-3s executions %-10s edges (whole binary) %-6s edges in its target files %-22s crash/leak/timeout files %s\n' \
+    "$h" "$rc" "${execs:-?}" "${edges:-?}" "$tcov" "$crashes" | tee -a "$summary"
 done
 
 if [[ "${COVERAGE:-0}" == 1 ]]; then
@@ -60,14 +89,7 @@ if [[ "${COVERAGE:-0}" == 1 ]]; then
   llvm_bin=$(dirname "$(readlink -f "$(command -v clang)")")
   for h in "${harnesses[@]}"; do
     nice -n 19 cmake --build "$cov" -j"${MFREE_FUZZ_JOBS:-1}" --target "mfree_fuzz_replay_$h" >/dev/null || continue
-    case $h in
-      particles) files="src/core/particles.cpp src/core/neighbors.cpp src/capi/particles.cpp" ;;
-      approximant) files="src/core/approximant.cpp src/core/apply.cpp src/core/local.cpp src/core/shape_fast.cpp src/capi/approximant.cpp" ;;
-      mpfem) files="src/core/mpfem.cpp src/capi/mesh.cpp" ;;
-      assembly) files="src/core/assembler.cpp src/core/matrix.cpp src/capi/assembler.cpp src/capi/matrix.cpp" ;;
-      system) files="src/core/fluid.cpp src/core/fluid_wall.cpp src/core/elastodynamics.cpp src/capi/system.cpp" ;;
-      adapters) files="adapters/suitesparse/src/suitesparse.cpp adapters/sundials/src/sundials.cpp" ;;
-    esac
+    files=$(target_files "$h")
     rm -f "$cov"/"$h".prof*
     find build/fuzz/fuzz/corpus/"$h" fuzz/corpus/"$h" fuzz/regressions/"$h" -type f 2>/dev/null |
       xargs -r -n 500 env LLVM_PROFILE_FILE="$cov/$h.prof-%p.profraw" nice -n 19 "$cov/fuzz/mfree_fuzz_replay_$h" >/dev/null 2>&1 || true
