@@ -9,6 +9,7 @@
  *    within one support radius of them (the halo contract of docs/mpi.md);
  *  - the same with host-supplied neighbour lists (shuffled rows that omit the particle
  *    itself) and with the symmetric-mean search convention;
+ *  - rows of host points (MLS 2) over a permuted set: the same ids, order and bits;
  *  - bad input: negative or repeated ids (copied, and borrowed ids changed before setup:
  *    nothing changes), get without ids, a negative or NaN halo width, and a declared halo
  *    width narrower than the search radius or the kernel support: MFREE_ERR_HALO. */
@@ -75,7 +76,8 @@ static void shuffle(int *a, int n, mfree_rng_t *r) {
 }
 
 /* A sub-domain of ref: the particles with x_0 < cut owned, those with x_0 in
- * [cut, cut + halo) ghosts, each group in random order (cut = INFINITY: a permutation). */
+ * [cut, cut + halo) ghosts, each group in random order (cut = INFINITY: a permutation),
+ * or in id order for seed 0. */
 static void make_subdomain(cloud_t *out, const cloud_t *ref, double cut, double halo, uint64_t seed) {
   mfree_rng_t r;
   mfree_rng_seed(&r, seed);
@@ -86,8 +88,10 @@ static void make_subdomain(cloud_t *out, const cloud_t *ref, double cut, double 
     if (x0 < cut) own[no++] = i;
     else if (x0 < cut + halo) gh[ng++] = i;
   }
-  shuffle(own, no, &r);
-  shuffle(gh, ng, &r);
+  if (seed) { /* seed 0: owned and ghosts in id order, ghosts last (few rows out of id order) */
+    shuffle(own, no, &r);
+    shuffle(gh, ng, &r);
+  }
   out->dim = dim;
   out->n = no + ng;
   out->n_ghost = ng;
@@ -281,13 +285,15 @@ static double max_support(const cloud_t *c) {
 }
 
 /* variant: 0 permutation, 1 sub-domain with ghosts, 2 sub-domain with host lists,
- * 3 sub-domain, symmetric-mean convention */
+ * 3 sub-domain, symmetric-mean convention, 4 sub-domain in id order (the rows are put in
+ * id order by insertion; in the others, where the numbering is unrelated to the ids,
+ * they are rebuilt) */
 static void run(int dim, int variant) {
   static cloud_t ref, sub;
   make_cloud(&ref, dim, dim == 2 ? 17 : 7, 11 + dim);
   const int conv = variant == 3 ? MFREE_SEARCH_SYMMETRIC_MEAN : MFREE_SEARCH_GATHER;
   const double halo = KAPPA * max_support(&ref) * 1.0000001;
-  make_subdomain(&sub, &ref, variant == 0 ? INFINITY : 0.45, halo, 100 + variant);
+  make_subdomain(&sub, &ref, variant == 0 ? INFINITY : 0.45, halo, variant == 4 ? 0 : 100 + variant);
   assert_true(variant == 0 || sub.n_ghost > 0);
   mfree_particles_t *pa = make_set(ctx, &ref, conv, 1), *pb = make_set(ctx2, &sub, conv, 1);
   int64_t *hrp = NULL;
@@ -319,6 +325,54 @@ static void run(int dim, int variant) {
   mfree_particles_destroy(&pb);
 }
 
+/* Host points (MLS 2 values and gradients at 40 points): the rows of the points over a
+ * permuted set hold the same ids in the same order and the same bits. */
+static void test_points(void **s) {
+  (void)s;
+  static cloud_t ref, sub;
+  for (int dim = 2; dim <= 3; ++dim) {
+    make_cloud(&ref, dim, dim == 2 ? 17 : 7, 21 + dim);
+    make_subdomain(&sub, &ref, INFINITY, 0, 9);
+    double px[40 * 3], ph = 1.3 / (dim == 2 ? 16 : 6);
+    mfree_rng_t r;
+    mfree_rng_seed(&r, 77);
+    for (int k = 0; k < 40 * dim; ++k) px[k] = 0.1 + 0.8 * mfree_rng_uniform(&r);
+    tables_t T[2];
+    for (int side = 0; side < 2; ++side) {
+      const cloud_t *c = side ? &sub : &ref;
+      mfree_context_t *cx = side ? ctx2 : ctx;
+      mfree_particles_t *ps = make_set(cx, c, MFREE_SEARCH_GATHER, 1);
+      mfree_approximant_t *a = NULL;
+      assert_ok(cx, mfree_approximant_create(cx, ps, MFREE_METHOD_MLS, &a));
+      assert_ok(cx, mfree_approximant_set_order(a, 2));
+      assert_ok(cx, mfree_approximant_set_points(a, 40, px, MFREE_LAYOUT_AOS, dim, &ph, 0, MFREE_COPY));
+      assert_ok(cx, mfree_approximant_setup(a));
+      int64_t nnz = 0;
+      assert_ok(cx, mfree_approximant_get_nnz(a, &nnz));
+      T[side].cols = malloc(sizeof(int32_t) * (size_t)(nnz + 1));
+      for (int k = 0; k <= dim; ++k) {
+        T[side].tab[k] = malloc(sizeof(double) * (size_t)(nnz + 1));
+        assert_ok(cx, mfree_approximant_assemble_csr(a, k ? MFREE_DERIV_GRADIENT : MFREE_DERIV_VALUE, k ? k - 1 : 0,
+                                                     T[side].rp, T[side].cols, T[side].tab[k]));
+      }
+      mfree_approximant_destroy(&a);
+      mfree_particles_destroy(&ps);
+    }
+    for (int p = 0; p < 40; ++p) {
+      assert_int_equal(T[0].rp[p + 1] - T[0].rp[p], T[1].rp[p + 1] - T[1].rp[p]);
+      for (int64_t q = 0; q < T[0].rp[p + 1] - T[0].rp[p]; ++q) {
+        const int64_t a0 = T[0].rp[p] + q, b0 = T[1].rp[p] + q;
+        assert_int_equal(ref.id[T[0].cols[a0]], sub.id[T[1].cols[b0]]);
+        for (int k = 0; k <= dim; ++k) assert_memory_equal(&T[0].tab[k][a0], &T[1].tab[k][b0], sizeof(double));
+      }
+    }
+    for (int side = 0; side < 2; ++side) {
+      free(T[side].cols);
+      for (int k = 0; k <= dim; ++k) free(T[side].tab[k]);
+    }
+  }
+}
+
 static void test_permutation_2d(void **s) { (void)s; run(2, 0); }
 static void test_permutation_3d(void **s) { (void)s; run(3, 0); }
 static void test_subdomain_2d(void **s) { (void)s; run(2, 1); }
@@ -327,6 +381,8 @@ static void test_host_lists_2d(void **s) { (void)s; run(2, 2); }
 static void test_host_lists_3d(void **s) { (void)s; run(3, 2); }
 static void test_symmetric_mean_2d(void **s) { (void)s; run(2, 3); }
 static void test_symmetric_mean_3d(void **s) { (void)s; run(3, 3); }
+static void test_id_order_2d(void **s) { (void)s; run(2, 4); }
+static void test_id_order_3d(void **s) { (void)s; run(3, 4); }
 
 /* Without ids the rows stay sorted by local index; the ids order them by id. */
 static void test_row_order(void **s) {
@@ -446,6 +502,8 @@ int main(void) {
       cmocka_unit_test(test_subdomain_2d),      cmocka_unit_test(test_subdomain_3d),
       cmocka_unit_test(test_host_lists_2d),     cmocka_unit_test(test_host_lists_3d),
       cmocka_unit_test(test_symmetric_mean_2d), cmocka_unit_test(test_symmetric_mean_3d),
+      cmocka_unit_test(test_id_order_2d),       cmocka_unit_test(test_id_order_3d),
+      cmocka_unit_test(test_points),
       cmocka_unit_test(test_row_order),         cmocka_unit_test(test_bad_ids),
       cmocka_unit_test(test_halo_width),
   };

@@ -231,24 +231,22 @@ void ParticleSet::set_neighbors(const int64_t *rowptr, const int32_t *cols, int3
 }
 
 void ParticleSet::check_global_ids(const int64_t *ids) {
-  // sorted copy (reserved once: a repeated setup with borrowed ids allocates nothing)
-  gid_check_.resize(static_cast<size_t>(n_));
-  for (int32_t i = 0; i < n_; ++i) {
+  for (int32_t i = 0; i < n_; ++i)
     if (ids[i] < 0)
       throw Error(MFREE_ERR_INPUT, "global id of particle " + std::to_string(i) + " is " +
                                        std::to_string(ids[i]) + " (must be >= 0)");
-    gid_check_[i] = ids[i];
-  }
-  std::sort(gid_check_.begin(), gid_check_.end());
-  const auto dup = std::adjacent_find(gid_check_.begin(), gid_check_.end());
-  if (dup == gid_check_.end()) return;
-  const int64_t v = *dup;
-  int32_t a = -1, b = -1;
-  for (int32_t i = 0; i < n_ && b < 0; ++i)
-    if (ids[i] == v) (a < 0 ? a : b) = i;
-  throw Error(MFREE_ERR_INPUT, "global id " + std::to_string(v) + " is given to particles " +
-                                   std::to_string(a) + " and " + std::to_string(b) +
-                                   " (ids must be unique in the set)");
+  // the particles in id order (ties by index); a repeat is two neighbours with one id
+  std::vector<int32_t> &perm = gid_perm_next_;
+  perm.resize(static_cast<size_t>(n_));
+  for (int32_t i = 0; i < n_; ++i) perm[i] = i;
+  std::sort(perm.begin(), perm.end(),
+            [ids](int32_t a, int32_t b) { return ids[a] < ids[b] || (ids[a] == ids[b] && a < b); });
+  for (int32_t q = 1; q < n_; ++q)
+    if (ids[perm[q]] == ids[perm[q - 1]])
+      throw Error(MFREE_ERR_INPUT, "global id " + std::to_string(ids[perm[q]]) + " is given to particles " +
+                                       std::to_string(perm[q - 1]) + " and " + std::to_string(perm[q]) +
+                                       " (ids must be unique in the set)");
+  gid_perm_.swap(gid_perm_next_);
 }
 
 void ParticleSet::set_global_ids(const int64_t *ids, int mem) {
@@ -259,10 +257,14 @@ void ParticleSet::set_global_ids(const int64_t *ids, int mem) {
     setup_done_ = false;
     return;
   }
+  // (the copy first: after the check, which replaces the id order, nothing may fail)
+  std::vector<int64_t> own;
+  if (mem == MFREE_COPY) {
+    own.assign(ids, ids + n_);
+    if (own.empty()) own.push_back(0);  // keep data() non-NULL: the set has ids
+  }
   check_global_ids(ids);
   if (mem == MFREE_COPY) {
-    std::vector<int64_t> own(ids, ids + n_);
-    if (own.empty()) own.push_back(0);  // keep data() non-NULL: the set has ids
     gid_own_.swap(own);
     gid_ = gid_own_.data();
   } else {
@@ -279,24 +281,58 @@ void ParticleSet::set_halo_width(double w) {
   setup_done_ = false;
 }
 
-void ParticleSet::order_rows_by_id(Csr &rows) const {
+void ParticleSet::order_rows_by_id(Csr &rows, RowOrderScratch &sc) const {
   if (!gid_) return;
   const int64_t *g = gid_;
-  const int64_t nrows = static_cast<int64_t>(rows.rowptr.size()) - 1;
+  const int64_t nrows = static_cast<int64_t>(rows.rowptr.size()) - 1, nnz = rows.nnz();
   const int64_t *rp = rows.rowptr.data();
   int32_t *cl = rows.cols.data();
-  // rows are short and nearly in order already (local numbering often follows the
-  // ids): insertion sort, no allocation, the same result on any thread count
-  parallel_blocks(nrows, num_threads(rows.nnz()), [&](int, int64_t b, int64_t e) {
+  // Rows come sorted by index. Where the local numbering follows the ids (a host's own
+  // particles in id order, ghosts appended) few entries are out of id order: insertion
+  // sort, in place. Otherwise (numbering unrelated to the ids) the rows are rebuilt in
+  // O(nnz): each particle's rows listed, then the particles visited in id order, each
+  // appended to its rows.
+  const int nt = block_count(num_threads(nnz));
+  int64_t per_block[kMaxBlocks] = {0};
+  parallel_blocks(nrows, nt, [&](int t, int64_t b, int64_t e) {
+    int64_t d = 0;
     for (int64_t r = b; r < e; ++r)
-      for (int64_t k = rp[r] + 1; k < rp[r + 1]; ++k) {
-        const int32_t v = cl[k];
-        const int64_t gv = g[v];
-        int64_t q = k;
-        for (; q > rp[r] && g[cl[q - 1]] > gv; --q) cl[q] = cl[q - 1];
-        cl[q] = v;
-      }
+      for (int64_t k = rp[r] + 1; k < rp[r + 1]; ++k) d += g[cl[k - 1]] > g[cl[k]];
+    per_block[t] = d;
   });
+  int64_t descents = 0;
+  for (int t = 0; t < nt; ++t) descents += per_block[t];
+  if (descents == 0) return;
+  if (descents * 8 < nnz) {
+    parallel_blocks(nrows, num_threads(nnz), [&](int, int64_t b, int64_t e) {
+      for (int64_t r = b; r < e; ++r)
+        for (int64_t k = rp[r] + 1; k < rp[r + 1]; ++k) {
+          const int32_t v = cl[k];
+          const int64_t gv = g[v];
+          int64_t q = k;
+          for (; q > rp[r] && g[cl[q - 1]] > gv; --q) cl[q] = cl[q - 1];
+          cl[q] = v;
+        }
+    });
+    return;
+  }
+  const int32_t n = n_;
+  sc.start.assign(static_cast<size_t>(n) + 1, 0);
+  int64_t *start = sc.start.data();
+  for (int64_t k = 0; k < nnz; ++k) ++start[cl[k] + 1];
+  for (int32_t j = 0; j < n; ++j) start[j + 1] += start[j];
+  sc.fill.assign(start, start + n);
+  sc.owner.resize(static_cast<size_t>(nnz));
+  int64_t *fill = sc.fill.data();
+  int32_t *owner = sc.owner.data();
+  for (int64_t r = 0; r < nrows; ++r)
+    for (int64_t k = rp[r]; k < rp[r + 1]; ++k) owner[fill[cl[k]]++] = static_cast<int32_t>(r);
+  sc.fill.assign(rp, rp + nrows);
+  fill = sc.fill.data();
+  for (int32_t q = 0; q < n; ++q) {
+    const int32_t j = gid_perm_[q];
+    for (int64_t t = start[j]; t < start[j + 1]; ++t) cl[fill[owner[t]]++] = j;
+  }
 }
 
 int32_t ParticleSet::data_status(int32_t i) const {
@@ -454,7 +490,7 @@ Report ParticleSet::setup() {
   } else if (host_neighbors()) {
     nbr_ = std::move(out);
   }
-  order_rows_by_id(nbr_);
+  order_rows_by_id(nbr_, row_order_);
   setup_done_ = true;
   ++setups_;
   return rep;

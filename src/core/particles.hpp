@@ -126,8 +126,17 @@ class ParticleSet {
   double halo_width() const { return halo_; }
   // With global ids, each row of rows (columns are particle indices) reordered by
   // ascending global id, so that every sum over a row runs in one order whatever the
-  // local numbering; without ids rows are left as they are (sorted by index).
-  void order_rows_by_id(Csr &rows) const;
+  // local numbering; without ids rows are left as they are (sorted by index). The const
+  // form (rows of host points) works in scratch of its own.
+  struct RowOrderScratch {
+    std::vector<int64_t> start, fill;
+    std::vector<int32_t> owner;
+  };
+  void order_rows_by_id(Csr &rows, RowOrderScratch &scratch) const;
+  void order_rows_by_id(Csr &rows) const {
+    RowOrderScratch scratch;
+    order_rows_by_id(rows, scratch);
+  }
   // Throws MFREE_ERR_HALO when a declared halo width is narrower than the radius r(s)
   // that site s of the valid owned particles reaches (what: the radius' name).
   template <class Radius>
@@ -172,10 +181,14 @@ class ParticleSet {
   HVec<int64_t> host_rowptr_own_;
   HVec<int32_t> host_cols_own_;
 
-  // global ids: n values, borrowed or in gid_own_; gid_check_ is the duplicate check's
-  // sorted copy, kept so that a repeated setup with borrowed ids allocates nothing
+  // global ids: n values, borrowed or in gid_own_. gid_perm_ lists the particles in
+  // ascending id order (the duplicate check's sort, and the order rows are rebuilt in);
+  // gid_perm_next_ is where a check sorts before it succeeds. Both, and the row-order
+  // scratch, are kept so that a repeated setup allocates nothing.
   const int64_t *gid_ = nullptr;
-  std::vector<int64_t> gid_own_, gid_check_;
+  std::vector<int64_t> gid_own_;
+  std::vector<int32_t> gid_perm_, gid_perm_next_;
+  RowOrderScratch row_order_;
   void check_global_ids(const int64_t *ids);
   double halo_ = 0.0;
   struct PairList {
