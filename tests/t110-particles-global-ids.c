@@ -10,6 +10,8 @@
  *  - the same with host-supplied neighbour lists (shuffled rows that omit the particle
  *    itself) and with the symmetric-mean search convention;
  *  - rows of host points (MLS 2) over a permuted set: the same ids, order and bits;
+ *  - pair gradients of a host pair list (SPH, RL, KB 1, MLS 1), the set permuted and the
+ *    pairs reordered and flipped: both sides of every pair the same bits;
  *  - bad input: negative or repeated ids (copied, and borrowed ids changed before setup:
  *    nothing changes), get without ids, a negative or NaN halo width, and a declared halo
  *    width narrower than the search radius or the kernel support: MFREE_ERR_HALO. */
@@ -373,6 +375,78 @@ static void test_points(void **s) {
   }
 }
 
+/* Pair gradients (a host's half pair list): the set permuted, its pairs listed in
+ * another order and orientation, every pair's i and j sides the same bits, for SPH, RL,
+ * KB 1, MLS 1, 2D and 3D. */
+static void test_pair_gradients(void **s) {
+  (void)s;
+  static cloud_t ref, sub;
+  static int32_t pi[2][NMAX * 40], pj[2][NMAX * 40];
+  static int64_t where[NMAX * 40];
+  static int flip[NMAX * 40];
+  const int methods[4] = {MFREE_METHOD_SPH, MFREE_METHOD_RANDLES_LIBERSKY, MFREE_METHOD_KB_METHOD1,
+                          MFREE_METHOD_MLS};
+  for (int dim = 2; dim <= 3; ++dim) {
+    make_cloud(&ref, dim, dim == 2 ? 15 : 7, 31 + dim);
+    make_subdomain(&sub, &ref, INFINITY, 0, 12);
+    int inv[NMAX];
+    for (int k = 0; k < sub.n; ++k) inv[sub.orig[k]] = k;
+    int64_t np = 0;
+    for (int i = 0; i < ref.n; ++i)
+      for (int j = i + 1; j < ref.n; ++j) {
+        double r2 = 0, hm = ref.h[i] > ref.h[j] ? ref.h[i] : ref.h[j];
+        for (int d = 0; d < dim; ++d) r2 += pow(ref.x[i * dim + d] - ref.x[j * dim + d], 2);
+        if (r2 < KAPPA * KAPPA * hm * hm) {
+          assert_true(np < NMAX * 40);
+          pi[0][np] = i;
+          pj[0][np] = j;
+          ++np;
+        }
+      }
+    /* the permuted list: pair k of the reference at where[k], flipped or not */
+    mfree_rng_t r;
+    mfree_rng_seed(&r, 5);
+    for (int64_t k = 0; k < np; ++k) where[k] = k;
+    for (int64_t k = np - 1; k > 0; --k) {
+      const int64_t j = (int64_t)(mfree_rng_uniform(&r) * (double)(k + 1)), t = where[k];
+      where[k] = where[j];
+      where[j] = t;
+    }
+    for (int64_t k = 0; k < np; ++k) {
+      flip[k] = mfree_rng_uniform(&r) < 0.5;
+      const int a = inv[pi[0][k]], b = inv[pj[0][k]];
+      pi[1][where[k]] = flip[k] ? b : a;
+      pj[1][where[k]] = flip[k] ? a : b;
+    }
+    for (int m = 0; m < 4; ++m) {
+      double *g[2][2];
+      for (int side = 0; side < 2; ++side) {
+        const cloud_t *c = side ? &sub : &ref;
+        mfree_context_t *cx = side ? ctx2 : ctx;
+        mfree_particles_t *ps = make_set(cx, c, MFREE_SEARCH_GATHER, 1);
+        assert_ok(cx, mfree_particles_set_pairs(ps, np, pi[side], pj[side], 0, MFREE_COPY));
+        assert_ok(cx, mfree_particles_setup(ps));
+        mfree_approximant_t *a = NULL;
+        assert_ok(cx, mfree_approximant_create(cx, ps, methods[m], &a));
+        assert_ok(cx, mfree_approximant_setup(a));
+        for (int q = 0; q < 2; ++q) g[side][q] = malloc(sizeof(double) * (size_t)(np * dim + 1));
+        assert_ok(cx, mfree_approximant_get_pair_gradients(a, g[side][0], g[side][1], dim, np * dim));
+        mfree_approximant_destroy(&a);
+        mfree_particles_destroy(&ps);
+      }
+      for (int64_t k = 0; k < np; ++k) {
+        const double *ai = g[0][0] + k * dim, *aj = g[0][1] + k * dim;
+        const double *bi = g[1][flip[k]] + where[k] * dim, *bj = g[1][!flip[k]] + where[k] * dim;
+        if (memcmp(ai, bi, sizeof(double) * dim) || memcmp(aj, bj, sizeof(double) * dim))
+          fail_msg("%dD method %d: pair %lld (ids %lld, %lld) differs: %.17g / %.17g", dim, methods[m],
+                   (long long)k, (long long)ref.id[pi[0][k]], (long long)ref.id[pj[0][k]], ai[0], bi[0]);
+      }
+      for (int side = 0; side < 2; ++side)
+        for (int q = 0; q < 2; ++q) free(g[side][q]);
+    }
+  }
+}
+
 static void test_permutation_2d(void **s) { (void)s; run(2, 0); }
 static void test_permutation_3d(void **s) { (void)s; run(3, 0); }
 static void test_subdomain_2d(void **s) { (void)s; run(2, 1); }
@@ -503,7 +577,7 @@ int main(void) {
       cmocka_unit_test(test_host_lists_2d),     cmocka_unit_test(test_host_lists_3d),
       cmocka_unit_test(test_symmetric_mean_2d), cmocka_unit_test(test_symmetric_mean_3d),
       cmocka_unit_test(test_id_order_2d),       cmocka_unit_test(test_id_order_3d),
-      cmocka_unit_test(test_points),
+      cmocka_unit_test(test_points),            cmocka_unit_test(test_pair_gradients),
       cmocka_unit_test(test_row_order),         cmocka_unit_test(test_bad_ids),
       cmocka_unit_test(test_halo_width),
   };
