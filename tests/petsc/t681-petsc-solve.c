@@ -5,7 +5,8 @@
  * through mfree_petsc_set_dirichlet; background Gauss cells with penalty conditions) and
  * a 3D block clamped at x = 0 under a body force, on a recursive-bisection decomposition.
  * The beam's solution is also checked against Timoshenko's exact displacement (000 eqs
- * 120-121) at the tip, an independent oracle of the whole chain. */
+ * 120-121) at the tip, an independent oracle of the whole chain. The block once more with
+ * BoomerAMG chosen through PETSc's options database (prefix t681_). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,12 +16,15 @@
 static int rank_, size_;
 
 /* Solve the problem on the local particles l over comm; u: owned dofs. */
+static const char *prefix_; /* options prefix of the distributed solves (NULL: none) */
+
 static void solve(mfree_context_t *ctx, const pk_problem_t *p, const pk_local_t *l, MPI_Comm comm, double *u,
                   int32_t *its) {
   pk_system_t s;
   assert_ok(ctx, pk_system(ctx, p, l, &s));
   mfree_petsc_t *pk = NULL;
   assert_ok(ctx, mfree_petsc_create(ctx, comm, &pk));
+  if (comm != PETSC_COMM_SELF) assert_ok(ctx, mfree_petsc_set_options_prefix(pk, prefix_));
   double *xo = malloc(sizeof(double) * (size_t)p->dim * (size_t)(l->nowned ? l->nowned : 1));
   memcpy(xo, s.x, sizeof(double) * (size_t)p->dim * (size_t)l->nowned);
   assert_ok(ctx, mfree_petsc_set_coordinates(pk, p->dim, l->nowned, xo));
@@ -30,6 +34,15 @@ static void solve(mfree_context_t *ctx, const pk_problem_t *p, const pk_local_t 
   pk_dirichlet(p, l, &nd, &dofs, &vals);
   assert_ok(ctx, mfree_petsc_set_dirichlet(pk, nd, dofs, vals));
   assert_ok(ctx, mfree_petsc_solve(pk, u));
+  {
+    KSP ksp = NULL;
+    PC pc = NULL;
+    PCType type = NULL;
+    assert_ok(ctx, mfree_petsc_get_objects(pk, NULL, &ksp, NULL, NULL));
+    KSPGetPC(ksp, &pc);
+    PCGetType(pc, &type);
+    assert_string_equal(type, comm != PETSC_COMM_SELF && prefix_ ? PCHYPRE : PCGAMG);
+  }
   int32_t reason = 0;
   assert_ok(ctx, mfree_petsc_get_info(pk, its, NULL, &reason));
   assert_true(reason > 0);
@@ -104,11 +117,28 @@ static void block(void **state) {
   pk_problem_free(&p);
 }
 
+/* The options database reaches the solver: BoomerAMG (hypre) instead of GAMG through
+ * -t681_pc_type hypre, and the solution is still the one-rank one (GAMG) to 1e-8. */
+static void block_boomeramg(void **state) {
+  (void)state;
+  pk_problem_t p;
+  pk_problem_block(&p, 11, 6, 6);
+  PetscOptionsSetValue(NULL, "-t681_pc_type", "hypre");
+  PetscOptionsSetValue(NULL, "-t681_pc_hypre_type", "boomeramg");
+  prefix_ = "t681_";
+  run(&p, "3D block, BoomerAMG from the options database", 0.0);
+  prefix_ = NULL;
+  PetscOptionsClearValue(NULL, "-t681_pc_type");
+  PetscOptionsClearValue(NULL, "-t681_pc_hypre_type");
+  pk_problem_free(&p);
+}
+
 int main(int argc, char **argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(beam_nodal),
       cmocka_unit_test(beam_gauss),
       cmocka_unit_test(block),
+      cmocka_unit_test(block_boomeramg),
   };
   return pk_main(&argc, &argv, tests, sizeof tests / sizeof tests[0], &rank_, &size_);
 }
