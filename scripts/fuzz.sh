@@ -3,8 +3,8 @@
 # (default 5), under nice -n 19 (a shared machine: one harness at a time, one process).
 #   scripts/fuzz.sh [minutes] [harness...]
 # Builds the fuzz preset (clang, libFuzzer, ASan+UBSan) first. New inputs go to
-# build/fuzz/fuzz/corpus/<harness> (the repository's corpus is read only: copy inputs
-# worth keeping to fuzz/corpus/<harness>); a crash leaves build/fuzz/fuzz/<harness>-crash-*
+# build/fuzz/tests/robustness/fuzz/corpus/<harness> (the repository's corpus is read only: copy inputs
+# worth keeping to fuzz/corpus/<harness>); a crash leaves build/fuzz/tests/robustness/fuzz/<harness>-crash-*
 # (copy it to fuzz/regressions/<harness>/, fix the bug, commit both). Prints, per
 # harness, the executions, the edges libFuzzer counted (whole binary), the edges covered
 # in the harness's target files (libFuzzer's -print_coverage) and the crashes, and keeps
@@ -55,22 +55,22 @@ mkdir -p "$out"
 summary="$out/summary.txt"
 : >"$summary"
 for h in "${harnesses[@]}"; do
-  bin=build/fuzz/fuzz/mfree_fuzz_$h
+  bin=build/fuzz/tests/robustness/fuzz/mfree_fuzz_$h
   [[ -x "$bin" ]] || { echo "no harness $h (adapters need SuiteSparse and SUNDIALS)"; continue; }
-  work=build/fuzz/fuzz/corpus/$h
+  work=build/fuzz/tests/robustness/fuzz/corpus/$h
   mkdir -p "$work"
   log="$out/$h.log"
   echo "==== $h: $minutes min"
   set +e
   ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 UBSAN_OPTIONS=print_stacktrace=1 \
     nice -n 19 "$bin" -max_total_time=$((minutes * 60)) -timeout=20 -rss_limit_mb=3072 \
-    -print_final_stats=1 -print_coverage=1 -artifact_prefix="build/fuzz/fuzz/$h-" \
+    -print_final_stats=1 -print_coverage=1 -artifact_prefix="build/fuzz/tests/robustness/fuzz/$h-" \
     "$work" "fuzz/corpus/$h" "fuzz/regressions/$h" >"$log" 2>&1
   rc=$?
   set -e
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
   edges=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
-  crashes=$(ls build/fuzz/fuzz/"$h"-crash-* build/fuzz/fuzz/"$h"-leak-* build/fuzz/fuzz/"$h"-timeout-* 2>/dev/null | wc -l)
+  crashes=$(ls build/fuzz/tests/robustness/fuzz/"$h"-crash-* build/fuzz/tests/robustness/fuzz/"$h"-leak-* build/fuzz/tests/robustness/fuzz/"$h"-timeout-* 2>/dev/null | wc -l)
   # shellcheck disable=SC2046
   tcov=$(edge_coverage "$log" $(target_files "$h"))
   printf '%-12s exit %-3s executions %-10s edges (whole binary) %-6s edges in its target files %-22s crash/leak/timeout files %s\n' \
@@ -91,10 +91,10 @@ if [[ "${COVERAGE:-0}" == 1 ]]; then
     nice -n 19 cmake --build "$cov" -j"${MFREE_FUZZ_JOBS:-1}" --target "mfree_fuzz_replay_$h" >/dev/null || continue
     files=$(target_files "$h")
     rm -f "$cov"/"$h".prof*
-    find build/fuzz/fuzz/corpus/"$h" fuzz/corpus/"$h" fuzz/regressions/"$h" -type f 2>/dev/null |
-      xargs -r -n 500 env LLVM_PROFILE_FILE="$cov/$h.prof-%p.profraw" nice -n 19 "$cov/fuzz/mfree_fuzz_replay_$h" >/dev/null 2>&1 || true
+    find build/fuzz/tests/robustness/fuzz/corpus/"$h" fuzz/corpus/"$h" fuzz/regressions/"$h" -type f 2>/dev/null |
+      xargs -r -n 500 env LLVM_PROFILE_FILE="$cov/$h.prof-%p.profraw" nice -n 19 "$cov/tests/robustness/fuzz/mfree_fuzz_replay_$h" >/dev/null 2>&1 || true
     "$llvm_bin/llvm-profdata" merge -o "$cov/$h.profdata" "$cov"/"$h".prof-*.profraw
-    objs=("$cov/fuzz/mfree_fuzz_replay_$h" -object "$cov/src/libmfree.so")
+    objs=("$cov/tests/robustness/fuzz/mfree_fuzz_replay_$h" -object "$cov/src/libmfree.so")
     [[ $h == adapters ]] && objs+=(-object "$cov/adapters/suitesparse/libmfree_suitesparse.so" -object "$cov/adapters/sundials/libmfree_sundials.so")
     echo "---- $h: coverage of its target files" | tee -a "$summary"
     # shellcheck disable=SC2086
