@@ -52,7 +52,7 @@ static void suitesparse(fz_bytes_t *b, mfree_context_t *ctx) {
     FZ_TRAP_IF(!fz_valid_status(st));
     const int32_t nrhs = (int32_t)(fz_u8(b) % 4) - (opts & 16 ? 1 : 0);
     const unsigned wl = fz_u8(b);
-    const int64_t ld = (wl & 1) ? (nr > 0 ? nr : 1) + (int64_t)(wl >> 1) % 3 : INT64_MAX / (1 + (wl >> 1));
+    const int64_t ld = (wl & 1) ? (nr > 0 ? nr : 1) + (int64_t)(wl >> 1) % 3 : INT64_MAX / (1 + (wl >> 1) % 4);
     double *bb = calloc((size_t)4 * (MAXR + 3), sizeof *bb), *xx = calloc((size_t)4 * (MAXR + 3), sizeof *xx);
     for (int k = 0; k < 4 * (MAXR + 3); ++k) bb[k] = 1.0 + k % 5;
     const int64_t ldx = ld <= MAXR + 3 ? ld : (nr > 0 ? nr : 1);

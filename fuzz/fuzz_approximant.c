@@ -127,8 +127,8 @@ static void program(fz_bytes_t *b, mfree_context_t *ctx, mfree_particles_t *ps, 
         break;
       }
       default: { /* a leading dimension that wraps: refused, nothing changed */
-        double o = 0.0;
-        st = mfree_approximant_apply(a, MFREE_OP_VALUE, 1, uu, MFREE_LAYOUT_AOS, INT64_MAX / (1 + take(b)), &o,
+        double o[MAXN + MAXP + 1] = {0}; /* one value per site */
+        st = mfree_approximant_apply(a, MFREE_OP_VALUE, 1, uu, MFREE_LAYOUT_AOS, INT64_MAX / (1 + take(b) % 4), o,
                                      MFREE_LAYOUT_AOS, 1);
         FZ_TRAP_IF(n > 1 && st == MFREE_SUCCESS);
       }

@@ -81,7 +81,9 @@ static mfree_status_t call(mfree_particles_t *ps, fz_bytes_t *b, data_t *d, int 
     case 7: {
       const unsigned k = fz_u8(b);
       const mfree_layout_t layout = (k & 1) ? MFREE_LAYOUT_SOA : MFREE_LAYOUT_AOS;
-      const int64_t ld = (k & 2) ? INT64_MAX / (1 + (k >> 2)) : (k & 1) ? d->n : d->dim;
+      /* (a huge ld must be one whose offsets wrap, which mfree refuses: a large one that does
+       * not wrap is a valid request for an array larger than ours) */
+      const int64_t ld = (k & 2) ? INT64_MAX / (1 + (k >> 2) % 4) : (k & 1) ? d->n : d->dim;
       return mfree_particles_set_positions(ps, d->x, layout, ld, mem);
     }
     case 8: return mfree_particles_set_support(ps, d->h, (int64_t)(fz_u8(b) % 3), mem);

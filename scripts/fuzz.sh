@@ -70,7 +70,7 @@ for h in "${harnesses[@]}"; do
   set -e
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
   edges=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
-  crashes=$(ls build/fuzz/tests/robustness/fuzz/"$h"-crash-* build/fuzz/tests/robustness/fuzz/"$h"-leak-* build/fuzz/tests/robustness/fuzz/"$h"-timeout-* 2>/dev/null | wc -l)
+  crashes=$( (ls build/fuzz/tests/robustness/fuzz/"$h"-crash-* build/fuzz/tests/robustness/fuzz/"$h"-leak-* build/fuzz/tests/robustness/fuzz/"$h"-timeout-* 2>/dev/null || true) | wc -l)
   # shellcheck disable=SC2046
   tcov=$(edge_coverage "$log" $(target_files "$h"))
   printf '%-12s exit %-3s executions %-10s edges (whole binary) %-6s edges in its target files %-22s crash/leak/timeout files %s\n' \
