@@ -1,4 +1,4 @@
-// Specialised per-site shape functions for the common value + gradient tables (issue 8):
+// Specialised per-site shape functions for the common value + gradient tables:
 // one template per (dimension, kernel shape, method family, basis order), SoA neighbour
 // data gathered once per site, the kernel shape inlined for the cubic spline, moments
 // accumulated as sums of monomials in one neighbour pass, fixed-size factorisations that

@@ -1,4 +1,4 @@
-// Function multiversioning for the hot row kernels (issue 8). The library is built for
+// Function multiversioning for the hot row kernels. The library is built for
 // the baseline of its target (x86-64: SSE2, no -march) so that it runs on every machine;
 // row kernels that profit from wider vectors and fused multiply-adds are compiled a
 // second time for AVX2 + FMA, and the copy to run is chosen at run time from the CPU.
