@@ -8,6 +8,10 @@
  *    MFREE_ERR_ARG everywhere;
  *  - a global id given to particles of two ranks (of one rank on one rank):
  *    MFREE_ERR_INPUT everywhere, the message names the id;
+ *  - ranks that disagree on an argument that must be common (the dimension at create,
+ *    the width at setup, ncomp at exchange: another message size): MFREE_ERR_ARG
+ *    everywhere, naming two ranks and their values; an exchange that fails on one rank
+ *    (ld below ncomp, a NULL field) fails on every rank; no ghost item is written;
  *  - a halo too narrow for the supports: the particle set that declares the plan's width
  *    returns MFREE_ERR_HALO at setup on every rank, instead of rows that miss ghosts. */
 #include <math.h>
@@ -42,6 +46,11 @@ int main(int argc, char **argv) {
   expect(ctx, mfree_halo_create(ctx, MPI_COMM_WORLD, rank == last ? 4 : 2, &halo), MFREE_ERR_ARG, who,
          "create, dim 4 on the last rank");
   CHECK(halo == NULL, "no plan after a failed create");
+  if (size > 1) {
+    expect(ctx, mfree_halo_create(ctx, MPI_COMM_WORLD, rank == last ? 3 : 2, &halo), MFREE_ERR_ARG,
+           "ranks disagree on the dimension: rank 0 passes 2, rank", "create, dim 3 on the last rank only");
+    CHECK(halo == NULL, "no plan after a disagreement");
+  }
   CHECK(mfree_halo_create(ctx, MPI_COMM_WORLD, 2, &halo) == MFREE_SUCCESS, "create");
 
   cloud_t c;
@@ -88,7 +97,11 @@ int main(int argc, char **argv) {
   /* ids on some ranks only (the last gives none): MFREE_ERR_ARG everywhere */
   if (size > 1)
     expect(ctx, mfree_halo_setup(halo, no, xo, 2, rank == last ? NULL : io, width), MFREE_ERR_ARG,
-           "all ranks or none", "ids on some ranks only");
+           "all ranks with particles or none", "ids on some ranks only");
+  /* a width of its own on the last rank (e.g. kappa times its own largest support) */
+  if (size > 1)
+    expect(ctx, mfree_halo_setup(halo, no, xo, 2, io, rank == last ? 1.5 * width : width), MFREE_ERR_ARG,
+           "ranks disagree on the halo width", "a width of its own on the last rank");
 
   /* the same global id on two ranks (on one rank: twice on it) */
   const int64_t dup = c.id[0]; /* owned by rank 0 in the slab split */
@@ -103,6 +116,37 @@ int main(int argc, char **argv) {
   for (int i = 0, k = 0; i < c.n; ++i)
     if (part[i] == rank) io[k++] = c.id[i];
   CHECK(mfree_halo_setup(halo, no, xo, 2, io, width) == MFREE_SUCCESS, "recovery after ids");
+
+  /* exchanges that fail on one rank, or whose ranks disagree on ncomp: every rank
+   * returns, nothing is written into the ghost items, and the next exchange works */
+  {
+    mfree_halo_get_size(halo, &n_owned, &n_ghost);
+    const int nall = n_owned + n_ghost;
+    double *f = malloc(sizeof(double) * (size_t)(2 * nall + 2));
+    for (int i = 0; i < 2 * nall; ++i) f[i] = i < 2 * n_owned ? xo[i] : -1.0;
+    if (size > 1)
+      expect(ctx, mfree_halo_exchange(halo, rank == last ? 2 : 1, f, 2), MFREE_ERR_ARG,
+             "ranks disagree on ncomp", "ncomp 2 on the last rank, 1 elsewhere");
+    expect(ctx, mfree_halo_exchange(halo, 2, f, rank == last ? 1 : 2), MFREE_ERR_ARG, who,
+           "ld below ncomp on the last rank");
+    /* (rank 0 owns particles in the slab split) */
+    expect(ctx, mfree_halo_exchange(halo, 2, rank == 0 ? NULL : f, 2), MFREE_ERR_NULL, "rank 0: field is NULL",
+           "NULL field on rank 0");
+    int untouched = 1;
+    for (int i = 2 * n_owned; i < 2 * nall; ++i) untouched = untouched && f[i] == -1.0;
+    CHECK(untouched, "no ghost item written by a failed exchange");
+    CHECK(mfree_halo_exchange(halo, 2, f, 2) == MFREE_SUCCESS, "an exchange after the faults");
+    int64_t *gid = malloc(sizeof(int64_t) * (size_t)(nall + 1));
+    mfree_halo_get_global_ids(halo, gid);
+    int exact = 1;
+    for (int g = n_owned; g < nall; ++g) {
+      const int64_t k = (gid[g] - 5) / 2; /* cloud ids are 5 + 2 i */
+      exact = exact && f[2 * g] == c.x[2 * k] && f[2 * g + 1] == c.x[2 * k + 1];
+    }
+    CHECK(exact, "ghost positions are their owners' after the faults");
+    free(gid);
+    free(f);
+  }
 
   /* a halo too narrow: the plan holds the ghosts within half the supports' reach; the
    * set that declares that width refuses to build rows */

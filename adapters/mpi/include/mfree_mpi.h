@@ -20,8 +20,9 @@
  *
  * Collective calls (create, setup, exchange) must be called by every rank of the
  * communicator. Their errors are agreed: when one rank fails (bad argument, duplicate
- * global id anywhere, out of memory), every rank returns the same status and its context
- * holds a message naming the failing rank and its reason; no rank is left waiting. Only
+ * global id anywhere, out of memory) or the ranks pass different values of an argument
+ * that must be common (dim, width, ncomp), every rank returns the same status and its
+ * context holds a message naming the failing rank and its reason; no rank is left waiting. Only
  * a NULL handle or context is reported locally (MFREE_ERR_NULL), as it has no
  * communicator. The core library never calls MPI; this one does. docs/mpi.md shows how
  * a host runs on ranks and which ghosts each method needs.
@@ -58,10 +59,11 @@ typedef struct mfree_halo mfree_halo_t;
  * host's). Collective over comm.
  * @param[in]  ctx   context for errors (kept alive by the plan)
  * @param[in]  comm  the ranks sharing the particles
- * @param[in]  dim   1, 2 or 3 (else MFREE_ERR_ARG on every rank)
+ * @param[in]  dim   1, 2 or 3, the same on every rank (else MFREE_ERR_ARG on every rank)
  * @param[out] halo  the new plan; NULL on failure
  * @return MFREE_SUCCESS; MFREE_ERR_NULL (local) for a NULL ctx or halo; MFREE_ERR_ARG,
- *         MFREE_ERR_ALLOC or MFREE_ERR_INTERNAL on every rank when one rank fails
+ *         MFREE_ERR_ALLOC or MFREE_ERR_INTERNAL on every rank when one rank fails or the
+ *         ranks pass different dimensions
  */
 MFREE_MPI_API mfree_status_t mfree_halo_create(mfree_context_t *ctx, MPI_Comm comm, int32_t dim,
                                                mfree_halo_t **halo);
@@ -98,10 +100,12 @@ MFREE_MPI_API mfree_status_t mfree_halo_destroy(mfree_halo_t **halo);
  *                     the owned particles are numbered offset + i, offset the exclusive
  *                     scan of n_owned (mfree_halo_get_global_offset); every rank with
  *                     particles gives ids, or none does (else MFREE_ERR_ARG)
- * @param[in] width    halo width (finite, > 0): at least the largest distance at which a
- *                     particle of another rank can be a neighbour (kappa times the
- *                     largest support), plus twice the largest displacement before the
- *                     next setup for plans kept while particles move
+ * @param[in] width    halo width (finite, > 0), the same on every rank (else MFREE_ERR_ARG
+ *                     on every rank, naming two ranks and their widths): at least the
+ *                     largest distance at which a particle of another rank can be a
+ *                     neighbour (kappa times the largest support over all ranks), plus
+ *                     twice the largest displacement before the next setup for plans
+ *                     kept while particles move
  * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG, MFREE_ERR_NULL,
  *         MFREE_ERR_INPUT (non-finite position, negative id, an id repeated anywhere:
  *         the message names it and the ranks), MFREE_ERR_ALLOC, MFREE_ERR_INTERNAL (an
@@ -155,16 +159,22 @@ MFREE_MPI_API mfree_status_t mfree_halo_get_plan(const mfree_halo_t *halo, int32
 
 /**
  * Forward exchange: the owners' values of a per-particle field written into the ghost
- * items. Collective: one MPI_Neighbor_alltoallv; no allocation once the buffers have
- * grown to the largest ncomp used. Its arguments are checked on the calling rank only
- * (no agreement round): every rank must pass the same ncomp.
+ * items. Collective: one MPI_Allreduce of three (value, rank) pairs that agrees on the
+ * status and on ncomp, then one MPI_Neighbor_alltoallv; no allocation once the buffers
+ * have grown to the largest ncomp used. A rank that fails its checks, or passes another
+ * ncomp than the others (another message size), makes every rank return the same status
+ * and message before any data moves; ld is local (it sets the layout in memory, not the
+ * message).
  * @param[in]     halo   a set-up plan
- * @param[in]     ncomp  components per particle (>= 1)
+ * @param[in]     ncomp  components per particle (>= 1), the same on every rank
  * @param[in,out] field  AoS, n_owned + n_ghost items of ld doubles: items [0, n_owned)
  *                       are read, components [0, ncomp) of the ghost items written
- * @param[in]     ld     leading dimension (>= ncomp)
- * @return MFREE_SUCCESS; MFREE_ERR_STATE before a successful setup; MFREE_ERR_ARG,
- *         MFREE_ERR_NULL; MFREE_ERR_ALLOC; MFREE_ERR_INTERNAL for an MPI failure
+ * @param[in]     ld     leading dimension (>= ncomp); may differ between ranks
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_STATE before a successful
+ *         setup; MFREE_ERR_ARG (a bad argument, or ranks that disagree on ncomp: "ranks
+ *         disagree on ncomp", naming two ranks and their values), MFREE_ERR_NULL,
+ *         MFREE_ERR_ALLOC; the message starts with the failing rank. MFREE_ERR_INTERNAL
+ *         for an MPI failure (of the data exchange: on the ranks where it failed)
  */
 MFREE_MPI_API mfree_status_t mfree_halo_exchange(mfree_halo_t *halo, int32_t ncomp, double *field,
                                                  int64_t ld);

@@ -34,15 +34,11 @@ struct mfree_halo {
 
 namespace {
 
-mfree_status_t record(mfree_context_t *ctx, mfree_status_t st, const char *fn,
-                      const std::string &msg) noexcept {
-  try {
-    const std::string text = std::string(fn) + ": " + msg;
-    mfree_context_set_error(ctx, st, text.c_str());
-  } catch (...) {  // no memory for the message: keep at least the code and the function
-    mfree_context_set_error(ctx, st, fn);
-  }
-  return st;
+// (const char *: no std::string is built outside a try on the callers' side)
+mfree_status_t record(mfree_context_t *ctx, mfree_status_t st, const char *fn, const char *msg) noexcept {
+  char text[640];
+  std::snprintf(text, sizeof text, "%s: %s", fn, msg);
+  return mfree_context_set_error(ctx, st, text);
 }
 
 // A local step's outcome: status and message, not yet shared with the other ranks.
@@ -77,27 +73,50 @@ Local run_local(Body &&body) noexcept {
   return l;
 }
 
+// One value of a rank in an agreement: its minimum over the ranks and the lowest rank
+// holding it come back (MPI_DOUBLE_INT, MPI_MINLOC; maxima as minima of the negatives).
+struct Loc {
+  double v;
+  int r;
+};
+
 // Every rank learns the lowest status of the ranks (the first rank holding it breaks
-// ties) and that rank's message; all return the same status. MPI failures of the
-// agreement itself are internal errors.
-mfree_status_t agree(mfree_halo_t *h, const char *fn, const Local &l) noexcept {
-  struct {
-    int v, r;
-  } in{static_cast<int>(l.st < 0 ? l.st : MFREE_SUCCESS), h->rank}, out{0, 0};
-  if (MPI_Allreduce(&in, &out, 1, MPI_2INT, MPI_MINLOC, h->comm) != MPI_SUCCESS)
+// ties) and that rank's message; all return the same status. The same all-reduce carries
+// the nv values of vals (each rank's in, the minimum and its rank out), which the callers
+// compare to find ranks that disagree on an argument that must be common. MPI failures of
+// the agreement itself are internal errors.
+mfree_status_t agree(mfree_halo_t *h, const char *fn, const Local &l, Loc *vals = nullptr,
+                     int nv = 0) noexcept {
+  Loc buf_in[8], buf_out[8];
+  if (nv > 7) return record(h->ctx, MFREE_ERR_INTERNAL, fn, "too many values to agree on");
+  buf_in[0] = {static_cast<double>(l.st < 0 ? l.st : MFREE_SUCCESS), h->rank};
+  for (int k = 0; k < nv; ++k) buf_in[k + 1] = {vals[k].v, h->rank};
+  if (MPI_Allreduce(buf_in, buf_out, nv + 1, MPI_DOUBLE_INT, MPI_MINLOC, h->comm) != MPI_SUCCESS)
     return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Allreduce failed");
-  if (out.v == MFREE_SUCCESS) return MFREE_SUCCESS;
+  for (int k = 0; k < nv; ++k) vals[k] = buf_out[k + 1];
+  const int worst = static_cast<int>(buf_out[0].v), who = buf_out[0].r;
+  if (worst == MFREE_SUCCESS) return MFREE_SUCCESS;
   char buf[512] = {0};
-  if (h->rank == out.r) std::snprintf(buf, sizeof buf, "%s", l.msg.c_str());
-  if (MPI_Bcast(buf, static_cast<int>(sizeof buf), MPI_CHAR, out.r, h->comm) != MPI_SUCCESS)
+  if (h->rank == who) std::snprintf(buf, sizeof buf, "%s", l.msg.c_str());
+  if (MPI_Bcast(buf, static_cast<int>(sizeof buf), MPI_CHAR, who, h->comm) != MPI_SUCCESS)
     return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Bcast failed");
   buf[sizeof buf - 1] = 0;
-  const mfree_status_t st = static_cast<mfree_status_t>(out.v);
-  try {
-    return record(h->ctx, st, fn, "rank " + std::to_string(out.r) + ": " + buf);
-  } catch (...) {
-    return record(h->ctx, st, fn, "");
-  }
+  const mfree_status_t st = static_cast<mfree_status_t>(worst);
+  char text[560];
+  std::snprintf(text, sizeof text, "rank %d: %s", who, buf);
+  return record(h->ctx, st, fn, text);
+}
+
+// After an agreement on (v, -v): MFREE_ERR_ARG on every rank alike when the ranks passed
+// different values of an argument that must be common (the message names the lowest
+// ranks holding the smallest and the largest value).
+mfree_status_t same_everywhere(mfree_halo_t *h, const char *fn, const char *what, const Loc &lo,
+                               const Loc &neg_hi) noexcept {
+  if (lo.v == -neg_hi.v) return MFREE_SUCCESS;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "ranks disagree on %s: rank %d passes %.17g, rank %d passes %.17g (every rank must pass the same)",
+                what, lo.r, lo.v, neg_hi.r, -neg_hi.v);
+  return record(h->ctx, MFREE_ERR_ARG, fn, buf);
 }
 
 // An MPI call inside a local step: its failure becomes MFREE_ERR_INTERNAL.
@@ -155,7 +174,9 @@ mfree_status_t mfree_halo_create(mfree_context_t *ctx, MPI_Comm comm, int32_t di
     const mfree_status_t st = mfree_matrix_create_csr(ctx, 0, 0, &zero, nullptr, nullptr, &h->ctx_ref);
     if (st != MFREE_SUCCESS) l.fail(st, "cannot hold the context");
   }
-  const mfree_status_t st = agree(h, fn, l);
+  Loc dims[2] = {{static_cast<double>(dim), 0}, {-static_cast<double>(dim), 0}};
+  mfree_status_t st = agree(h, fn, l, dims, 2);
+  if (st == MFREE_SUCCESS) st = same_everywhere(h, fn, "the dimension", dims[0], dims[1]);
   if (st != MFREE_SUCCESS) {
     mfree_halo_destroy(&h);
     return st;
@@ -187,7 +208,7 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
   h->ready = false;
   const int dim = h->dim;
   // 1. arguments and this rank's bounding box (empty: lo = +inf, hi = -inf)
-  std::vector<double> box(2 * static_cast<size_t>(dim), 0.0);
+  double box[6] = {0, 0, 0, 0, 0, 0};  // (dim <= 3: checked at create)
   Local l = run_local([&](Local &r) {
     if (n_owned < 0) return r.fail(MFREE_ERR_ARG, "n_owned " + std::to_string(n_owned) + " is negative");
     if (ld < dim) return r.fail(MFREE_ERR_ARG, "leading dimension " + std::to_string(ld) + " is below dim");
@@ -213,26 +234,34 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
           return r.fail(MFREE_ERR_INPUT, "global id of particle " + std::to_string(i) + " is " +
                                              std::to_string(ids[i]) + " (must be >= 0)");
   });
-  mfree_status_t st = agree(h, fn, l);
-  if (st != MFREE_SUCCESS) return st;
-  // ids from the host on every rank with particles, or on none: agreed, because the
-  // duplicate check below is collective (a rank without particles may pass NULL)
   // The duplicate check (an all-to-all of every id) is skipped when no rank's owned ids
   // changed since the last one passed: a rebuild after motion without migration.
   const bool same = h->ids_checked && ids && n_owned == h->n_owned &&
                     static_cast<int64_t>(h->ids.size()) >= n_owned &&
                     std::equal(ids, ids + n_owned, h->ids.begin());
   h->ids_checked = false;
-  int flag[3] = {n_owned > 0 ? (ids ? 1 : 0) : -1, n_owned > 0 ? (ids ? -1 : 0) : -1, same ? 0 : 1};
-  int any[3] = {0, 0, 0};
-  l = run_local([&](Local &r) {
-    mpi_ok(r, MPI_Allreduce(flag, any, 3, MPI_INT, MPI_MAX, h->comm), "MPI_Allreduce");
-    if (!r.st && any[0] == 1 && any[1] == 0 && n_owned > 0 && !ids)
-      r.fail(MFREE_ERR_ARG, "no global ids here while other ranks give theirs (all ranks or none)");
-  });
-  st = agree(h, fn, l);
+  // Agreed with the status, in the same all-reduce: the width (common to all ranks: the
+  // neighbour relation must be symmetric), ids from every rank with particles or from
+  // none (the duplicate check below is collective; a rank without particles may pass
+  // NULL), and whether any rank's ids changed.
+  const double has_ids = ids ? 1.0 : 0.0;
+  Loc v[5] = {{width, 0},
+              {-width, 0},
+              {n_owned > 0 ? has_ids : 1.0, 0},    // min: 0 when a rank with particles has none
+              {n_owned > 0 ? -has_ids : 0.0, 0},   // -max: -1 when a rank gives ids
+              {same ? 0.0 : -1.0, 0}};             // -1 when some rank's ids changed
+  mfree_status_t st = agree(h, fn, l, v, 5);
+  if (st == MFREE_SUCCESS) st = same_everywhere(h, fn, "the halo width", v[0], v[1]);
+  if (st == MFREE_SUCCESS && v[2].v == 0.0 && v[3].v == -1.0) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "rank %d gives no global ids while rank %d gives its own (all ranks with particles or none)",
+                  v[2].r, v[3].r);
+    st = record(h->ctx, MFREE_ERR_ARG, fn, text);
+  }
   if (st != MFREE_SUCCESS) return st;
-  const bool host_ids = any[0] == 1;
+  const bool any_changed = v[4].v == -1.0;
+  const bool host_ids = v[3].v == -1.0;
 
   // 2. global numbering, every rank's box, and the duplicate-id check: each id is sent to
   // the rank id_owner(id), which finds repeats among what it receives
@@ -244,11 +273,11 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
     h->offset = off;
     h->total = tot;
     h->boxes.resize(2 * static_cast<size_t>(dim) * h->size);
-    mpi_ok(r, MPI_Allgather(box.data(), 2 * dim, MPI_DOUBLE, h->boxes.data(), 2 * dim, MPI_DOUBLE, h->comm),
+    mpi_ok(r, MPI_Allgather(box, 2 * dim, MPI_DOUBLE, h->boxes.data(), 2 * dim, MPI_DOUBLE, h->comm),
            "MPI_Allgather");
     h->ids.resize(static_cast<size_t>(n_owned));
     for (int32_t i = 0; i < n_owned; ++i) h->ids[i] = host_ids ? ids[i] : off + i;
-    if (!host_ids || any[2] == 0) return;  // numbered here, or unchanged since checked
+    if (!host_ids || !any_changed) return;  // numbered here, or unchanged since checked
     std::vector<int> cnt(h->size, 0), rcnt(h->size, 0), sdis(h->size, 0), rdis(h->size, 0);
     for (int32_t i = 0; i < n_owned; ++i) ++cnt[id_owner(ids[i], h->size)];  // (n_owned = 0 if ids is NULL)
     mpi_ok(r, MPI_Alltoall(cnt.data(), 1, MPI_INT, rcnt.data(), 1, MPI_INT, h->comm), "MPI_Alltoall");
@@ -285,7 +314,7 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
   l = run_local([&](Local &r) {
     free_graph(h);
     h->nbrs.clear();
-    const double *me = box.data();
+    const double *me = box;
     for (int p = 0; p < h->size; ++p)
       if (p != h->rank && overlaps(me, &h->boxes[2 * static_cast<size_t>(dim) * p], dim, width))
         h->nbrs.push_back(p);
@@ -387,17 +416,21 @@ mfree_status_t mfree_halo_get_plan(const mfree_halo_t *h, int32_t *n_neighbors, 
 mfree_status_t mfree_halo_exchange(mfree_halo_t *h, int32_t ncomp, double *field, int64_t ld) {
   const char *fn = "mfree_halo_exchange";
   if (!h) return MFREE_ERR_NULL;
-  // Argument checks are local (no agreement round: one neighbourhood collective per
-  // exchange); every rank must pass the same ncomp.
-  if (!h->ready) return record(h->ctx, MFREE_ERR_STATE, fn, "the plan is not set up");
-  if (ncomp < 1) return record(h->ctx, MFREE_ERR_ARG, fn, "ncomp must be >= 1");
-  if (ld < ncomp) return record(h->ctx, MFREE_ERR_ARG, fn, "leading dimension is below ncomp");
-  if (!field && h->n_owned + h->n_ghost > 0) return record(h->ctx, MFREE_ERR_NULL, fn, "field is NULL");
-  try {
+  // Local checks and the packing of the send buffer, then one small all-reduce that
+  // agrees on the status and on ncomp before the neighbourhood collective: a rank that
+  // fails, or passes another ncomp (another message size), makes every rank return
+  // instead of leaving its neighbours waiting for its message.
+  Local l = run_local([&](Local &r) {
+    if (!h->ready) return r.fail(MFREE_ERR_STATE, "the plan is not set up");
+    if (ncomp < 1) return r.fail(MFREE_ERR_ARG, "ncomp must be >= 1, got " + std::to_string(ncomp));
+    if (ld < ncomp)
+      return r.fail(MFREE_ERR_ARG, "leading dimension " + std::to_string(ld) + " is below ncomp " +
+                                       std::to_string(ncomp));
+    if (!field && h->n_owned + h->n_ghost > 0) return r.fail(MFREE_ERR_NULL, "field is NULL");
     const size_t k = h->nbrs.size();
     const int64_t biggest = std::max<int64_t>(static_cast<int64_t>(h->send_idx.size()), h->n_ghost) * ncomp;
     if (biggest > std::numeric_limits<int>::max())
-      return record(h->ctx, MFREE_ERR_ARG, fn, "more than 2^31 doubles in one exchange");
+      return r.fail(MFREE_ERR_ARG, "more than 2^31 doubles in one exchange");
     h->sc.resize(k);
     h->sd.resize(k);
     h->rc.resize(k);
@@ -412,20 +445,22 @@ mfree_status_t mfree_halo_exchange(mfree_halo_t *h, int32_t ncomp, double *field
     h->sbuf.resize(ns * ncomp);
     for (size_t s = 0; s < ns; ++s)
       std::memcpy(&h->sbuf[s * ncomp], field + h->send_idx[s] * ld, sizeof(double) * ncomp);
-    // contiguous ghost items are received in place
-    const bool direct = ld == ncomp;
-    double *dst = field ? field + static_cast<int64_t>(h->n_owned) * ld : nullptr;
-    if (!direct) h->rbuf.resize(static_cast<size_t>(h->n_ghost) * ncomp);
-    double *recv = direct ? dst : h->rbuf.data();
-    if (MPI_Neighbor_alltoallv(h->sbuf.data(), h->sc.data(), h->sd.data(), MPI_DOUBLE, recv, h->rc.data(),
-                               h->rd.data(), MPI_DOUBLE, h->graph) != MPI_SUCCESS)
-      return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Neighbor_alltoallv failed");
-    if (!direct)
-      for (int32_t g = 0; g < h->n_ghost; ++g)
-        std::memcpy(dst + g * ld, &h->rbuf[static_cast<size_t>(g) * ncomp], sizeof(double) * ncomp);
-  } catch (const std::bad_alloc &) {
-    return record(h->ctx, MFREE_ERR_ALLOC, fn, "out of memory");
-  }
+    if (ld != ncomp) h->rbuf.resize(static_cast<size_t>(h->n_ghost) * ncomp);
+  });
+  Loc v[2] = {{static_cast<double>(ncomp), 0}, {-static_cast<double>(ncomp), 0}};
+  mfree_status_t st = agree(h, fn, l, v, 2);
+  if (st == MFREE_SUCCESS) st = same_everywhere(h, fn, "ncomp (the message size)", v[0], v[1]);
+  if (st != MFREE_SUCCESS) return st;
+  // contiguous ghost items are received in place
+  const bool direct = ld == ncomp;
+  double *dst = field ? field + static_cast<int64_t>(h->n_owned) * ld : nullptr;
+  double *recv = direct ? dst : h->rbuf.data();
+  if (MPI_Neighbor_alltoallv(h->sbuf.data(), h->sc.data(), h->sd.data(), MPI_DOUBLE, recv, h->rc.data(),
+                             h->rd.data(), MPI_DOUBLE, h->graph) != MPI_SUCCESS)
+    return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Neighbor_alltoallv failed");
+  if (!direct)
+    for (int32_t g = 0; g < h->n_ghost; ++g)
+      std::memcpy(dst + g * ld, &h->rbuf[static_cast<size_t>(g) * ncomp], sizeof(double) * ncomp);
   return MFREE_SUCCESS;
 }
 
