@@ -1574,6 +1574,17 @@ module mfree
   integer(c_int32_t), target, save :: empty_i32(0)
   real(c_double), target, save :: empty_dbl(0)
 
+  ! The wrappers' argument checks (check_out, view_dbl below), for the adapter modules
+  ! (mfree_mpi), which check their arrays the same way; not meant for hosts. Generic
+  ! names with the mfree_ prefix, so that a host's own check_out does not clash.
+  interface mfree_wrapper_check_out
+    module procedure check_out
+  end interface mfree_wrapper_check_out
+  interface mfree_wrapper_view_dbl
+    module procedure view_dbl
+  end interface mfree_wrapper_view_dbl
+  public :: mfree_wrapper_check_out, mfree_wrapper_view_dbl
+
 contains
 
   ! ==== helpers ========================================================================

@@ -8,10 +8,17 @@
 !> (mfree_halo_create takes one and calls mfree_halo_create_f: the C function with an
 !> MPI_Comm has no portable Fortran interface). Arrays are AoS: x(ld, n), field(ld, n).
 !> Fortran hosts give global ids (the C API's numbering by the plan, ids = NULL, is C only).
+!>
+!> The typed wrappers check every caller array as module mfree's do (its own checks,
+!> mfree_wrapper_check_out and mfree_wrapper_view_dbl): an array too short for what the C
+!> function reads or writes, or an output that is not contiguous, is MFREE_ERR_ARG with
+!> nothing read or written. In the collective calls (setup, exchange) a rank whose check
+!> fails still takes part: mfree_halo_set_pending_error hands its failure to the C call,
+!> which returns it on every rank, so no rank is left waiting.
 module mfree_mpi
   use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_ptr, &
-    c_null_ptr
-  use mfree, only: mfree_context
+    c_null_ptr, c_loc, c_f_pointer
+  use mfree, only: mfree_context, MFREE_SUCCESS, mfree_wrapper_check_out, mfree_wrapper_view_dbl
   implicit none
   private
 
@@ -80,6 +87,19 @@ module mfree_mpi
       integer(c_int64_t), intent(out) :: n_recv
     end function mfree_halo_get_plan_c
 
+    integer(c_int) function mfree_halo_get_context_c(halo, ctx) &
+        bind(C, name="mfree_halo_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: halo
+      type(c_ptr), intent(out) :: ctx
+    end function mfree_halo_get_context_c
+
+    integer(c_int) function mfree_halo_set_pending_error_c(halo) &
+        bind(C, name="mfree_halo_set_pending_error")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: halo
+    end function mfree_halo_set_pending_error_c
+
     integer(c_int) function mfree_halo_exchange_c(halo, ncomp, field, ld) &
         bind(C, name="mfree_halo_exchange")
       import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
@@ -93,9 +113,13 @@ module mfree_mpi
   public :: mfree_halo_create_f_c, mfree_halo_destroy_c, mfree_halo_setup_c
   public :: mfree_halo_get_size_c, mfree_halo_get_global_ids_c
   public :: mfree_halo_get_global_offset_c, mfree_halo_get_plan_c, mfree_halo_exchange_c
+  public :: mfree_halo_get_context_c, mfree_halo_set_pending_error_c
   public :: mfree_halo_create, mfree_halo_create_f, mfree_halo_destroy, mfree_halo_setup
   public :: mfree_halo_get_size, mfree_halo_get_global_ids, mfree_halo_get_global_offset
-  public :: mfree_halo_get_plan, mfree_halo_exchange
+  public :: mfree_halo_get_plan, mfree_halo_exchange, mfree_halo_get_context
+  public :: mfree_halo_set_pending_error
+
+  real(c_double), target, save :: empty_dbl(0)
 
 contains
 
@@ -122,15 +146,30 @@ contains
   end function mfree_halo_destroy
 
   !> Ghost layer and plan of n_owned particles x(ld, n_owned) with global ids(n_owned).
-  !> Collective.
+  !> Collective. x (any rank, read) holds at least ld * n_owned values and ids n_owned,
+  !> else MFREE_ERR_ARG on every rank, naming this one.
   integer(c_int) function mfree_halo_setup(halo, n_owned, x, ld, ids, width) result(st)
     type(mfree_halo), intent(in) :: halo
     integer(c_int32_t), intent(in) :: n_owned
-    real(c_double), intent(in) :: x(*)
+    real(c_double), intent(in), target :: x(..)
     integer(c_int64_t), intent(in) :: ld
-    integer(c_int64_t), intent(in) :: ids(*)
+    integer(c_int64_t), intent(in), contiguous :: ids(:)
     real(c_double), intent(in) :: width
-    st = mfree_halo_setup_c(halo%ptr, n_owned, x, ld, ids, width)
+    character(len=*), parameter :: fn = 'mfree_halo_setup'
+    real(c_double), pointer :: px(:)
+    real(c_double), allocatable, target :: tx(:)
+    integer(c_int64_t) :: n
+    n = max(int(n_owned, c_int64_t), 0_c_int64_t)
+    st = mfree_wrapper_check_out(halo_ctx(halo), fn, 'x', .true., size(x, kind=c_int64_t), ld * n)
+    if (st == MFREE_SUCCESS) &
+      st = mfree_wrapper_check_out(halo_ctx(halo), fn, 'ids', .true., size(ids, kind=c_int64_t), n)
+    if (st /= MFREE_SUCCESS) then
+      if (mfree_halo_set_pending_error_c(halo%ptr) /= MFREE_SUCCESS) return
+      st = mfree_halo_setup_c(halo%ptr, n_owned, empty_dbl, ld, ids, width)
+      return
+    end if
+    call mfree_wrapper_view_dbl(x, tx, px)
+    st = mfree_halo_setup_c(halo%ptr, n_owned, px, ld, ids, width)
   end function mfree_halo_setup
 
   integer(c_int) function mfree_halo_get_size(halo, n_owned, n_ghost) result(st)
@@ -139,10 +178,17 @@ contains
     st = mfree_halo_get_size_c(halo%ptr, n_owned, n_ghost)
   end function mfree_halo_get_size
 
-  !> ids(n_owned + n_ghost): owned first, then the ghosts.
+  !> ids(n_owned + n_ghost): owned first, then the ghosts; contiguous and at least that
+  !> long, else MFREE_ERR_ARG with nothing written.
   integer(c_int) function mfree_halo_get_global_ids(halo, ids) result(st)
     type(mfree_halo), intent(in) :: halo
-    integer(c_int64_t), intent(out) :: ids(*)
+    integer(c_int64_t), intent(out) :: ids(:)
+    integer(c_int32_t) :: no, ng
+    st = mfree_halo_get_size_c(halo%ptr, no, ng)
+    if (st == MFREE_SUCCESS) &
+      st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_get_global_ids', 'ids', is_contiguous(ids), &
+                                   size(ids, kind=c_int64_t), int(no, c_int64_t) + ng)
+    if (st /= MFREE_SUCCESS) return
     st = mfree_halo_get_global_ids_c(halo%ptr, ids)
   end function mfree_halo_get_global_ids
 
@@ -159,14 +205,54 @@ contains
     st = mfree_halo_get_plan_c(halo%ptr, n_neighbors, n_send, n_recv)
   end function mfree_halo_get_plan
 
-  !> field(ld, n_owned + n_ghost): components 1..ncomp of the ghost columns from their
-  !> owners. Collective.
+  !> field(ld, n_owned + n_ghost) (any rank: h(n) for a scalar): components 1..ncomp of
+  !> the ghost columns from their owners. Collective. field must be contiguous and hold
+  !> (n_owned + n_ghost - 1) * ld + ncomp values, else MFREE_ERR_ARG on every rank, naming
+  !> this one, with nothing written.
   integer(c_int) function mfree_halo_exchange(halo, ncomp, field, ld) result(st)
     type(mfree_halo), intent(in) :: halo
     integer(c_int32_t), intent(in) :: ncomp
-    real(c_double), intent(inout) :: field(*)
+    real(c_double), intent(inout), target :: field(..)
     integer(c_int64_t), intent(in) :: ld
-    st = mfree_halo_exchange_c(halo%ptr, ncomp, field, ld)
+    real(c_double), pointer :: pf(:)
+    integer(c_int32_t) :: no, ng
+    integer(c_int64_t) :: need
+    st = MFREE_SUCCESS
+    ! (a plan that is not set up, or a bad ncomp or ld: the C call says so on every rank)
+    if (mfree_halo_get_size_c(halo%ptr, no, ng) == MFREE_SUCCESS .and. ncomp >= 1 .and. ld >= ncomp) then
+      need = 0
+      if (no + ng > 0) need = (int(no, c_int64_t) + ng - 1) * ld + ncomp
+      st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_exchange', 'field', is_contiguous(field), &
+                                   size(field, kind=c_int64_t), need)
+    end if
+    pf => empty_dbl
+    if (st /= MFREE_SUCCESS) then
+      if (mfree_halo_set_pending_error_c(halo%ptr) /= MFREE_SUCCESS) return
+    else if (size(field) > 0) then
+      call c_f_pointer(c_loc(field), pf, [size(field)])
+    end if
+    st = mfree_halo_exchange_c(halo%ptr, ncomp, pf, ld)
   end function mfree_halo_exchange
+
+  !> Typed wrapper of mfree_halo_get_context (mfree_mpi.h): the plan's context, borrowed.
+  integer(c_int) function mfree_halo_get_context(halo, ctx) result(st)
+    type(mfree_halo), intent(in) :: halo
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_halo_get_context_c(halo%ptr, ctx%ptr)
+  end function mfree_halo_get_context
+
+  !> Typed wrapper of mfree_halo_set_pending_error (mfree_mpi.h).
+  integer(c_int) function mfree_halo_set_pending_error(halo) result(st)
+    type(mfree_halo), intent(in) :: halo
+    st = mfree_halo_set_pending_error_c(halo%ptr)
+  end function mfree_halo_set_pending_error
+
+  !> The context of a plan (NULL for a NULL handle).
+  type(c_ptr) function halo_ctx(halo) result(ctx)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int) :: st
+    ctx = c_null_ptr
+    st = mfree_halo_get_context_c(halo%ptr, ctx)
+  end function halo_ctx
 
 end module mfree_mpi

@@ -2,6 +2,10 @@
 !> particles per rank (x_k = k / n, global id k), a plan on MPI_COMM_WORLD of `use mpi`,
 !> the ghosts' ids and exchanged positions equal their owners' (x = id / n), the global
 !> offset is the exclusive scan, and a plan that is not set up answers MFREE_ERR_STATE.
+!> The wrappers' array checks: an ids array too short for get_global_ids is MFREE_ERR_ARG
+!> with nothing written; in the collective calls an array too short (or a strided field)
+!> on one rank is MFREE_ERR_ARG on every rank, naming that rank, with no ghost written and
+!> no rank left waiting; a scalar field h(n) is exchanged as it is.
 program t167_mpi_halo_f
   use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double
   use mpi
@@ -15,8 +19,13 @@ program t167_mpi_halo_f
   integer(c_int64_t), allocatable :: ids(:)
   integer(c_int32_t) :: no, ng, nn
   integer(c_int64_t) :: off, total, ns, nr
-  integer :: ierr, rank, nprocs, k, bad, allbad
+  integer(c_int) :: st_
+  integer :: ierr, rank, nprocs, k, bad, allbad, last
   real(c_double) :: n
+  integer(c_int64_t), allocatable :: short_ids(:)
+  real(c_double), allocatable :: h(:), f(:, :)
+  type(mfree_context) :: hctx
+  character(len=16) :: who
 
   call MPI_Init(ierr)
   call MPI_Comm_rank(MPI_COMM_WORLD, rank, ierr)
@@ -49,6 +58,60 @@ program t167_mpi_halo_f
   call check(mfree_halo_get_plan(halo, nn, ns, nr) == MFREE_SUCCESS, 'plan')
   call check(nr == ng .and. ns == ng .and. nn == merge(1, 0, rank > 0) + merge(1, 0, rank < nprocs - 1), &
              'plan sizes')
+
+  ! ---- the wrappers' array checks ----
+  last = nprocs - 1
+  write (who, '(a,i0,a)') 'rank ', last, ':'
+  call check(mfree_halo_get_context(halo, hctx) == MFREE_SUCCESS, 'get_context')
+  allocate (short_ids(no + ng - 1))
+  short_ids = -9
+  if (no + ng > 0) then
+    call check(mfree_halo_get_global_ids(halo, short_ids) == MFREE_ERR_ARG, 'ids one short')
+    call check(index(mfree_last_error(hctx), 'ids holds') > 0, 'ids message: '//mfree_last_error(hctx))
+    call check(all(short_ids == -9), 'nothing written into a short ids')
+  end if
+  ! a field one item short on the last rank: every rank fails, naming it, no ghost written
+  allocate (f(2, no + ng))
+  do k = 1, no + ng
+    f(:, k) = merge(real(ids(k), c_double), -1.0_c_double, k <= no)
+  end do
+  if (rank == last) then
+    st_ = mfree_halo_exchange(halo, 2_c_int32_t, f(:, 1:no + ng - 1), 2_c_int64_t)
+  else
+    st_ = mfree_halo_exchange(halo, 2_c_int32_t, f, 2_c_int64_t)
+  end if
+  call check(st_ == MFREE_ERR_ARG, 'short field on the last rank: MFREE_ERR_ARG everywhere')
+  call check(index(mfree_last_error(hctx), trim(who)) > 0 .and. &
+             index(mfree_last_error(hctx), 'field holds') > 0, 'short field message: '//mfree_last_error(hctx))
+  call check(all(f(:, no + 1:) == -1.0_c_double), 'no ghost written after a short field')
+  ! a strided field (every second column of a wider array) on rank 0
+  if (rank == 0) then
+    st_ = mfree_halo_exchange(halo, 1_c_int32_t, f(1, :), 2_c_int64_t)
+  else
+    st_ = mfree_halo_exchange(halo, 1_c_int32_t, f, 2_c_int64_t)
+  end if
+  call check(st_ == MFREE_ERR_ARG, 'strided field on rank 0: MFREE_ERR_ARG everywhere')
+  call check(index(mfree_last_error(hctx), 'rank 0:') > 0 .and. &
+             index(mfree_last_error(hctx), 'not contiguous') > 0, 'strided field message: '//mfree_last_error(hctx))
+  call check(all(f(:, no + 1:) == -1.0_c_double), 'no ghost written after a strided field')
+  ! then the whole field, and a scalar h(n): the owners' values
+  call check(mfree_halo_exchange(halo, 2_c_int32_t, f, 2_c_int64_t) == MFREE_SUCCESS, 'exchange after the faults')
+  allocate (h(no + ng))
+  h = -1
+  h(1:no) = 2 * real(ids(1:no), c_double)
+  call check(mfree_halo_exchange(halo, 1_c_int32_t, h, 1_c_int64_t) == MFREE_SUCCESS, 'scalar exchange')
+  do k = no + 1, no + ng
+    call check(f(1, k) == real(ids(k), c_double) .and. f(2, k) == real(ids(k), c_double), 'field at a ghost')
+    call check(h(k) == 2 * real(ids(k), c_double), 'scalar at a ghost')
+  end do
+  ! ids one short on rank 0 at setup: every rank fails, naming rank 0; the plan recovers
+  st_ = mfree_halo_setup(halo, no, x, 1_c_int64_t, ids(1:merge(no - 1, no + 0, rank == 0)), 3.5_c_double / n)
+  call check(st_ == MFREE_ERR_ARG, 'setup with short ids on rank 0: MFREE_ERR_ARG everywhere')
+  call check(index(mfree_last_error(hctx), 'rank 0:') > 0 .and. &
+             index(mfree_last_error(hctx), 'ids holds') > 0, 'short ids message: '//mfree_last_error(hctx))
+  call check(mfree_halo_setup(halo, no, x, 1_c_int64_t, ids(1:no), 3.5_c_double / n) == MFREE_SUCCESS, &
+             'setup again')
+
   call check(mfree_halo_destroy(halo) == MFREE_SUCCESS, 'destroy')
   call check(mfree_context_destroy(ctx) == MFREE_SUCCESS, 'context destroy')
   call MPI_Allreduce(bad, allbad, 1, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD, ierr)

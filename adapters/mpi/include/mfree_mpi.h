@@ -158,6 +158,29 @@ MFREE_MPI_API mfree_status_t mfree_halo_get_plan(const mfree_halo_t *halo, int32
                                                  int64_t *n_send, int64_t *n_recv);
 
 /**
+ * The context a plan was created on, for bindings that check arguments themselves.
+ * @param[in]  halo  the plan
+ * @param[out] ctx   its context, borrowed: the plan keeps it alive; never destroy it
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (without a message) for a NULL handle or output
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_get_context(const mfree_halo_t *halo, mfree_context_t **ctx);
+
+/**
+ * Hand a failure found on this rank before a collective call to that call, for bindings
+ * that check what the C API cannot see (the Fortran module: an array too short): the
+ * last failure recorded on the plan's context (its status and message, e.g. by
+ * mfree_context_set_error) becomes this rank's outcome of the next mfree_halo_setup or
+ * mfree_halo_exchange on the plan. That call reads and writes none of its arrays, takes
+ * part in the agreement, and returns the status on every rank with this rank's message
+ * ("rank R: <message>", a leading "mfree_...: " of the message dropped), so that no
+ * rank waits for one that gave up. Not collective.
+ * @param[in] halo  the plan
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle; MFREE_ERR_STATE when the
+ *         context holds no failure (nothing is handed over)
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_set_pending_error(mfree_halo_t *halo);
+
+/**
  * Forward exchange: the owners' values of a per-particle field written into the ghost
  * items. Collective: one MPI_Allreduce of three (value, rank) pairs that agrees on the
  * status and on ncomp, then one MPI_Neighbor_alltoallv; no allocation once the buffers

@@ -22,6 +22,8 @@ struct mfree_halo {
   int rank = 0, size = 1, dim = 0;
   bool ready = false;
   bool ids_checked = false;  // the owned ids in ids[0, n_owned) passed the global check
+  mfree_status_t pending = MFREE_SUCCESS;  // mfree_halo_set_pending_error: the next
+  char pending_msg[512] = {0};             // collective call's outcome on this rank
   int32_t n_owned = 0, n_ghost = 0;
   int64_t offset = 0, total = 0;
   std::vector<int> nbrs;                          // neighbour ranks, ascending
@@ -119,6 +121,21 @@ mfree_status_t same_everywhere(mfree_halo_t *h, const char *fn, const char *what
   return record(h->ctx, MFREE_ERR_ARG, fn, buf);
 }
 
+// A collective call's local step: the failure a binding handed over with
+// mfree_halo_set_pending_error (taken: it is reported once), else body's outcome.
+template <class Body>
+Local first_step(mfree_halo_t *h, Body &&body) noexcept {
+  if (h->pending == MFREE_SUCCESS) return run_local(body);
+  Local l;
+  l.st = h->pending;
+  h->pending = MFREE_SUCCESS;
+  try {
+    l.msg = h->pending_msg;
+  } catch (...) {
+  }
+  return l;
+}
+
 // An MPI call inside a local step: its failure becomes MFREE_ERR_INTERNAL.
 void mpi_ok(Local &l, int rc, const char *what) {
   if (rc != MPI_SUCCESS) l.fail(MFREE_ERR_INTERNAL, std::string(what) + " failed");
@@ -209,7 +226,7 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
   const int dim = h->dim;
   // 1. arguments and this rank's bounding box (empty: lo = +inf, hi = -inf)
   double box[6] = {0, 0, 0, 0, 0, 0};  // (dim <= 3: checked at create)
-  Local l = run_local([&](Local &r) {
+  Local l = first_step(h, [&](Local &r) {
     if (n_owned < 0) return r.fail(MFREE_ERR_ARG, "n_owned " + std::to_string(n_owned) + " is negative");
     if (ld < dim) return r.fail(MFREE_ERR_ARG, "leading dimension " + std::to_string(ld) + " is below dim");
     if (!std::isfinite(width) || width <= 0.0)
@@ -378,6 +395,27 @@ mfree_status_t mfree_halo_setup(mfree_halo_t *h, int32_t n_owned, const double *
   return MFREE_SUCCESS;
 }
 
+mfree_status_t mfree_halo_get_context(const mfree_halo_t *h, mfree_context_t **ctx) {
+  if (!h || !ctx) return MFREE_ERR_NULL;
+  *ctx = h->ctx;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_set_pending_error(mfree_halo_t *h) {
+  if (!h) return MFREE_ERR_NULL;
+  mfree_status_t code = MFREE_SUCCESS;
+  char msg[sizeof h->pending_msg] = {0};
+  mfree_context_get_last_error(h->ctx, &code, msg, sizeof msg);
+  if (code >= 0)
+    return record(h->ctx, MFREE_ERR_STATE, "mfree_halo_set_pending_error", "the context holds no failure to hand over");
+  // "fn: reason" as mfree_context_set_error got it: the collective call adds its own name
+  const char *colon = std::strstr(msg, ": ");
+  const char *reason = colon && std::strncmp(msg, "mfree_", 6) == 0 ? colon + 2 : msg;
+  h->pending = code;
+  std::snprintf(h->pending_msg, sizeof h->pending_msg, "%s", reason);
+  return MFREE_SUCCESS;
+}
+
 mfree_status_t mfree_halo_get_size(const mfree_halo_t *h, int32_t *n_owned, int32_t *n_ghost) {
   if (!h) return MFREE_ERR_NULL;
   if (!h->ready) return record(h->ctx, MFREE_ERR_STATE, "mfree_halo_get_size", "the plan is not set up");
@@ -420,7 +458,7 @@ mfree_status_t mfree_halo_exchange(mfree_halo_t *h, int32_t ncomp, double *field
   // agrees on the status and on ncomp before the neighbourhood collective: a rank that
   // fails, or passes another ncomp (another message size), makes every rank return
   // instead of leaving its neighbours waiting for its message.
-  Local l = run_local([&](Local &r) {
+  Local l = first_step(h, [&](Local &r) {
     if (!h->ready) return r.fail(MFREE_ERR_STATE, "the plan is not set up");
     if (ncomp < 1) return r.fail(MFREE_ERR_ARG, "ncomp must be >= 1, got " + std::to_string(ncomp));
     if (ld < ncomp)
