@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Build and run a host program against an *installed* adapter library libmfree_ADAPTER
-# (sundials, suitesparse): with pkg-config (shared, and the archives forced) and with
-# find_package(mfree). The host program is tests/ADAPTER/consumer; it prints one
+# (sundials, suitesparse, mpi, petsc): with pkg-config (shared, and the archives forced)
+# and with find_package(mfree COMPONENTS ADAPTER), which must also refuse an unknown
+# component by name. The host program is tests/ADAPTER/consumer; it prints one
 # "...: ok" line per solver or integrator, and its CMake project builds
 # BIN_PREFIX_consumer_shared and BIN_PREFIX_consumer_static. EXTRA_LIBS are linked after
 # the pkg-config flags (SUNDIALS ships no pkg-config file: its host links it itself).
@@ -95,7 +96,29 @@ if readelf -d "$scratch/pc_static" | grep -q 'NEEDED.*\[libmfree'; then
 fi
 run pkgconfig-static "$scratch/pc_static"
 
-step "find_package(mfree): mfree::$lib and mfree::${lib}_static"
+step "find_package(mfree COMPONENTS $adapter), and an unknown component refused by name"
+comp=$scratch/components
+mkdir -p "$comp"
+cat >"$comp/CMakeLists.txt" <<EOF
+cmake_minimum_required(VERSION 3.16)
+project(mfree_components LANGUAGES C)
+find_package(mfree REQUIRED COMPONENTS \${WANT})
+foreach(t mfree::$lib mfree::${lib}_static)
+  if(NOT TARGET \${t})
+    message(FATAL_ERROR "find_package(mfree COMPONENTS $adapter) gave no \${t}")
+  endif()
+endforeach()
+EOF
+"$cmake_cmd" -S "$comp" -B "$comp/ok" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_C_COMPILER="$cc" \
+  -DWANT="$adapter" >"$comp/ok.log" 2>&1 || { cat "$comp/ok.log" >&2; fail "find_package(mfree COMPONENTS $adapter)"; }
+if "$cmake_cmd" -S "$comp" -B "$comp/bad" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_C_COMPILER="$cc" \
+  "-DWANT=$adapter;nonesuch" >"$comp/bad.log" 2>&1; then
+  fail "find_package(mfree COMPONENTS $adapter nonesuch) succeeded"
+fi
+grep -q "unknown component 'nonesuch'" "$comp/bad.log" ||
+  { cat "$comp/bad.log" >&2; fail "the unknown component is not named"; }
+
+step "find_package(mfree COMPONENTS $adapter): mfree::$lib and mfree::${lib}_static"
 "$cmake_cmd" -S "$consumer" -B "$scratch/cmake" -DCMAKE_PREFIX_PATH="$prefix" \
   -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_RPATH="$libdir" >"$scratch/cmake.log" 2>&1 ||
   { cat "$scratch/cmake.log" >&2; fail "configure the CMake consumer"; }
