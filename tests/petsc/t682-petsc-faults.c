@@ -1,7 +1,8 @@
 /* t682 (mpirun -np 1..3): faults of libmfree_petsc. A bad argument or a failed setup on
  * one rank makes every rank return the same documented status (the failing rank's
  * message there, "rank R failed: ..." on the others) without a hang (the test's timeout
- * bounds it), and a failed call changes nothing: the previous setup still solves. */
+ * bounds it), and a failed call changes nothing: the previous setup still solves.
+ * Coordinates for the near null space on some ranks only: every rank refuses the setup. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -146,6 +147,21 @@ static void faults(void **state) {
   expect_all(ctx, mfree_petsc_setup(pk, s.as, 2, l.nlocal, l.nowned, l.gid), MFREE_ERR_MISMATCH, 0, "coordinates",
              "coordinates of other nodes");
   assert_ok(ctx, mfree_petsc_set_coordinates(pk, 2, l.nowned, s.x));
+
+  /* coordinates on rank 0 only, while every rank owns nodes: the near null space is
+   * built on every rank or on none, so every rank refuses, naming one without them */
+  if (size_ > 1) {
+    mfree_petsc_t *pk2 = NULL;
+    assert_ok(ctx, mfree_petsc_create(ctx, PETSC_COMM_WORLD, &pk2));
+    if (rank_ == 0) assert_ok(ctx, mfree_petsc_set_coordinates(pk2, 2, l.nowned, s.x));
+    const mfree_status_t st = mfree_petsc_setup(pk2, s.as, 2, l.nlocal, l.nowned, l.gid);
+    char msg[1024] = "";
+    mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+    assert_int_equal(st, MFREE_ERR_ARG);
+    if (!strstr(msg, "rank 1 owns nodes but gave no coordinates") || !strstr(msg, "rank 0 gave them"))
+      fail_msg("coordinates on rank 0 only: message '%s'", msg);
+    assert_ok(ctx, mfree_petsc_destroy(&pk2));
+  }
 
   /* a good setup, then failures that change nothing */
   assert_ok(ctx, mfree_petsc_set_options_prefix(pk, "t682_"));

@@ -111,7 +111,8 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_set_options_prefix(mfree_petsc_t *pk,
  * Coordinates of the owned nodes, for the near null space of elasticity (the rigid-body
  * modes, MatNullSpaceCreateRigidBody) that algebraic multigrid uses. Copied; takes
  * effect at the next setup, and only when the number of components per node equals dim.
- * Not collective.
+ * Not collective, but every rank with owned nodes gives them or none does (else the
+ * next setup returns MFREE_ERR_ARG on every rank, naming a rank without them).
  * @param[in] pk      the system
  * @param[in] dim     2 or 3 (else MFREE_ERR_ARG)
  * @param[in] nowned  number of owned nodes (must match setup's, else setup returns
@@ -137,7 +138,8 @@ MFREE_PETSC_API mfree_status_t mfree_petsc_set_coordinates(mfree_petsc_t *pk, in
  *                    particles, without Lagrange multipliers (its unknowns must be
  *                    nlocal * ncomp, else MFREE_ERR_MISMATCH)
  * @param[in] ncomp   components per node: 1 (Laplace, mass) or the dimension
- *                    (elasticity); else MFREE_ERR_ARG
+ *                    (elasticity), the same on every rank; else MFREE_ERR_ARG on every
+ *                    rank
  * @param[in] nlocal  particles of the set (owned first, then ghosts), >= nowned
  * @param[in] nowned  the owned nodes: particles 0 .. nowned - 1 (>= 0)
  * @param[in] gids    nlocal global ids (borrowed for the call), each in [0, 2^31 / ncomp)

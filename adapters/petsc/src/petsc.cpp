@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <new>
@@ -368,6 +369,33 @@ mfree_status_t mfree_petsc_setup(mfree_petsc_t *pk, mfree_assembler_t *as, int32
     mfree_matrix_destroy(&K);
     return st;
   }
+  // Arguments that must be common, agreed in one all-reduce of (value, rank) pairs:
+  // ncomp (the unknowns per node of every row), and the near null space, which is built
+  // collectively on every rank or on none: from the coordinates that every rank with
+  // owned nodes gave for this ncomp, or from none (a rank without owned nodes takes part
+  // either way).
+  bool near_null = false;
+  {
+    const int has = pk->cdim > 1 && pk->cdim == ncomp && pk->cn == nowned ? 1 : 0;
+    const int in[8] = {ncomp, pk->rank, -ncomp, pk->rank, nowned > 0 ? has : 1, pk->rank, -has, pk->rank};
+    int out[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    MPI_Allreduce(in, out, 4, MPI_2INT, MPI_MINLOC, pk->comm);
+    char msg[320] = "";
+    if (out[0] != -out[2])
+      std::snprintf(msg, sizeof msg,
+                    "ranks disagree on ncomp: rank %d passes %d, rank %d passes %d (every rank must pass the same)",
+                    out[1], out[0], out[3], -out[2]);
+    else if (out[6] == -1 && out[4] == 0)
+      std::snprintf(msg, sizeof msg,
+                    "rank %d owns nodes but gave no coordinates for ncomp %d (mfree_petsc_set_coordinates) while "
+                    "rank %d gave them: every rank with owned nodes gives them, or none does",
+                    out[5], ncomp, out[7]);
+    if (msg[0]) {
+      mfree_matrix_destroy(&K);
+      return record(pk->ctx, MFREE_ERR_ARG, fn, msg);
+    }
+    near_null = out[6] == -1;
+  }
   // 2. numbering: owned nodes in rank order; ghosts through an application ordering
   PetscInt first = 0, total = 0;
   std::vector<PetscInt> node_row(static_cast<size_t>(nlocal));
@@ -439,7 +467,7 @@ mfree_status_t mfree_petsc_setup(mfree_petsc_t *pk, mfree_assembler_t *as, int32
     MFREE_PETSC_CALL(MatSetOption(A, MAT_NO_OFF_PROC_ENTRIES, PETSC_TRUE));
     MFREE_PETSC_CALL(MatSetOption(A, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
     MFREE_PETSC_CALL(MatCreateVecs(A, &x, &b));
-    if (pk->cn == nowned && pk->cdim == ncomp && ncomp > 1) {
+    if (near_null) {  // (a rank without owned nodes adds no rows)
       Vec c = nullptr;
       MatNullSpace nsp = nullptr;
       MFREE_PETSC_CALL(VecCreateMPI(pk->comm, nrows, PETSC_DETERMINE, &c));
