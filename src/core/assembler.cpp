@@ -145,7 +145,7 @@ void Assembler::check_points(int32_t npts, const double *x, const double *w, con
 }
 
 void Assembler::read_points(int32_t npts, const double *x, int layout, int64_t ld,
-                            std::vector<double> &out) const {
+                            HVec<double> &out) const {
   if (layout != MFREE_LAYOUT_AOS && layout != MFREE_LAYOUT_SOA) throw Error(MFREE_ERR_ARG, "unknown layout");
   if (ld < (layout == MFREE_LAYOUT_AOS ? dim_ : npts)) throw Error(MFREE_ERR_ARG, "leading dimension too small");
   check_extent(npts, dim_, layout, ld, "the points");
@@ -173,7 +173,7 @@ void Assembler::set_quadrature_cells(const double *lo, const double *hi, const i
   }
   std::vector<double> g, gw;
   gauss_legendre(ngauss, g, gw);
-  std::vector<double> x, w;
+  HVec<double> x, w;
   int64_t total = 1;
   for (int c = 0; c < dim_; ++c) total *= static_cast<int64_t>(ncells[c]) * ngauss;
   if (total > (int64_t(1) << 31) - 1) throw Error(MFREE_ERR_ARG, "too many quadrature points");
@@ -205,7 +205,7 @@ void Assembler::set_quadrature_points(int32_t npts, const double *x, int layout,
   check_points(npts, x, w, "quadrature");
   if (npts > 0 && !w) throw Error(MFREE_ERR_NULL, "quadrature weights are NULL");
   // both copies made before either is replaced: running out of memory leaves the old pair
-  std::vector<double> pts, wts;
+  HVec<double> pts, wts;
   read_points(npts, x, layout, ld, pts);
   wts.assign(w, w + npts);
   qx_.swap(pts);
@@ -360,6 +360,7 @@ void Assembler::set_consistent_integration(int32_t npts, const double *x, int la
     s->w.assign(w, w + npts);
     s->normals.assign(normals, normals + static_cast<size_t>(npts) * dim_);
   }
+  psets_.reserve(psets_.size() + 1);  // the last allocation: nothing below may fail
   psets_.erase(std::remove_if(psets_.begin(), psets_.end(), [](const std::unique_ptr<PointSet> &q) { return q->kind == 5; }),
                psets_.end());
   if (s) psets_.push_back(std::move(s));
@@ -463,13 +464,14 @@ void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, in
       fe.bmax.push_back(xmax[d] + pad);
     }
   }
-  fe_ = std::move(fe);
   NodeSet ns;
   ns.kind = 3;
   ns.nodes.assign(gu, gu + ngu);
   ns.mask = mask;
   ns.fn = g;
   ns.user = user;
+  nsets_.reserve(nsets_.size() + 1);  // the last allocation: nothing below may fail
+  fe_ = std::move(fe);
   nsets_.push_back(std::move(ns));
   setup_done_ = false;
 }
@@ -541,14 +543,14 @@ bool Assembler::fe_shape(int32_t e, const double *x, double *N, double *dN) cons
   return true;
 }
 
-void Assembler::fill_qtable(const Approximant &a, QTable &t, const std::vector<double> *w,
-                            const std::vector<double> *pts) const {
+void Assembler::fill_qtable(const Approximant &a, QTable &t, const HVec<double> *w,
+                            const HVec<double> *pts) const {
   const int dim = dim_;
   const int32_t nq = a.num_sites();
   t.w.resize(nq);
   for (int32_t q = 0; q < nq; ++q) t.w[q] = w ? (*w)[q] : ps_->volume(q);
   if (pts) {
-    t.x = *pts;
+    t.x.assign(pts->begin(), pts->end());
   } else {
     t.x.resize(static_cast<size_t>(nq) * dim);
     for (int32_t q = 0; q < nq; ++q)
@@ -565,7 +567,7 @@ void Assembler::fill_qtable(const Approximant &a, QTable &t, const std::vector<d
 // R = sum of the FE functions of the interface nodes; at nodal quadrature points on the
 // essential boundary the functions are the FE ones, the node's volume split among its
 // elements (the Figure 2 procedure).
-void Assembler::blend_qtable(QTable &t, const std::vector<double> *pts) const {
+void Assembler::blend_qtable(QTable &t, const HVec<double> *pts) const {
   const int npe = fe_.npe;
   const int32_t nelem = static_cast<int32_t>(fe_.conn.size() / npe);
   QTable out;
@@ -715,7 +717,7 @@ void Assembler::build_qtables() {
 // whatever the quadrature (nodal, or the layer's strip sampled at its two edges), and
 // the integration error of linear stress fields is removed too. A support whose moment
 // matrix is singular (too few points) gets the constant correction only.
-void Assembler::correct_test_gradients(QTable &t, const QTable &b, const std::vector<double> &normals) const {
+void Assembler::correct_test_gradients(QTable &t, const QTable &b, const HVec<double> &normals) const {
   const int dim = dim_, np = 1 + dim;
   const int32_t n = ps_->size();
   std::vector<double> M(static_cast<size_t>(n) * np * np, 0.0), R(static_cast<size_t>(n) * np * dim, 0.0);
@@ -820,7 +822,7 @@ ApproxConfig Assembler::values_config(const ApproxConfig &c) const {
   return v;
 }
 
-std::vector<double> Assembler::point_supports(const std::vector<double> &pts) const {
+std::vector<double> Assembler::point_supports(const HVec<double> &pts) const {
   const int32_t n = ps_->size(), m = static_cast<int32_t>(pts.size() / dim_);
   if (!ps_->has_support() || n == 0) return {mean_h()};
   double hmin = ps_->h(0), hmax = hmin;
@@ -867,7 +869,7 @@ std::vector<double> Assembler::point_supports(const std::vector<double> &pts) co
   return h;
 }
 
-std::unique_ptr<Approximant> Assembler::make(const ApproxConfig &cfg, const std::vector<double> *pts) const {
+std::unique_ptr<Approximant> Assembler::make(const ApproxConfig &cfg, const HVec<double> *pts) const {
   auto a = std::make_unique<Approximant>(ps_, cfg);
   if (pts) {
     // Supports of quadrature and boundary points: the particles' supports averaged around

@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "alloc.hpp"
 #include "approximant.hpp"
 #include "error.hpp"
 #include "matrix.hpp"
@@ -69,7 +70,7 @@ class Assembler {
  private:
   struct PointSet {  // boundary points with weights
     int kind = 0;    // 1 traction, 2 penalty, 3 Lagrange, 4 Nitsche, 5 boundary for VCI
-    std::vector<double> x, w, normals;
+    HVec<double> x, w, normals;  // (copies of host data come from the context's hook)
     int32_t mask = 0;
     mfree_field_fn fn = nullptr;
     void *user = nullptr;
@@ -79,8 +80,8 @@ class Assembler {
   struct BlendedSet;  // per point set: blended test/trial tables (defined below)
   struct NodeSet {
     int kind = 0;  // 1 Dirichlet rows, 2 traction rows, 3 identity rows (FE layer nodes)
-    std::vector<int32_t> nodes;
-    std::vector<double> normals;
+    HVec<int32_t> nodes;
+    HVec<double> normals;
     int32_t mask = 0;
     mfree_field_fn fn = nullptr;
     void *user = nullptr;
@@ -110,36 +111,36 @@ class Assembler {
   };
   struct FeLayer {
     int npe = 0;                  // 3 (triangles) or 4 (quadrilaterals); 0: none
-    std::vector<int32_t> conn;    // nelem * npe particle indices
-    std::vector<char> on_gu;      // per particle: node on the essential boundary
-    std::vector<char> in_layer;   // per particle: node of some layer element
-    std::vector<double> bmin, bmax;  // element bounding boxes
+    HVec<int32_t> conn;      // nelem * npe particle indices
+    HVec<char> on_gu;        // per particle: node on the essential boundary
+    HVec<char> in_layer;     // per particle: node of some layer element
+    HVec<double> bmin, bmax;  // element bounding boxes
   };
   void build_qtables();
   // Second-order VCI of the test gradients in t from the boundary values b with normals.
-  void correct_test_gradients(QTable &t, const QTable &b, const std::vector<double> &normals) const;
+  void correct_test_gradients(QTable &t, const QTable &b, const HVec<double> &normals) const;
   // The test table of the assembly: its own when the test functions differ from the
   // trial functions or their gradients were corrected, else the trial table.
   const QTable &test_table() const { return own_test_table_ ? qtest_ : qtrial_; }
   // Copy an approximant's rows; weights w (NULL: the particle volumes).
   // Positions pts (NULL: the particles).
-  void fill_qtable(const Approximant &a, QTable &t, const std::vector<double> *w,
-                   const std::vector<double> *pts = nullptr) const;
+  void fill_qtable(const Approximant &a, QTable &t, const HVec<double> *w,
+                   const HVec<double> *pts = nullptr) const;
   // Blend rows at points pts (NULL: the particles, nodal quadrature) with the FE layer.
-  void blend_qtable(QTable &t, const std::vector<double> *pts) const;
+  void blend_qtable(QTable &t, const HVec<double> *pts) const;
   // FE shape functions of layer element e at x (N[npe], dN[npe*2]); false if x is outside.
   bool fe_shape(int32_t e, const double *x, double *N, double *dN) const;
 
   bool collocation() const { return form_ >= MFREE_FORM_COLLOCATION_LAPLACE; }
   bool elasticity() const;
   bool mass() const { return form_ == MFREE_FORM_MASS || form_ == MFREE_FORM_MASS_LUMPED; }
-  std::unique_ptr<Approximant> make(const ApproxConfig &cfg, const std::vector<double> *pts) const;
+  std::unique_ptr<Approximant> make(const ApproxConfig &cfg, const HVec<double> *pts) const;
   // Support of each point (AoS): the particles' supports averaged with their scatter
   // weights around it; one value when the particles' supports are all equal.
-  std::vector<double> point_supports(const std::vector<double> &pts) const;
+  std::vector<double> point_supports(const HVec<double> &pts) const;
   ApproxConfig values_config(const ApproxConfig &c) const;
   void check_points(int32_t npts, const double *x, const double *w, const char *what) const;
-  void read_points(int32_t npts, const double *x, int layout, int64_t ld, std::vector<double> &out) const;
+  void read_points(int32_t npts, const double *x, int layout, int64_t ld, HVec<double> &out) const;
   Report build_tables();
   void build_pattern();
   // The order in which the quadrature points' contributions are summed (qorder_): the
@@ -162,7 +163,7 @@ class Assembler {
   bool penalty_set_ = false;
 
   int quad_kind_ = 0;  // 0 nodal, 1 cells or points (qx_/qw_)
-  std::vector<double> qx_, qw_;
+  HVec<double> qx_, qw_;
   mfree_field_fn body_ = nullptr;
   void *body_user_ = nullptr;
   std::vector<std::unique_ptr<PointSet>> psets_;

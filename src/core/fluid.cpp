@@ -47,7 +47,7 @@ void FluidSystem::set_fluid(const double *rho0, int64_t stride, double kappa, do
   if (!(std::isfinite(kappa) && kappa > 0.0) || !(std::isfinite(gamma) && gamma >= 1.0) ||
       !(std::isfinite(mu) && mu >= 0.0))
     throw Error(MFREE_ERR_ARG, "needs kappa > 0, gamma >= 1, mu >= 0");
-  std::vector<double> r(n_);
+  HVec<double> r(n_);
   for (int32_t i = 0; i < n_; ++i) {
     r[i] = rho0[i * stride];
     if (!(std::isfinite(r[i]) && r[i] > 0.0))
@@ -63,7 +63,7 @@ void FluidSystem::set_masses(const double *m, int64_t stride) {
   if (!m && n_ > 0) throw Error(MFREE_ERR_NULL, "masses are NULL");
   if (stride < 0) throw Error(MFREE_ERR_ARG, "negative stride");
   check_stride(n_, stride, "mass");
-  std::vector<double> v(n_);
+  HVec<double> v(n_);
   for (int32_t i = 0; i < n_; ++i) {
     v[i] = m[i * stride];
     if (!(std::isfinite(v[i]) && v[i] > 0.0))
@@ -74,8 +74,8 @@ void FluidSystem::set_masses(const double *m, int64_t stride) {
 
 void FluidSystem::set_smoothing(double h) {
   if (!(std::isfinite(h) && h > 0.0)) throw Error(MFREE_ERR_ARG, "h must be finite and > 0");
+  ps_.set_support(&h, 0, MFREE_COPY);  // (first: the one step that may fail)
   h_ = h;
-  ps_.set_support(&h_, 0, MFREE_COPY);
 }
 
 void FluidSystem::set_gravity(const double *g) {
@@ -107,8 +107,9 @@ void FluidSystem::set_walls(int32_t nwall, const double *x, const double *normal
   const double hw = 0.5 * r0;                               // gather radius kappa*h = r0
   w->set_support(&hw, 0, MFREE_COPY);
   w->setup();
+  HVec<double> n(normals, normals + static_cast<size_t>(nwall) * dim_);
   walls_ = std::move(w);
-  wall_n_.assign(normals, normals + static_cast<size_t>(nwall) * dim_);
+  wall_n_.swap(n);
   r0_ = r0;
   strength_ = strength;
 }

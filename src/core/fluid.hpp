@@ -130,12 +130,12 @@ class FluidSystem : public System {
 
   int dim_;
   int32_t n_;
-  std::vector<double> rho0_, mass_;
+  HVec<double> rho0_, mass_;  // (copies of host data come from the context's hook)
   double kappa_ = 1.0, gamma_ = 7.0, mu_ = 0.0, h_ = 0.0;
   double g_[3] = {0, 0, 0};
   int lump_ = MFREE_LUMP_GALERKIN;
   std::unique_ptr<ParticleSet> walls_;
-  std::vector<double> wall_n_;
+  HVec<double> wall_n_;
   double r0_ = 0.0, strength_ = 0.0;
   double shepard_cond_ = 100.0;
   mutable DummyWall dummy_;  // scratch node arrays are refilled by const evaluations
@@ -162,7 +162,7 @@ class FluidSystem : public System {
   // (then every pair closer than 2h now was closer than 2h + skin then), so that the
   // tables never depend on the skin, only the cost does. The wall lists use the same rule.
   ParticleSet ps_;
-  std::vector<double> vol_;
+  HVec<double> vol_;
   int64_t rb(int64_t k) const { return rb_[k]; }
   int64_t re(int64_t k) const { return re_[k]; }
   std::vector<int64_t> rb_, re_;  // row begins and ends

@@ -63,26 +63,31 @@ void FluidSystem::set_dummy_particles(int32_t n, const double *x, const double *
   if (stride < 0) throw Error(MFREE_ERR_ARG, "negative stride");
   check_stride(n, stride, "dummy volume");
   if (static_cast<int64_t>(n_) + n > INT32_MAX) throw Error(MFREE_ERR_ARG, "too many particles with the dummies");
-  std::vector<double> xd(static_cast<size_t>(n) * dim_), vd(n);
+  // Everything is built aside and swapped in when complete: running out of memory half
+  // way leaves the system as it was.
+  HVec<double> xd(static_cast<size_t>(n) * dim_);
+  HVec<double> vols(std::max<size_t>(static_cast<size_t>(n_) + n, 1), 1.0);
   for (int32_t w = 0; w < n; ++w) {
     for (int c = 0; c < dim_; ++c) {
       xd[static_cast<size_t>(w) * dim_ + c] = x[static_cast<size_t>(w) * dim_ + c];
       if (!std::isfinite(xd[static_cast<size_t>(w) * dim_ + c]))
         throw Error(MFREE_ERR_INPUT, "dummy particle " + std::to_string(w) + " has a non-finite position");
     }
-    vd[w] = vol[w * stride];
-    if (!(std::isfinite(vd[w]) && vd[w] > 0.0))
+    const double v = vol[w * stride];
+    if (!(std::isfinite(v) && v > 0.0))
       throw Error(MFREE_ERR_INPUT, "volume of dummy particle " + std::to_string(w) + " must be finite and > 0");
+    vols[static_cast<size_t>(n_) + w] = v;
   }
   // a particle set of the new size; the approximant is rebuilt on it at the next prepare
+  ParticleSet nodes(dim_, n_ + n);
+  if (h_ > 0.0) nodes.set_support(&h_, 0, MFREE_COPY);
+  DummyWall dummy;
+  dummy.n = n;
+  dummy.xd.swap(xd);
   lists_valid_ = false;
-  ps_ = ParticleSet(dim_, n_ + n);
-  if (h_ > 0.0) ps_.set_support(&h_, 0, MFREE_COPY);
-  vol_.assign(std::max<size_t>(static_cast<size_t>(n_) + n, 1), 1.0);
-  std::copy(vd.begin(), vd.end(), vol_.begin() + n_);
-  dummy_ = DummyWall();
-  dummy_.n = n;
-  dummy_.xd.swap(xd);
+  ps_ = std::move(nodes);
+  vol_.swap(vols);
+  dummy_ = std::move(dummy);
 }
 
 void FluidSystem::set_density_diffusion(double delta) {

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "alloc.hpp"
+
 namespace mfree {
 
 // Dummy particles are appended to the fluid's particle set: nodes of the MLS
@@ -17,7 +19,7 @@ namespace mfree {
 // arrays below hold the fluid's n values followed by the n_dummy dummies'.
 struct DummyWall {
   int32_t n = 0;             // dummy count
-  std::vector<double> xd;    // dummy positions (dim each), copied at set-up
+  HVec<double> xd;           // dummy positions (dim each), copied at set-up
   std::vector<double> x;     // node positions: fluid (refreshed at every prepare), dummies
   std::vector<double> v;     // node velocity parameters: fluid, then zeros
   std::vector<double> rho;   // node densities: fluid, then extrapolated

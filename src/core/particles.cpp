@@ -236,7 +236,7 @@ void ParticleSet::check_global_ids(const int64_t *ids) {
       throw Error(MFREE_ERR_INPUT, "global id of particle " + std::to_string(i) + " is " +
                                        std::to_string(ids[i]) + " (must be >= 0)");
   // the particles in id order (ties by index); a repeat is two neighbours with one id
-  std::vector<int32_t> &perm = gid_perm_next_;
+  HVec<int32_t> &perm = gid_perm_next_;
   perm.resize(static_cast<size_t>(n_));
   for (int32_t i = 0; i < n_; ++i) perm[i] = i;
   std::sort(perm.begin(), perm.end(),
@@ -258,7 +258,7 @@ void ParticleSet::set_global_ids(const int64_t *ids, int mem) {
     return;
   }
   // (the copy first: after the check, which replaces the id order, nothing may fail)
-  std::vector<int64_t> own;
+  HVec<int64_t> own;
   if (mem == MFREE_COPY) {
     own.assign(ids, ids + n_);
     if (own.empty()) own.push_back(0);  // keep data() non-NULL: the set has ids

@@ -186,8 +186,8 @@ class ParticleSet {
   // gid_perm_next_ is where a check sorts before it succeeds. Both, and the row-order
   // scratch, are kept so that a repeated setup allocates nothing.
   const int64_t *gid_ = nullptr;
-  std::vector<int64_t> gid_own_;
-  std::vector<int32_t> gid_perm_, gid_perm_next_;
+  HVec<int64_t> gid_own_;
+  HVec<int32_t> gid_perm_, gid_perm_next_;
   RowOrderScratch row_order_;
   void check_global_ids(const int64_t *ids);
   double halo_ = 0.0;

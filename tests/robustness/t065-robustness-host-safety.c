@@ -1,11 +1,14 @@
 /* Never corrupt the host (mfree.h, "Statuses"): a call with a negative status changes
  * nothing; after a positive status every site reported valid holds finite values.
  *  1. Every setter that copies host data (particle positions, volumes, masses,
- *     densities, supports, neighbour lists; approximant points; mesh elements) with each
- *     of its allocations failing in turn (the context's allocator hook): MFREE_ERR_ALLOC,
- *     and the object gives bitwise the results it gave before (a half-updated copy used to
- *     leave rows and columns of different lists: a heap-buffer-overflow at the next setup).
- *     At least one allocation of each copy must go through the hook.
+ *     densities, supports, neighbour lists, global ids; approximant points; mesh
+ *     elements; the assemblers' quadratures, boundary conditions and finite-element
+ *     layer; the fluid systems' properties, masses, smoothing, walls and dummy particles)
+ *     with each of its allocations failing in turn (the context's allocator hook):
+ *     MFREE_ERR_ALLOC, and the object gives bitwise the results it gave before (a
+ *     half-updated copy used to leave rows and columns of different lists: a
+ *     heap-buffer-overflow at the next setup). At least one allocation of each copy must
+ *     go through the hook.
  *  2. For every method, NaN / Inf / zero in borrowed
  *     positions, supports and volumes, through the documented per-step path
  *     (particles_update + approximant_update) and through approximant_update alone: a
@@ -42,24 +45,60 @@ static void lattice(double *x, double scale, uint64_t seed) {
 
 static counter_t C = {0, 0, 0, -1};
 
-/* Gradient of a fixed field by approximant a after setting its set and a up again. */
-static void results(mfree_context_t *ctx, mfree_particles_t *ps, mfree_approximant_t *a, int32_t n,
-                    double *out, int64_t *nnz) {
-  double u[N];
-  for (int p = 0; p < n; ++p) u[p] = sin(1.0 + p);
-  assert_ok(ctx, mfree_particles_setup(ps));
-  assert_ok(ctx, mfree_approximant_setup(a));
-  int32_t ns = 0;
-  assert_ok(ctx, mfree_approximant_get_num_sites(a, &ns));
-  memset(out, 0, sizeof(double) * 2 * (size_t)N);
-  assert_ok(ctx, mfree_approximant_apply(a, MFREE_OP_GRADIENT, 1, u, MFREE_LAYOUT_AOS, 1, out,
-                                         MFREE_LAYOUT_AOS, 2));
-  assert_ok(ctx, mfree_approximant_get_nnz(a, nnz));
-  *nnz = *nnz * 1000 + ns;
+/* The objects of one case; the setters under test copy into one of them. */
+typedef struct {
+  mfree_context_t *ctx;
+  mfree_particles_t *ps;
+  mfree_approximant_t *a;
+  mfree_mesh_t *mesh;
+  mfree_assembler_t *as;
+  mfree_system_t *sys;
+  double y[5 * N]; /* the fluid's state */
+} objs_t;
+
+/* A setter under test: kind, variant 0 (the state before) or 1 (the failing copy). */
+typedef mfree_status_t (*setter_fn)(objs_t *o, int kind, int variant);
+/* The results the objects give (set up again), as a digest of their bytes. */
+typedef uint64_t (*results_fn)(objs_t *o);
+
+static uint64_t digest(uint64_t h, const void *p, size_t bytes) {
+  const unsigned char *b = (const unsigned char *)p;
+  for (size_t k = 0; k < bytes; ++k) h = (h ^ b[k]) * 1099511628211ull; /* FNV-1a */
+  return h;
+}
+static const uint64_t DIGEST0 = 14695981039346656037ull;
+
+/* Calls setter (kind, variant 1) with each of its allocations failing in turn until it
+ * succeeds: every failure is MFREE_ERR_ALLOC and leaves the results as they were; at
+ * least one allocation went through the hook. */
+static void inject(objs_t *o, int kind, const char *name, setter_fn setter, results_fn results) {
+  const uint64_t ref = results(o);
+  int failures = 0;
+  for (int k = 0;; ++k) {
+    C.fail_after = C.calls + k;
+    const mfree_status_t st = setter(o, kind, 1);
+    C.fail_after = -1;
+    if (st == MFREE_SUCCESS) break;
+    if (st != MFREE_ERR_ALLOC) fail_msg("%s: status %d with %d allocations allowed", name, st, k);
+    ++failures;
+    if (results(o) != ref) fail_msg("%s: a failed copy (%d allocations allowed) changed the results", name, k);
+    assert_true(k < 100);
+  }
+  if (failures == 0) fail_msg("%s: no allocation of the copy went through the hook", name);
 }
 
-typedef mfree_status_t (*setter_fn)(void *obj, int variant);
+static void destroy_objs(objs_t *o) {
+  mfree_system_destroy(&o->sys);
+  mfree_assembler_destroy(&o->as);
+  mfree_mesh_destroy(&o->mesh);
+  mfree_approximant_destroy(&o->a);
+  mfree_particles_destroy(&o->ps);
+  mfree_context_destroy(&o->ctx);
+  assert_int_equal(C.held, 0);
+}
+
 static double Xa[2 * N], Xb[2 * N], Va[N], Vb[N], Ha[N], Hb[N], Pa[2 * 10], Pb[2 * 20];
+static int64_t IDa[N], IDb[N];
 static int64_t RPa[N + 1], RPb[N + 1];
 static int32_t CLa[N * N], CLb[N * N];
 
@@ -75,33 +114,7 @@ static void host_lists(const double *x, double r, int64_t *rp, int32_t *cl) {
   }
 }
 
-typedef struct {
-  const char *name;
-  int kind; /* 0 positions, 1 volumes, 2 masses, 3 densities, 4 support, 5 lists, 6 points, 7 mesh */
-} setter_t;
-
-static mfree_status_t call_setter(int kind, int variant, mfree_particles_t *ps, mfree_approximant_t *a,
-                                  mfree_mesh_t *mesh) {
-  switch (kind) {
-    case 0: return mfree_particles_set_positions(ps, variant ? Xb : Xa, MFREE_LAYOUT_AOS, 2, MFREE_COPY);
-    case 1: return mfree_particles_set_volumes(ps, variant ? Vb : Va, 1, MFREE_COPY);
-    case 2: return mfree_particles_set_masses(ps, variant ? Vb : Va, 1, MFREE_COPY);
-    case 3: return mfree_particles_set_densities(ps, variant ? Vb : Va, 1, MFREE_COPY);
-    case 4: return mfree_particles_set_support(ps, variant ? Hb : Ha, 1, MFREE_COPY);
-    case 5: return mfree_particles_set_neighbors(ps, variant ? RPb : RPa, variant ? CLb : CLa, 0, MFREE_COPY);
-    case 6: return mfree_approximant_set_points(a, variant ? 20 : 10, variant ? Pb : Pa, MFREE_LAYOUT_AOS, 2,
-                                                variant ? Hb : Ha, 1, MFREE_COPY);
-    default: {
-      static const int32_t quad[4] = {0, 1, M + 1, M};
-      static const int32_t quads[8] = {1, 2, M + 2, M + 1, 2, 3, M + 3, M + 2};
-      return mfree_mesh_add_elements(mesh, MFREE_ELEMENT_QUAD4, variant ? 2 : 1, variant ? quads : quad, 0,
-                                     MFREE_COPY);
-    }
-  }
-}
-
-static void test_failed_copy_changes_nothing(void **state) {
-  (void)state;
+static void fill_data(void) {
   lattice(Xa, 1.0, 1);
   lattice(Xb, 0.9, 2);
   for (int p = 0; p < N; ++p) {
@@ -109,6 +122,8 @@ static void test_failed_copy_changes_nothing(void **state) {
     Vb[p] = 2.0 * Va[p];
     Ha[p] = 1.5 * SP;
     Hb[p] = 1.7 * SP;
+    IDa[p] = 3 * p + 1;
+    IDb[p] = 5 * (N - p);
   }
   for (int s = 0; s < 20; ++s) {
     if (s < 10) Pa[2 * s] = Xa[2 * (s + 7)] + 0.01, Pa[2 * s + 1] = Xa[2 * (s + 7) + 1];
@@ -117,64 +132,257 @@ static void test_failed_copy_changes_nothing(void **state) {
   host_lists(Xa, 3.0 * SP, RPa, CLa);
   host_lists(Xa, 3.3 * SP, RPb, CLb);
   assert_true(RPb[N] > RPa[N]);
+}
 
+/* A context with the counting hook, and a set of the lattice's particles (copied). */
+static void new_objs(objs_t *o, int volumes) {
+  memset(o, 0, sizeof *o);
+  assert_ok(NULL, mfree_context_create(&o->ctx));
+  assert_ok(o->ctx, mfree_context_set_allocator(o->ctx, count_alloc, count_free, &C));
+  assert_ok(o->ctx, mfree_particles_create(o->ctx, 2, N, &o->ps));
+  assert_ok(o->ctx, mfree_particles_set_positions(o->ps, Xa, MFREE_LAYOUT_AOS, 2, MFREE_COPY));
+  assert_ok(o->ctx, mfree_particles_set_support(o->ps, Ha, 1, MFREE_COPY));
+  if (volumes) assert_ok(o->ctx, mfree_particles_set_volumes(o->ps, Va, 1, MFREE_COPY));
+}
+
+/* 1a. particle sets, approximants, meshes: kind 0 positions, 1 volumes, 2 masses,
+ * 3 densities, 4 support, 5 lists, 6 points, 7 mesh, 8 global ids */
+static mfree_status_t particle_setter(objs_t *o, int kind, int variant) {
+  switch (kind) {
+    case 0: return mfree_particles_set_positions(o->ps, variant ? Xb : Xa, MFREE_LAYOUT_AOS, 2, MFREE_COPY);
+    case 1: return mfree_particles_set_volumes(o->ps, variant ? Vb : Va, 1, MFREE_COPY);
+    case 2: return mfree_particles_set_masses(o->ps, variant ? Vb : Va, 1, MFREE_COPY);
+    case 3: return mfree_particles_set_densities(o->ps, variant ? Vb : Va, 1, MFREE_COPY);
+    case 4: return mfree_particles_set_support(o->ps, variant ? Hb : Ha, 1, MFREE_COPY);
+    case 5:
+      return mfree_particles_set_neighbors(o->ps, variant ? RPb : RPa, variant ? CLb : CLa, 0, MFREE_COPY);
+    case 6: return mfree_approximant_set_points(o->a, variant ? 20 : 10, variant ? Pb : Pa, MFREE_LAYOUT_AOS, 2,
+                                                variant ? Hb : Ha, 1, MFREE_COPY);
+    case 7: {
+      static const int32_t quad[4] = {0, 1, M + 1, M};
+      static const int32_t quads[8] = {1, 2, M + 2, M + 1, 2, 3, M + 3, M + 2};
+      return mfree_mesh_add_elements(o->mesh, MFREE_ELEMENT_QUAD4, variant ? 2 : 1, variant ? quads : quad, 0,
+                                     MFREE_COPY);
+    }
+    default: return mfree_particles_set_global_ids(o->ps, variant ? IDb : IDa, MFREE_COPY);
+  }
+}
+
+/* Gradient of a fixed field by the approximant after setting the set and it up again,
+ * its nnz and site count, and the mesh's element count. */
+static uint64_t approximant_results(objs_t *o) {
+  double u[N], out[2 * N];
+  for (int p = 0; p < N; ++p) u[p] = sin(1.0 + p);
+  assert_ok(o->ctx, mfree_particles_setup(o->ps));
+  assert_ok(o->ctx, mfree_approximant_setup(o->a));
+  int32_t ns = 0, nel = 0;
+  int64_t nnz = 0;
+  assert_ok(o->ctx, mfree_approximant_get_num_sites(o->a, &ns));
+  memset(out, 0, sizeof out);
+  assert_ok(o->ctx, mfree_approximant_apply(o->a, MFREE_OP_GRADIENT, 1, u, MFREE_LAYOUT_AOS, 1, out,
+                                            MFREE_LAYOUT_AOS, 2));
+  assert_ok(o->ctx, mfree_approximant_get_nnz(o->a, &nnz));
+  if (o->mesh) assert_ok(o->ctx, mfree_mesh_get_size(o->mesh, &nel));
+  uint64_t h = digest(DIGEST0, out, sizeof out);
+  h = digest(h, &nnz, sizeof nnz);
+  h = digest(h, &ns, sizeof ns);
+  return digest(h, &nel, sizeof nel);
+}
+
+static void test_failed_copy_changes_nothing(void **state) {
+  (void)state;
+  fill_data();
   static const char *names[] = {"positions", "volumes", "masses", "densities", "support",
-                                "neighbour lists", "points", "mesh elements"};
-  for (int kind = 0; kind < 8; ++kind) {
-    mfree_context_t *ctx = NULL;
-    assert_ok(NULL, mfree_context_create(&ctx));
-    assert_ok(ctx, mfree_context_set_allocator(ctx, count_alloc, count_free, &C));
-    mfree_particles_t *ps = NULL;
-    mfree_approximant_t *a = NULL;
-    mfree_mesh_t *mesh = NULL;
-    assert_ok(ctx, mfree_particles_create(ctx, 2, N, &ps));
-    assert_ok(ctx, call_setter(0, 0, ps, NULL, NULL));
-    assert_ok(ctx, call_setter(4, 0, ps, NULL, NULL));
-    assert_ok(ctx, call_setter(1, 0, ps, NULL, NULL));
-    if (kind == 2 || kind == 3) { /* the set's volumes from masses and densities */
-      mfree_particles_destroy(&ps);
-      assert_ok(ctx, mfree_particles_create(ctx, 2, N, &ps));
-      assert_ok(ctx, call_setter(0, 0, ps, NULL, NULL));
-      assert_ok(ctx, call_setter(4, 0, ps, NULL, NULL));
-      assert_ok(ctx, call_setter(2, 0, ps, NULL, NULL));
-      assert_ok(ctx, call_setter(3, 0, ps, NULL, NULL));
+                                "neighbour lists", "points", "mesh elements", "global ids"};
+  for (int kind = 0; kind < 9; ++kind) {
+    objs_t o;
+    /* masses and densities: the set's volumes from them */
+    const int from_masses = kind == 2 || kind == 3;
+    new_objs(&o, !from_masses);
+    if (from_masses) {
+      assert_ok(o.ctx, particle_setter(&o, 2, 0));
+      assert_ok(o.ctx, particle_setter(&o, 3, 0));
     }
-    if (kind == 5) assert_ok(ctx, call_setter(5, 0, ps, NULL, NULL));
-    assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_RKPM, &a));
-    if (kind == 6) assert_ok(ctx, call_setter(6, 0, ps, a, NULL));
+    if (kind == 5 || kind == 8) assert_ok(o.ctx, particle_setter(&o, kind, 0));
+    assert_ok(o.ctx, mfree_approximant_create(o.ctx, o.ps, MFREE_METHOD_RKPM, &o.a));
+    if (kind == 6) assert_ok(o.ctx, particle_setter(&o, 6, 0));
     if (kind == 7) {
-      assert_ok(ctx, mfree_mesh_create(ctx, ps, &mesh));
-      assert_ok(ctx, call_setter(7, 0, ps, NULL, mesh));
+      assert_ok(o.ctx, mfree_mesh_create(o.ctx, o.ps, &o.mesh));
+      assert_ok(o.ctx, particle_setter(&o, 7, 0));
     }
-    double ref[2 * N], got[2 * N];
-    int64_t ref_nnz = 0, got_nnz = 0;
-    results(ctx, ps, a, N, ref, &ref_nnz);
-    int32_t ref_nel = 0, nel = 0;
-    if (mesh) assert_ok(ctx, mfree_mesh_get_size(mesh, &ref_nel));
+    inject(&o, kind, names[kind], particle_setter, approximant_results);
+    destroy_objs(&o);
+  }
+}
 
-    int failures = 0;
-    for (int k = 0;; ++k) {
-      C.fail_after = C.calls + k;
-      const mfree_status_t st = call_setter(kind, 1, ps, a, mesh);
-      C.fail_after = -1;
-      if (st == MFREE_SUCCESS) break;
-      if (st != MFREE_ERR_ALLOC) fail_msg("%s: status %d with %d allocations allowed", names[kind], st, k);
-      ++failures;
-      results(ctx, ps, a, N, got, &got_nnz);
-      if (got_nnz != ref_nnz || memcmp(got, ref, sizeof got) != 0)
-        fail_msg("%s: a failed copy (%d allocations allowed) changed the results", names[kind], k);
-      if (mesh) {
-        assert_ok(ctx, mfree_mesh_get_size(mesh, &nel));
-        assert_int_equal(nel, ref_nel);
-      }
-      assert_true(k < 100);
+/* 1b. assemblers: kind 0 quadrature points, 1 quadrature cells, 2 traction points,
+ * 3 traction segments, 4 penalty points, 5 Nitsche points, 6 Lagrange points,
+ * 7 consistent integration, 8 Dirichlet nodes, 9 finite-element layer (Galerkin
+ * Laplace); 10 traction nodes (collocation Laplace) */
+enum { ASM_KINDS = 11, ASM_COLLOCATION = 10 };
+
+static void boundary_value(void *user, const double *x, double *v) {
+  (void)user;
+  v[0] = 1.0 + x[0] - 0.5 * x[1];
+}
+
+/* npts points on the unit square's boundary (on its bottom side only when !whole), with
+ * weights and outward normals. */
+static void boundary_points(int npts, int whole, double *x, double *w, double *nrm) {
+  const int sides = whole ? 4 : 1, per = npts / sides;
+  for (int p = 0; p < npts; ++p) {
+    const int side = p / per;
+    const double t = (p % per + 0.5) / per;
+    const double px[4] = {t, 1.0, 1.0 - t, 0.0}, py[4] = {0.0, t, 1.0, 1.0 - t};
+    const double nx[4] = {0.0, 1.0, 0.0, -1.0}, ny[4] = {-1.0, 0.0, 1.0, 0.0};
+    x[2 * p] = px[side], x[2 * p + 1] = py[side];
+    nrm[2 * p] = nx[side], nrm[2 * p + 1] = ny[side];
+    w[p] = 1.0 / per;
+  }
+}
+
+static mfree_status_t assembler_setter(objs_t *o, int kind, int variant) {
+  double x[2 * 25], w[25], nrm[2 * 25];
+  const int npts = variant ? 24 : 16;
+  boundary_points(npts, kind == 7, x, w, nrm);
+  static const int32_t nodes[] = {0, 1, 2, 3, 4, 5, 6};
+  switch (kind) {
+    case 0: { /* a g x g grid over the square */
+      const int g = variant ? 5 : 4;
+      for (int p = 0; p < g * g; ++p) x[2 * p] = (p % g + 0.5) / g, x[2 * p + 1] = (p / g + 0.5) / g, w[p] = 1.0 / (g * g);
+      return mfree_assembler_set_quadrature_points(o->as, g * g, x, MFREE_LAYOUT_AOS, 2, w);
     }
-    if (failures == 0) fail_msg("%s: no allocation of the copy went through the hook", names[kind]);
-    mfree_mesh_destroy(&mesh);
-    mfree_approximant_destroy(&a);
-    mfree_particles_destroy(&ps);
-    mfree_context_destroy(&ctx);
-    assert_int_equal(C.held, 0);
+    case 1: {
+      const double lo[2] = {0.0, 0.0}, hi[2] = {1.0, 1.0};
+      const int32_t ncells[2] = {variant ? 4 : 3, variant ? 4 : 3};
+      return mfree_assembler_set_quadrature_cells(o->as, lo, hi, ncells, 2, NULL, NULL);
+    }
+    case 2: return mfree_assembler_add_traction(o->as, npts, x, MFREE_LAYOUT_AOS, 2, w, boundary_value, NULL);
+    case 3: {
+      const double seg[8] = {0.0, 0.0, 0.5, 0.0, 0.5, 0.0, 1.0, 0.0};
+      return mfree_assembler_add_traction_segments(o->as, variant ? 2 : 1, seg, 3, boundary_value, NULL);
+    }
+    case 4:
+    case 5:
+    case 6: {
+      const mfree_bc_t bc = kind == 4 ? MFREE_BC_PENALTY : kind == 5 ? MFREE_BC_NITSCHE : MFREE_BC_LAGRANGE;
+      return mfree_assembler_add_dirichlet(o->as, bc, npts / 4, x, MFREE_LAYOUT_AOS, 2, w, nrm, 1,
+                                           boundary_value, NULL);
+    }
+    case 7: return mfree_assembler_set_consistent_integration(o->as, npts, x, MFREE_LAYOUT_AOS, 2, w, nrm);
+    case 8: return mfree_assembler_add_dirichlet_nodes(o->as, variant ? 4 : 3, nodes + 3 * variant, 1,
+                                                       boundary_value, NULL);
+    case 9: {
+      const int32_t quad[2][4] = {{0, 1, M + 1, M}, {1, 2, M + 2, M + 1}}, gu[2][2] = {{0, 1}, {2, 1}};
+      return mfree_assembler_set_fe_layer(o->as, 1, 4, quad[variant], 2, gu[variant], 1, boundary_value, NULL);
+    }
+    default:
+      return mfree_assembler_add_traction_nodes(o->as, variant ? 4 : 3, nodes + 3 * variant, nrm,
+                                                boundary_value, NULL);
+  }
+}
+
+/* The assembler set up again: its size, matrix and right-hand side. */
+static uint64_t assembler_results(objs_t *o) {
+  assert_ok(o->ctx, mfree_assembler_setup(o->as));
+  int32_t size[2] = {0, 0}, nrows = 0;
+  int64_t nnz = 0;
+  assert_ok(o->ctx, mfree_assembler_get_size(o->as, &size[0], &size[1]));
+  mfree_matrix_t *K = NULL;
+  assert_ok(o->ctx, mfree_assembler_assemble_matrix(o->as, &K));
+  const int64_t *rp = NULL;
+  const int32_t *cl = NULL;
+  const double *val = NULL;
+  assert_ok(o->ctx, mfree_matrix_get_size(K, &nrows, NULL, &nnz));
+  assert_ok(o->ctx, mfree_matrix_get_csr(K, &rp, &cl, &val));
+  double *f = calloc((size_t)size[0] + 1, sizeof(double));
+  assert_ok(o->ctx, mfree_assembler_assemble_rhs(o->as, f));
+  uint64_t h = digest(DIGEST0, size, sizeof size);
+  h = digest(h, rp, sizeof(int64_t) * ((size_t)nrows + 1));
+  h = digest(h, cl, sizeof(int32_t) * (size_t)nnz);
+  h = digest(h, val, sizeof(double) * (size_t)nnz);
+  h = digest(h, f, sizeof(double) * (size_t)size[0]);
+  free(f);
+  mfree_matrix_destroy(&K);
+  return h;
+}
+
+static void test_failed_assembler_copy_changes_nothing(void **state) {
+  (void)state;
+  fill_data();
+  static const char *names[ASM_KINDS] = {"quadrature points", "quadrature cells", "traction points",
+                                         "traction segments", "penalty points", "Nitsche points",
+                                         "Lagrange points", "consistent integration", "Dirichlet nodes",
+                                         "finite-element layer", "traction nodes"};
+  for (int kind = 0; kind < ASM_KINDS; ++kind) {
+    objs_t o;
+    new_objs(&o, 1);
+    assert_ok(o.ctx, mfree_approximant_create(o.ctx, o.ps, MFREE_METHOD_RKPM, &o.a));
+    if (kind == ASM_COLLOCATION) {
+      assert_ok(o.ctx, mfree_approximant_set_order(o.a, 2));
+      assert_ok(o.ctx, mfree_approximant_set_derivatives(
+                           o.a, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT | MFREE_DERIV_HESSIAN));
+    }
+    assert_ok(o.ctx, mfree_assembler_create(o.ctx, o.a, NULL,
+                                            kind == ASM_COLLOCATION ? MFREE_FORM_COLLOCATION_LAPLACE
+                                                                    : MFREE_FORM_LAPLACE,
+                                            &o.as));
+    if (kind == 9 || kind == ASM_COLLOCATION) assert_ok(o.ctx, assembler_setter(&o, 8, 0));
+    assert_ok(o.ctx, assembler_setter(&o, kind, 0));
+    inject(&o, kind, names[kind], assembler_setter, assembler_results);
+    destroy_objs(&o);
+  }
+}
+
+/* 1c. fluid systems: kind 0 fluid properties, 1 masses, 2 smoothing, 3 walls, 4 dummy
+ * particles */
+static mfree_status_t system_setter(objs_t *o, int kind, int variant) {
+  switch (kind) {
+    case 0: {
+      const double rho0 = variant ? 1010.0 : 1000.0;
+      return mfree_system_set_fluid(o->sys, &rho0, 0, 100.0, 7.0, 0.01);
+    }
+    case 1: return mfree_system_set_masses(o->sys, variant ? Vb : Va, 1);
+    case 2: return mfree_system_set_smoothing(o->sys, variant ? 1.7 * SP : 1.5 * SP);
+    default: {
+      double wx[2 * 8], wn[2 * 8];
+      for (int k = 0; k < 8; ++k) wx[2 * k] = (k + 0.5) / 8, wx[2 * k + 1] = -0.25 * SP, wn[2 * k] = 0.0, wn[2 * k + 1] = 1.0;
+      if (kind == 3) return mfree_system_set_walls(o->sys, variant ? 8 : 6, wx, wn, 2.0 * SP, 10.0);
+      const double vol = SP * SP;
+      return mfree_system_set_dummy_particles(o->sys, variant ? 8 : 6, wx, &vol, 0);
+    }
+  }
+}
+
+/* The fluid's right-hand side at a fixed state. */
+static uint64_t system_results(objs_t *o) {
+  int32_t neq = 0;
+  double ydot[5 * N];
+  assert_ok(o->ctx, mfree_system_get_size(o->sys, &neq));
+  assert_int_equal(neq, 5 * N);
+  assert_ok(o->ctx, mfree_system_rhs(o->sys, 0.0, o->y, ydot));
+  return digest(DIGEST0, ydot, sizeof ydot);
+}
+
+static void test_failed_system_copy_changes_nothing(void **state) {
+  (void)state;
+  fill_data();
+  static const char *names[] = {"fluid properties", "fluid masses", "smoothing", "walls", "dummy particles"};
+  for (int kind = 0; kind < 5; ++kind) {
+    objs_t o;
+    memset(&o, 0, sizeof o);
+    assert_ok(NULL, mfree_context_create(&o.ctx));
+    assert_ok(o.ctx, mfree_context_set_allocator(o.ctx, count_alloc, count_free, &C));
+    for (int p = 0; p < N; ++p) {
+      o.y[2 * p] = Xa[2 * p], o.y[2 * p + 1] = Xa[2 * p + 1];
+      o.y[2 * N + 2 * p] = 0.1 * sin(p), o.y[2 * N + 2 * p + 1] = 0.1 * cos(p);
+      o.y[4 * N + p] = 1000.0 * (1.0 + 0.01 * sin(3.0 * p));
+    }
+    assert_ok(o.ctx, mfree_system_create_fluid(o.ctx, 2, N, &o.sys));
+    for (int k = 0; k < 3; ++k) assert_ok(o.ctx, system_setter(&o, k, 0));
+    if (kind >= 3) assert_ok(o.ctx, system_setter(&o, kind, 0));
+    inject(&o, kind, names[kind], system_setter, system_results);
+    destroy_objs(&o);
   }
 }
 
@@ -370,6 +578,8 @@ static void test_update_notices_changed_set(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_failed_copy_changes_nothing),
+      cmocka_unit_test(test_failed_assembler_copy_changes_nothing),
+      cmocka_unit_test(test_failed_system_copy_changes_nothing),
       cmocka_unit_test(test_nonfinite_never_valid),
       cmocka_unit_test(test_update_notices_changed_set),
   };
