@@ -421,6 +421,8 @@ void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, in
   if (fe_.npe && fe_.npe != npe)
     throw Error(MFREE_ERR_ARG, "the layer already has elements with " + std::to_string(fe_.npe) +
                                    " nodes; every call must use the same element type");
+  // (the orientation check below reads the positions)
+  if (!ps_->pos_data()) throw Error(MFREE_ERR_STATE, "the particle set has no positions");
   const int32_t n = ps_->num_owned();
   // Calls accumulate: elements of every call form one layer (the blending sees all of
   // them) and each call's boundary nodes get its own component mask, so symmetry lines

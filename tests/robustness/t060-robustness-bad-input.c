@@ -945,6 +945,19 @@ static void rows_assembler(void) {
   ROW(MFREE_ERR_NULL, mfree_assembler_set_fe_layer(F.as_new, 1, 3, NULL, 1, nodes, 1, host_field, NULL));
   ROW(MFREE_ERR_NULL, mfree_assembler_set_fe_layer(F.as_new, 1, 3, tri, 1, NULL, 1, host_field, NULL));
   ROW(MFREE_ERR_INPUT, mfree_assembler_set_fe_layer(F.as_new, 1, 3, tri, 1, nodesbad + 1, 1, host_field, NULL));
+  {
+    /* a set without positions: the layer's orientation check cannot read them */
+    mfree_particles_t *bare = NULL;
+    mfree_approximant_t *ab = NULL;
+    mfree_assembler_t *asb = NULL;
+    assert_ok(F.ctx, mfree_particles_create(F.ctx, 2, N, &bare));
+    assert_ok(F.ctx, mfree_approximant_create(F.ctx, bare, MFREE_METHOD_RKPM, &ab));
+    assert_ok(F.ctx, mfree_assembler_create(F.ctx, ab, NULL, MFREE_FORM_LAPLACE, &asb));
+    ROWC(F.ctx, MFREE_ERR_STATE, mfree_assembler_set_fe_layer(asb, 1, 3, tri, 1, nodes, 1, host_field, NULL));
+    mfree_assembler_destroy(&asb);
+    mfree_approximant_destroy(&ab);
+    mfree_particles_destroy(&bare);
+  }
   ROW0(MFREE_ERR_NULL, mfree_assembler_set_penalty(NULL, 1e6));
   ROW(MFREE_ERR_ARG, mfree_assembler_set_penalty(F.as_new, -1.0));
   ROW(MFREE_ERR_ARG, mfree_assembler_set_penalty(F.as_new, NAN));
