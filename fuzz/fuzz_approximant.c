@@ -1,8 +1,10 @@
 /* libFuzzer harness (issue 9): bytes -> a particle set (dimension, count, positions with
  * NaN/Inf/duplicates, supports and volumes with zero/negative/NaN values, ghosts,
- * search convention, periodic box, host neighbour lists), a method, kernel, order,
- * derivative flags, fallback, optional host points, and a field; then particles setup,
- * approximant setup, update and every apply operator in both layouts.
+ * search convention, periodic box, host neighbour lists or a half pair list), a method,
+ * kernel, order, derivative flags, fallback, optional host points, and a field; then
+ * particles setup, approximant setup, update, every apply operator in both layouts and
+ * the diagnostics (conditions, orders, neighbour counts, reproduction check, per-pair
+ * gradients, correction data).
  *
  * Then a program of changes read from the rest of the bytes: particles update,
  * approximant update, a borrowed position or support changed, a new ghost count with the
@@ -74,6 +76,40 @@ static void threads(const mfree_approximant_t *a, const double *uu, int nsites) 
     free(job[t].out);
   }
   free(ref);
+}
+
+/* ---- the diagnostics of a set-up approximant ------------------------------------------ */
+
+static void diagnostics(fz_bytes_t *b, const mfree_approximant_t *a, int dim, int nsites) {
+  const size_t ns = (size_t)nsites + 1;
+  double *cond = calloc(ns, sizeof *cond);
+  int32_t *ord = calloc(ns, sizeof *ord), *cnt = calloc(ns, sizeof *cnt);
+  CHECK_STATUS(mfree_approximant_get_condition(a, cond));
+  CHECK_STATUS(mfree_approximant_get_site_order(a, ord));
+  CHECK_STATUS(mfree_approximant_get_neighbor_counts(a, cnt));
+  double fe = 0.0, de = 0.0;
+  CHECK_STATUS(mfree_approximant_check_reproduction(a, (int32_t)(take(b) % 4) - 1, &fe, &de));
+  free(cond), free(ord), free(cnt);
+  /* per-pair gradients (a pair list set: one row per pair), with a capacity that may be short */
+  int64_t np = 0;
+  mfree_particles_t *ps = NULL;
+  if (mfree_approximant_get_particles(a, &ps) == MFREE_SUCCESS && ps &&
+      mfree_particles_get_num_pairs(ps, &np) == MFREE_SUCCESS && np > 0) {
+    const int64_t cap = np * dim - (int64_t)(take(b) % 2);
+    double *gi = calloc((size_t)(np * dim), sizeof *gi), *gj = calloc((size_t)(np * dim), sizeof *gj);
+    CHECK_STATUS(mfree_approximant_get_pair_gradients(a, gi, gj, dim, cap));
+    CHECK_STATUS(mfree_approximant_get_pair_gradients_antisymmetric(a, gi, dim, cap));
+    free(gi), free(gj);
+  }
+  /* correction data: one row of ncoef per particle */
+  int32_t ncoef = 0, n = 0;
+  if (mfree_approximant_get_correction_size(a, &ncoef) == MFREE_SUCCESS && ncoef > 0 && ps &&
+      mfree_particles_get_size(ps, &n, NULL) == MFREE_SUCCESS) {
+    const int64_t cap = (int64_t)ncoef * n - (int64_t)(take(b) % 2);
+    double *c = calloc((size_t)ncoef * (size_t)n + 1, sizeof *c);
+    CHECK_STATUS(mfree_approximant_get_correction(a, c, ncoef, cap));
+    free(c);
+  }
 }
 
 /* ---- a program of changes after the first setup ------------------------------------ */
@@ -159,7 +195,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const int opts = (int)take(&b);
   const int conv = 1 + (int)(take(&b) % 3);
   const double kappa = 1.0 + (take(&b) % 8) * 0.25;
-  const double scale = 1.0 / (1.0 + (take(&b) % 16));
+  const unsigned scale_byte = take(&b);
+  const double scale = 1.0 / (1.0 + (scale_byte % 16));
+  const int pairs = (int)(scale_byte & 16); /* a half pair list instead of CSR host lists */
 
   double x[3 * MAXN], h[MAXN], v[MAXN], u[MAXN], px[3 * MAXP], ph[MAXP];
   int finite_data = 1;
@@ -199,7 +237,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     const int32_t per[3] = {1, opts & 32 ? 1 : 0, 1};
     CHECK_STATUS(mfree_particles_set_periodic(ps, lo, hi, per));
   }
-  if ((opts & 64) && n > 0) {
+  if ((opts & 64) && n > 1 && pairs) {
+    /* each particle with the next one; the last pair repeated when scale_byte & 32 */
+    int32_t pi[MAXN], pj[MAXN];
+    int64_t np = 0;
+    for (int i = 0; i + 1 < n; ++i, ++np) pi[np] = i, pj[np] = i + 1;
+    if (scale_byte & 32) pi[np] = pi[np - 1], pj[np] = pj[np - 1], ++np;
+    CHECK_STATUS(mfree_particles_set_pairs(ps, np, pi, pj, 0, MFREE_COPY));
+    int64_t got = -1;
+    CHECK_STATUS(mfree_particles_get_num_pairs(ps, &got));
+  } else if ((opts & 64) && n > 0) {
     /* host lists: each owned particle sees itself and the next two (mod n) */
     int64_t rp[MAXN + 1];
     int32_t cols[3 * MAXN];
@@ -262,6 +309,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       }
       free(sst);
       free(out);
+      diagnostics(&b, a, dim, nsites);
       program(&b, ctx, ps, a, dim, n, npts >= 0, x, h, uu);
     }
     mfree_approximant_destroy(&a);

@@ -3,7 +3,9 @@
  * mfree_form_t and unknown ones), a quadrature (nodal, background cells with an
  * inside-test, host points with weights), material and coefficient, a body force,
  * essential conditions (penalty, Lagrange, collocation, Nitsche on boundary points;
- * conditions at nodes), setup, update after a move, the matrix (CSR, 32/64-bit views,
+ * conditions at nodes), tractions (points, 2D segments, 3D facets, collocation rows at
+ * nodes), consistent integration, a finite-element layer over lattice cells, back to
+ * nodal quadrature, setup, update after a move, the matrix (CSR, 32/64-bit views,
  * CSC, symmetric flag, product) and the right-hand side. Then a matrix from host CSR
  * (unsorted, repeated or out-of-range columns, non-finite values) and its product.
  * Oracles: documented statuses; a negative status leaves the matrix as it was; no NaN in
@@ -18,7 +20,7 @@ static void body(void *user, const double *x, double *f) {
 }
 static void gfun(void *user, const double *x, double *g) {
   (void)user;
-  for (int c = 0; c < 3; ++c) g[c] = x[0] * x[0] - c;
+  for (int c = 0; c < 3; ++c) g[c] = sin(x[0]) - c; /* finite at any finite point */
 }
 static int32_t inside(void *user, const double *x) {
   (void)user;
@@ -91,7 +93,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   double scale = 1.0;
 
   static double x[3 * MAXN], h[MAXN], v[MAXN], qx[3 * MAXQ], qw[MAXQ], f[4 * MAXN + 64];
-  static int32_t nodes[MAXN];
+  static int32_t nodes[MAXN], conn[4 * MAXN];
+  double nrm[3 * MAXQ];
+  for (int k = 0; k < 3 * MAXQ; ++k) nrm[k] = (k % dim) == 0 ? 1.0 : 0.0;
   int finite = 1;
   for (int p = 0; p < n; ++p) {
     const int idx[3] = {p % m, (p / m) % m, p / (m * m)};
@@ -147,8 +151,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (opts & 64) {
     const mfree_bc_t bc = (mfree_bc_t)(fz_u8(&b) % 6);
     const int32_t mask = (int32_t)(fz_u8(&b) % 9);
-    double nrm[3 * MAXQ];
-    for (int k = 0; k < dim * nq; ++k) nrm[k] = (k % dim) == 0 ? 1.0 : 0.0;
     FZ_CHECK(mfree_assembler_add_dirichlet(as, bc, nq, qx, MFREE_LAYOUT_AOS, dim, qw, nrm, mask, gfun, NULL));
   }
   if (opts & 128) {
@@ -156,6 +158,30 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     for (int k = 0; k < nn; ++k) nodes[k] = (int32_t)(fz_u8(&b) % (unsigned)(n + 1)) - (opts2 & 8 ? 1 : 0);
     FZ_CHECK(mfree_assembler_add_dirichlet_nodes(as, nn, nodes, (int32_t)(1 + fz_u8(&b) % 7), gfun, NULL));
   }
+  const unsigned opts3 = fz_u8(&b);
+  if (opts3 & 1) FZ_CHECK(mfree_assembler_add_traction(as, nq, qx, MFREE_LAYOUT_AOS, dim, qw, gfun, NULL));
+  if (opts3 & 2) { /* segments (2D) and triangles (3D) from the points' coordinates */
+    const int32_t ng = (int32_t)(fz_u8(&b) % 5);
+    FZ_CHECK(mfree_assembler_add_traction_segments(as, nq / 4, qx, ng, gfun, NULL));
+    FZ_CHECK(mfree_assembler_add_traction_facets(as, nq / 3, qx, ng, gfun, NULL));
+  }
+  if (opts3 & 4) { /* collocation traction rows at nodes */
+    const int nn = (int)(fz_u8(&b) % 6);
+    for (int k = 0; k < nn; ++k) nodes[k] = (int32_t)(fz_u8(&b) % (unsigned)(n + 1)) - (opts2 & 8 ? 1 : 0);
+    FZ_CHECK(mfree_assembler_add_traction_nodes(as, nn, nodes, nrm, gfun, NULL));
+  }
+  if (opts3 & 8) FZ_CHECK(mfree_assembler_set_consistent_integration(as, nq, qx, MFREE_LAYOUT_AOS, dim, qw, nrm));
+  if (opts3 & 16) { /* a finite-element layer over lattice cells (2D), maybe flipped or repeated */
+    const int npe = (opts3 & 32) ? 3 : 4, ne = 1 + (int)(fz_u8(&b) % 4);
+    for (int e = 0; e < ne; ++e) {
+      const unsigned w = fz_u8(&b);
+      const int32_t c0 = (int32_t)(w % (unsigned)n), c[4] = {c0, c0 + 1, c0 + m + 1, c0 + m};
+      for (int a = 0; a < npe; ++a) conn[npe * e + a] = (w & 128) ? c[npe - 1 - a] : c[a];
+    }
+    const int32_t ngu = (int32_t)(fz_u8(&b) % 3);
+    FZ_CHECK(mfree_assembler_set_fe_layer(as, ne, npe, conn, ngu, conn, (int32_t)(1 + fz_u8(&b) % 3), gfun, NULL));
+  }
+  if (opts3 & 64) FZ_CHECK(mfree_assembler_set_quadrature_nodal(as));
   if (opts2 & 16) FZ_CHECK(mfree_assembler_set_penalty(as, fz_positive(&b, 1e3)));
   /* an extreme (valid) coefficient or penalty may overflow the entries: no NaN oracle */
   finite &= !(opts & 16) && !(opts2 & 16);

@@ -106,6 +106,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (!mesh) goto done;
   FZ_CHECK(mfree_mesh_add_elements(mesh, type, ne, conn, base, mem));
   FZ_CHECK(mfree_mesh_setup(mesh));
+  int32_t nel = 0;
+  FZ_CHECK(mfree_mesh_get_size(mesh, &nel));
   {
     int32_t nq = 0;
     const int32_t ng = 1 + (int32_t)(fz_u8(&b) % 4);

@@ -2,7 +2,9 @@
  * count, ghosts, borrowed or copied positions, supports and volumes with special values,
  * search convention and kappa, a periodic box, host neighbour lists with arbitrary rows:
  * unsorted, repeated or out-of-range columns), then a program of calls: setup, update,
- * a change of ghost count, of a borrowed value, of the lists, of the box, of the search.
+ * a change of ghost count, of a borrowed value, of the lists, of the box, of the search;
+ * global ids (repeated, negative), masses and densities, a half pair list (repeated,
+ * self or out-of-range pairs), the halo width.
  * After every call: a documented status; after a negative one the lists and statuses are
  * those of before; after a setup or update the lists are sorted, in range, free of
  * repeated columns and of failed particles. */
@@ -13,8 +15,9 @@ enum { MAXN = 64, MAXNNZ = 8 * MAXN, NOPS = 24 };
 typedef struct {
   int dim, n;
   double x[3 * MAXN], h[MAXN], v[MAXN];
-  int64_t rp[MAXN + 1];
-  int32_t cols[MAXNNZ];
+  int64_t rp[MAXN + 1], gid[2][MAXN];
+  int gcur; /* gid[gcur] is the set's (maybe borrowed) ids: new ones go to the other */
+  int32_t cols[MAXNNZ], pi[MAXNNZ], pj[MAXNNZ];
 } data_t;
 
 /* Host lists from the bytes: row lengths 0..7, columns anywhere in [-1, n]. */
@@ -87,7 +90,38 @@ static mfree_status_t call(mfree_particles_t *ps, fz_bytes_t *b, data_t *d, int 
       return mfree_particles_set_positions(ps, d->x, layout, ld, mem);
     }
     case 8: return mfree_particles_set_support(ps, d->h, (int64_t)(fz_u8(b) % 3), mem);
-    default: return mfree_particles_set_volumes(ps, d->v, (int64_t)(fz_u8(b) % 2), mem);
+    case 9: return mfree_particles_set_volumes(ps, d->v, (int64_t)(fz_u8(b) % 2), mem);
+    case 10: { /* global ids: mostly distinct, sometimes repeated or negative; or none */
+      const unsigned k = fz_u8(b);
+      int64_t *ids = d->gid[1 - d->gcur];
+      for (int i = 0; i < d->n; ++i) ids[i] = (k & 1) ? (int64_t)(fz_u8(b) % 8) - 1 : 7 * (d->n - i);
+      const mfree_status_t st = mfree_particles_set_global_ids(ps, (k & 2) ? NULL : ids, mem);
+      if (st == MFREE_SUCCESS) d->gcur = 1 - d->gcur;
+      return st;
+    }
+    case 11: { /* masses or densities (volumes from them when both are set) */
+      const unsigned k = fz_u8(b);
+      return (k & 2) ? mfree_particles_set_masses(ps, d->v, (int64_t)(k % 2), mem)
+                     : mfree_particles_set_densities(ps, d->h, (int64_t)(k % 2), mem);
+    }
+    case 12: { /* a half pair list (0- or 1-based): pairs anywhere in [-1, n] */
+      const int base = (int)(fz_u8(b) & 1);
+      const int64_t np = fz_u8(b) % 32;
+      for (int64_t k = 0; k < np; ++k) {
+        const unsigned w = fz_u8(b);
+        d->pi[k] = (int32_t)(w % (unsigned)(d->n + 2)) - 1 + base;
+        d->pj[k] = (int32_t)((w >> 3) % (unsigned)(d->n + 2)) - 1 + base;
+      }
+      const mfree_status_t st = mfree_particles_set_pairs(ps, np, d->pi, d->pj, base, mem);
+      int64_t got = -1;
+      FZ_CHECK(mfree_particles_get_num_pairs(ps, &got));
+      return st;
+    }
+    default: {
+      double vol[MAXN + 1];
+      FZ_CHECK(mfree_particles_get_volumes(ps, vol));
+      return mfree_particles_set_halo_width(ps, fz_positive(b, 0.1));
+    }
   }
 }
 
@@ -114,7 +148,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   FZ_CHECK(mfree_particles_set_support(ps, d.h, 1, mem));
   FZ_CHECK(mfree_particles_set_volumes(ps, d.v, 1, mem));
   for (int k = 0; k < NOPS && b.n > 0; ++k) {
-    const int op = (int)(fz_u8(&b) % 10);
+    const int op = (int)(fz_u8(&b) % 14);
     fz_lists_t before, after;
     fz_lists_get(ps, &before);
     const mfree_status_t st = call(ps, &b, &d, op, mem);

@@ -2,8 +2,8 @@
  * (2D or 3D, particles jittered around a lattice, state with NaN, Inf, coincident
  * particles, zero or negative densities; fluid properties, masses, smoothing, gravity,
  * a box, walls, dummy particles, the Shepard threshold, density diffusion, velocity
- * smoothing, lumping), its right-hand side, mass and interpolation matrices, pressure,
- * a few integrator steps; (b) linear elastodynamics by Galerkin (Laplace or elasticity
+ * smoothing, consistent integration, lumping), its right-hand side, mass and
+ * interpolation matrices, pressure, smoothed velocity, a few integrator steps; (b) linear elastodynamics by Galerkin (Laplace or elasticity
  * stiffness with a mass assembler) and by collocation, its right-hand side and stress.
  * Oracles: documented statuses; a success status of the right-hand side on a finite
  * state gives a finite rate. */
@@ -20,9 +20,10 @@ static void fluid(fz_bytes_t *b, mfree_context_t *ctx) {
   const int dim = 2 + (int)(fz_u8(b) & 1);
   const int m = 2 + (int)(fz_u8(b) % (MAXM - 1));
   const int n = dim == 2 ? m * m : m * m * m;
-  const unsigned opts = fz_u8(b), opts2 = fz_u8(b);
+  const unsigned opts = fz_u8(b), opts2 = fz_u8(b), opts3 = fz_u8(b);
   const double sp = 1.0 / m;
-  static double y[7 * MAXN], ydot[7 * MAXN], mass[MAXN], p[MAXN], walls[6 * 8], dummy[3 * 8];
+  static double y[7 * MAXN], ydot[7 * MAXN], mass[MAXN], p[MAXN], vhat[3 * MAXN], rho0[MAXN], walls[6 * 8],
+      dummy[3 * 8];
   const int npos = dim * n;
   int finite = 1;
   for (int q = 0; q < n; ++q) {
@@ -37,13 +38,15 @@ static void fluid(fz_bytes_t *b, mfree_context_t *ctx) {
     y[2 * npos + q] = j == 0 ? 0.0 : j == 1 ? -1000.0 : 1000.0 * (1.0 + (j - 128) * 0.0005);
     finite &= j > 1;
     mass[q] = 1000.0 * pow(sp, dim);
+    rho0[q] = 1000.0 + q;
   }
   mfree_system_t *sys = NULL;
   FZ_CHECK(mfree_system_create_fluid(ctx, dim, n, &sys));
   if (!sys) return;
   if (opts & 1) {
-    const double rho0 = 1000.0, kappa = fz_positive(b, 10.0), gamma = 1.0 + (fz_u8(b) % 8);
-    FZ_CHECK(mfree_system_set_fluid(sys, &rho0, 0, kappa, gamma, (fz_u8(b) % 4) * 0.001));
+    const double kappa = fz_positive(b, 10.0), gamma = 1.0 + (fz_u8(b) % 8);
+    /* one rest density for all, or one per particle */
+    FZ_CHECK(mfree_system_set_fluid(sys, rho0, (opts3 & 2) ? 1 : 0, kappa, gamma, (fz_u8(b) % 4) * 0.001));
   }
   if (!(opts & 2)) FZ_CHECK(mfree_system_set_masses(sys, mass, 1));
   if (!(opts & 4)) FZ_CHECK(mfree_system_set_smoothing(sys, (opts2 & 1) ? fz_positive(b, sp) : 1.5 * sp));
@@ -72,6 +75,7 @@ static void fluid(fz_bytes_t *b, mfree_context_t *ctx) {
   if (opts2 & 16) FZ_CHECK(mfree_system_set_density_diffusion(sys, (fz_u8(b) % 4) * 0.05));
   if (opts2 & 32) FZ_CHECK(mfree_system_set_velocity_smoothing(sys, (fz_u8(b) % 3) * 0.25));
   if (opts2 & 64) FZ_CHECK(mfree_system_set_lumping(sys, (mfree_lumping_t)(fz_u8(b) % 4)));
+  if (opts3 & 1) FZ_CHECK(mfree_system_set_consistent_integration(sys, (int32_t)(fz_u8(b) % 3) - 1));
   int32_t neq = 0;
   FZ_TRAP_IF(mfree_system_get_size(sys, &neq) != MFREE_SUCCESS);
   /* extreme (valid) stiffness or smoothing may overflow the rate: no finiteness oracle */
@@ -84,6 +88,7 @@ static void fluid(fz_bytes_t *b, mfree_context_t *ctx) {
   FZ_CHECK(mfree_system_assemble_mass(sys, y, (int32_t)(opts2 >> 7), &M));
   FZ_CHECK(mfree_system_assemble_interpolation(sys, y, &S));
   FZ_CHECK(mfree_system_get_pressure(sys, y, p));
+  FZ_CHECK(mfree_system_get_velocity(sys, y, vhat));
   if (finite && (fz_u8(b) & 1)) {
     double t = 0.0;
     int64_t steps = 0;

@@ -54,8 +54,8 @@ static inline double fz_positive(fz_bytes_t *b, double scale) {
   }
 }
 
-/* The documented statuses: success, misuse -1..-7, data-dependent failures 1..7. */
-static inline int fz_valid_status(mfree_status_t st) { return st >= -7 && st <= 7; }
+/* The documented statuses: success, misuse -1..-8, data-dependent failures 1..7. */
+static inline int fz_valid_status(mfree_status_t st) { return st >= MFREE_ERR_HALO && st <= 7; }
 
 #define FZ_TRAP_IF(cond)          \
   do {                            \
@@ -151,14 +151,21 @@ static inline void fz_lists_get(const mfree_particles_t *ps, fz_lists_t *l) {
   l->status = calloc((size_t)l->n + 1, sizeof *l->status);
   FZ_TRAP_IF(mfree_particles_get_neighbors(ps, l->rowptr, l->cols) != MFREE_SUCCESS);
   FZ_TRAP_IF(mfree_particles_get_site_status(ps, l->status, NULL) != MFREE_SUCCESS);
-  /* rows sorted, in range, no column twice; failed particles listed nowhere */
+  /* rows sorted (by global id when the set has ids), in range, no column twice; failed
+   * particles listed nowhere */
+  int64_t *ids = calloc((size_t)l->n + 1, sizeof *ids);
+  const int by_id = mfree_particles_get_global_ids(ps, ids) == MFREE_SUCCESS;
   for (int32_t i = 0; i < l->n - ng; ++i)
     for (int64_t k = l->rowptr[i]; k < l->rowptr[i + 1]; ++k) {
       const int32_t j = l->cols[k];
       FZ_TRAP_IF(j < 0 || j >= l->n);
-      FZ_TRAP_IF(k > l->rowptr[i] && l->cols[k - 1] >= j);
+      if (k > l->rowptr[i]) {
+        const int32_t q = l->cols[k - 1];
+        FZ_TRAP_IF(by_id ? ids[q] >= ids[j] : q >= j);
+      }
       FZ_TRAP_IF(l->status[j] != 0 || l->status[i] != 0);
     }
+  free(ids);
 }
 
 static inline void fz_lists_same(const fz_lists_t *a, const fz_lists_t *b) {
