@@ -1109,9 +1109,13 @@ MFREE_API mfree_status_t mfree_approximant_get_site_order(const mfree_approximan
  * the corrected ones). Signs are those of a hydrocode's dwdx = grad_i W(x_i - x_j, h_ij):
  * for MFREE_METHOD_SPH and _SPH_SYMMETRIC, gi is exactly that, from the kernel, and
  * gj = -gi exactly when h_ij is symmetric (search convention SYMMETRIC_MEAN or _MAX, or
- * one h for all). Corrected gradients are not antisymmetric: gj != -gi. A side whose
- * particle has no row (a ghost, an isolated particle, a failed site) is 0, except for
- * SPH, which needs no row; a pair outside the kernel's support is 0. No allocation.
+ * one h for all). Corrected gradients are not antisymmetric: gj != -gi. For the methods
+ * with correction data (mfree_approximant_get_correction) each side is computed from its
+ * particle's record with the arithmetic of the table's rows (equal to the table entry
+ * divided by the volume to round-off). A side whose particle has no row (a ghost, an
+ * isolated particle, a failed site) is 0, except for SPH, which needs no row, and a
+ * ghost whose record was given (mfree_approximant_set_ghost_correction); a pair outside
+ * the kernel's support is 0. No allocation.
  * @param[in]  a         a set-up approximant at the particles (not MPFEM, not host
  *                       points: MFREE_ERR_UNSUPPORTED) with a gradient table
  * @param[out] gi, gj    npairs records of dim doubles every ld; gj may be NULL
@@ -1179,6 +1183,34 @@ MFREE_API mfree_status_t mfree_approximant_get_correction_size(const mfree_appro
 MFREE_API mfree_status_t mfree_approximant_get_correction(const mfree_approximant_t *a,
                                                           double *c, int64_t ld,
                                                           int64_t capacity);
+
+/**
+ * The ghosts' correction data, for a rank whose ghosts are other ranks' particles
+ * (docs/mpi.md): c holds one record of ncoef doubles (mfree_approximant_get_correction_size)
+ * per ghost, ghost g (g = 0 .. n_ghost-1, the set's ghost order: particle n_owned + g) at
+ * c[g*ld], each the record mfree_approximant_get_correction gives for that particle
+ * where it is owned. The data are copied. The ghost side of
+ * mfree_approximant_get_pair_gradients (and so the antisymmetrised form) is then
+ * computed from the ghost's record exactly as the owned side of a particle is from its
+ * own (every side of a method with correction data is computed from a record), so that
+ * with the records of the ghosts' owners and the same rows (global ids,
+ * mfree_particles_set_global_ids) a rank's pair gradients equal those of one process
+ * bit for bit. A record of zeros (a site that failed or fell back at its owner) leaves
+ * that ghost's side 0. The next mfree_approximant_setup or _update drops the data: the
+ * ghost side is 0 again until the next call.
+ * @param[in] a         a set-up approximant at the particles
+ * @param[in] c         n_ghost records of ncoef doubles every ld; may be NULL without ghosts
+ * @param[in] ld        >= ncoef
+ * @param[in] capacity  doubles c holds, at least (n_ghost - 1) * ld + ncoef
+ * @return MFREE_SUCCESS; MFREE_ERR_ARG for ld or capacity too small; MFREE_ERR_NULL for
+ *         c NULL with ghosts; MFREE_ERR_INPUT for a non-finite value (named);
+ *         MFREE_ERR_UNSUPPORTED for a method without correction data, host points or
+ *         MPFEM; MFREE_ERR_STATE when the approximant is not set up or the set was set
+ *         up again after it. A failed call changes nothing.
+ */
+MFREE_API mfree_status_t mfree_approximant_set_ghost_correction(mfree_approximant_t *a,
+                                                                const double *c, int64_t ld,
+                                                                int64_t capacity);
 
 /* ------------------------------------------------------------------------------------ */
 /* Sparse matrices                                                                        */

@@ -566,6 +566,15 @@ module mfree
       integer(c_int64_t), value :: capacity
     end function mfree_approximant_get_correction_c
 
+    integer(c_int) function mfree_approximant_set_ghost_correction_c(a, c, ld, capacity) &
+        bind(C, name="mfree_approximant_set_ghost_correction")
+      import :: c_int, c_int64_t, c_ptr, c_double
+      type(c_ptr), value :: a
+      real(c_double), intent(in) :: c(*)
+      integer(c_int64_t), value :: ld
+      integer(c_int64_t), value :: capacity
+    end function mfree_approximant_set_ghost_correction_c
+
     ! -- an object's context and particle set (for the wrappers' own checks)
     integer(c_int) function mfree_particles_get_context_c(ps, ctx) &
         bind(C, name="mfree_particles_get_context")
@@ -1410,6 +1419,7 @@ module mfree
   public :: mfree_approximant_get_pair_gradients_c
   public :: mfree_approximant_get_pair_gradients_antisymmetric_c
   public :: mfree_approximant_get_correction_size_c, mfree_approximant_get_correction_c
+  public :: mfree_approximant_set_ghost_correction_c
   public :: mfree_particles_get_context_c, mfree_approximant_get_context_c
   public :: mfree_mesh_get_context_c, mfree_matrix_get_context_c
   public :: mfree_assembler_get_context_c, mfree_system_get_context_c
@@ -1524,6 +1534,7 @@ module mfree
   public :: mfree_approximant_get_pair_gradients
   public :: mfree_approximant_get_pair_gradients_antisymmetric
   public :: mfree_approximant_get_correction_size, mfree_approximant_get_correction
+  public :: mfree_approximant_set_ghost_correction
   public :: mfree_particles_get_context, mfree_approximant_get_context
   public :: mfree_mesh_get_context, mfree_matrix_get_context
   public :: mfree_assembler_get_context, mfree_system_get_context
@@ -2925,23 +2936,53 @@ contains
   integer(c_int) function mfree_approximant_get_correction(a, c) result(st)
     type(mfree_approximant), intent(in) :: a
     real(c_double), intent(out), target :: c(:, :)
-    integer(c_int32_t) :: nsites, nc
-    character(len=*), parameter :: fn = 'mfree_approximant_get_correction'
-    st = mfree_approximant_get_correction_size_c(a%ptr, nc)
-    if (st == MFREE_SUCCESS) st = mfree_approximant_get_num_sites_c(a%ptr, nsites)
-    if (st /= MFREE_SUCCESS) return
-    if (size(c, 1) < nc) then
-      st = wrapper_error(ctx_of_approximant(a), MFREE_ERR_ARG, fn // ': c has ' // &
-                         int_str(size(c, 1, kind=c_int64_t)) // ' rows, ' // &
-                         int_str(int(nc, c_int64_t)) // ' are needed')
-      return
-    end if
-    st = check_out(ctx_of_approximant(a), fn, 'c columns', is_contiguous(c), &
-                   size(c, 2, kind=c_int64_t), int(nsites, c_int64_t))
+    integer(c_int32_t) :: nsites
+    st = mfree_approximant_get_num_sites_c(a%ptr, nsites)
+    if (st == MFREE_SUCCESS) st = check_correction_array(a, 'mfree_approximant_get_correction', &
+                                                         is_contiguous(c), size(c, 1, kind=c_int64_t), &
+                                                         size(c, 2, kind=c_int64_t), nsites)
     if (st /= MFREE_SUCCESS) return
     st = mfree_approximant_get_correction_c(a%ptr, out_loc(c), size(c, 1, kind=c_int64_t), &
                                             size(c, kind=c_int64_t))
   end function mfree_approximant_get_correction
+
+  !> The ghosts' correction data c(ld, n_ghost), ld >= ncoef, ghost g in column g (the
+  !> records mfree_approximant_get_correction gives where the ghosts are owned; mfree.h).
+  !> Copied (a non-contiguous section is packed first). MFREE_ERR_ARG, nothing read, when
+  !> c is too small.
+  integer(c_int) function mfree_approximant_set_ghost_correction(a, c) result(st)
+    type(mfree_approximant), intent(in) :: a
+    real(c_double), intent(in), target :: c(:, :)
+    integer(c_int32_t) :: dim, n, ng
+    real(c_double), allocatable, target :: tc(:)
+    real(c_double), pointer :: pc(:)
+    st = approximant_sizes(a, dim, n, ng)
+    if (st == MFREE_SUCCESS) st = check_correction_array(a, 'mfree_approximant_set_ghost_correction', &
+                                                         .true., size(c, 1, kind=c_int64_t), &
+                                                         size(c, 2, kind=c_int64_t), ng)
+    if (st /= MFREE_SUCCESS) return
+    call view_dbl(c, tc, pc)
+    st = mfree_approximant_set_ghost_correction_c(a%ptr, pc, size(c, 1, kind=c_int64_t), &
+                                                  size(c, kind=c_int64_t))
+  end function mfree_approximant_set_ghost_correction
+
+  !> A correction-data array (ld, ncol): ld >= ncoef, ncol >= count, contiguous.
+  integer(c_int) function check_correction_array(a, fn, contig, ld, ncol, count) result(st)
+    type(mfree_approximant), intent(in) :: a
+    character(len=*), intent(in) :: fn
+    logical, intent(in) :: contig
+    integer(c_int64_t), intent(in) :: ld, ncol
+    integer(c_int32_t), intent(in) :: count
+    integer(c_int32_t) :: nc
+    st = mfree_approximant_get_correction_size_c(a%ptr, nc)
+    if (st /= MFREE_SUCCESS) return
+    if (ld < nc) then
+      st = wrapper_error(ctx_of_approximant(a), MFREE_ERR_ARG, fn // ': c has ' // int_str(ld) // &
+                         ' rows, ' // int_str(int(nc, c_int64_t)) // ' are needed')
+      return
+    end if
+    st = check_out(ctx_of_approximant(a), fn, 'c columns', contig, ncol, int(count, c_int64_t))
+  end function check_correction_array
 
   !> The context (borrowed: do not destroy it) and the particle set (borrowed) of a.
   integer(c_int) function mfree_approximant_get_context(a, ctx) result(st)

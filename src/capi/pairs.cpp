@@ -100,4 +100,16 @@ mfree_status_t mfree_approximant_get_correction(const mfree_approximant_t *a, do
   });
 }
 
+mfree_status_t mfree_approximant_set_ghost_correction(mfree_approximant_t *a, const double *c,
+                                                     int64_t ld, int64_t capacity) {
+  return mfree::with_handle(a, "mfree_approximant_set_ghost_correction", [&](mfree::Approximant &ap) {
+    MFREE_REQUIRE(ap.is_setup(), MFREE_ERR_STATE, "the approximant is not set up");
+    const int m = ap.correction_size();
+    const mfree::ParticleSet &ps = ap.particles();
+    check_records(c, ps.size() - ps.num_owned(), m, ld, capacity, "c");
+    ap.set_ghost_correction(c, ld);
+    return MFREE_SUCCESS;
+  });
+}
+
 }  // extern "C"

@@ -743,6 +743,7 @@ Report Approximant::setup() {
   Report rep = compute("setup");
   record_set_state();
   setup_done_ = true;
+  refresh_records();
   return rep;
 }
 
@@ -752,7 +753,9 @@ Report Approximant::update() {
   if (method_ == MFREE_METHOD_MPFEM) return compute_mpfem();
   validate_config();
   pack();
-  return compute("update");
+  Report rep = compute("update");
+  refresh_records();
+  return rep;
 }
 
 namespace {

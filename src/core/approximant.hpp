@@ -84,6 +84,9 @@ class Approximant {
   // Per-site correction data (layout in mfree.h): doubles per site, and the records.
   int correction_size() const;
   void correction(double *c, int64_t ld) const;
+  // The ghosts' records (ghost g at c[g * ld], the layout of correction()), copied: the
+  // ghost side of the pair gradients then comes from them until the next setup/update.
+  void set_ghost_correction(const double *c, int64_t ld);
 
   const HVec<int32_t> &site_status() const { return status_; }
   const HVec<int32_t> &site_support() const { return support_; }
@@ -128,6 +131,13 @@ class Approximant {
   void check_pairs_ready(const char *what) const;
   // The volumes of the last setup/update: particle j's is vol[j * stride].
   const double *packed_volumes(int64_t &stride) const;
+  // Whether the method has correction data (correction_size() does not throw).
+  bool has_correction() const;
+  // The records of the sites (correction()) computed into c, every ld doubles.
+  void compute_records(double *c, int64_t ld) const;
+  // After a setup/update: the sites' records kept for the pair gradients when the set
+  // has a pair list (records_), the ghosts' dropped.
+  void refresh_records();
 
   const ParticleSet *ps_;
   int method_;
@@ -174,6 +184,12 @@ class Approximant {
   HVec<double> pack_, spack_;
   HVec<int32_t> pbad_;  // find_bad_particles
   uint64_t set_rows_hash_ = 0;  // (with set_setups_: record_set_state)
+  // Correction records (pair-list sets): the sites' (empty when not kept) and the
+  // ghosts' (set_ghost_correction; ghost_valid_ false for a record of zeros, a site that
+  // failed at its owner, and for all after a setup/update).
+  HVec<double> records_, ghost_records_;
+  HVec<uint8_t> ghost_valid_;
+  bool ghost_set_ = false;
   int32_t set_owned_ = 0;
 };
 

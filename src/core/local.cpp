@@ -44,28 +44,19 @@ int weights(Site &s, bool need_grad, bool need_hess) {
   int support = 0;
   for (int j = 0; j < s.n; ++j) {
     const double *dj = s.d(j);
-    double r2 = 0.0;
-    for (int c = 0; c < s.dim; ++c) r2 += dj[c] * dj[c];
-    const double r = std::sqrt(r2);
-    double wv, dw, d2w;
-    k.eval(r, s.in.h[j], wv, dw, d2w);
+    double r, wv, dw, d2w;
+    double *g = s.gw(j);
+    double *H = s.hw(j);
+    kernel_at(k, s.dim, dj, s.in.h[j], r, wv, dw, d2w, g);
     s.w.r[j] = r;
     s.w.w[j] = wv;
     if (wv != 0.0) ++support;
-    double *g = s.gw(j);
-    double *H = s.hw(j);
-    if (!need_grad && !need_hess) {
-      g[0] = g[1] = g[2] = 0.0;
-    } else {
-      if (r > 0.0) {
-        for (int c = 0; c < s.dim; ++c) g[c] = -dw * dj[c] / r;
-      } else {
-        for (int c = 0; c < s.dim; ++c) g[c] = 0.0;
-      }
-    }
+    if (!need_grad && !need_hess) g[0] = g[1] = g[2] = 0.0;
     if (!need_hess) {
       for (int e = 0; e < 6; ++e) H[e] = 0.0;
     } else {
+      double r2 = 0.0;
+      for (int c = 0; c < s.dim; ++c) r2 += dj[c] * dj[c];
       // W'' n n + W'/r (I - n n), n = d / r; at r = 0 the limit W''(0) I
       for (int a = 0; a < s.dim; ++a)
         for (int b = a; b < s.dim; ++b) {
@@ -589,6 +580,62 @@ int run(Site &s, int order) {
 }
 
 }  // namespace
+
+RecordGradient::RecordGradient(const LocalConfig &cfg)
+    : cfg_(cfg),
+      basis_(cfg.dim, cfg.method == MFREE_METHOD_MLS || cfg.method == MFREE_METHOD_RKPM ? cfg.order : 0) {}
+
+void RecordGradient::operator()(const double *rec, double hs, const double *d, double h,
+                                double vol, double *g) const {
+  const int dim = cfg_.dim;
+  double r, w, dw, d2w, gw[3] = {0, 0, 0};
+  kernel_at(*cfg_.kernel, dim, d, h, r, w, dw, d2w, gw);
+  // each case repeats the arithmetic of its rows in run() (and shepard(), mls_fixed())
+  switch (cfg_.method) {
+    case MFREE_METHOD_SHEPARD: {
+      const double iS = 1.0 / rec[0];
+      for (int c = 0; c < dim; ++c) g[c] = gw[c] * iS - w * rec[1 + c] * iS * iS;
+      return;
+    }
+    case MFREE_METHOD_JOHNSON_BEISSEL:
+      for (int c = 0; c < dim; ++c) g[c] = rec[c] * gw[c] * vol;
+      return;
+    case MFREE_METHOD_RANDLES_LIBERSKY:
+    case MFREE_METHOD_KB_METHOD1: {
+      const double ih = 1.0 / hs;
+      double q[3];
+      if (cfg_.method == MFREE_METHOD_RANDLES_LIBERSKY) {
+        for (int c = 0; c < dim; ++c) q[c] = gw[c] * vol * hs;
+      } else {  // the Shepard function's gradient, from S and grad S after M
+        const double *S = rec + dim * dim, iS = 1.0 / S[0];
+        for (int c = 0; c < dim; ++c) q[c] = (gw[c] * iS - w * S[1 + c] * iS * iS) * hs;
+      }
+      for (int a = 0; a < dim; ++a) {
+        double f = 0.0;
+        for (int b = 0; b < dim; ++b) f += rec[a + b * dim] * q[b];
+        g[a] = f * ih;
+      }
+      return;
+    }
+    default: {  // MLS, RKPM: gamma, then d gamma / dx_c
+      const bool rkpm = cfg_.method == MFREE_METHOD_RKPM;
+      const int L = basis_.size();
+      const double ih = 1.0 / hs;
+      double sj[3] = {0, 0, 0}, p[kMaxBasis];
+      for (int c = 0; c < dim; ++c) sj[c] = d[c] * ih;
+      basis_.eval(sj, p);
+      auto dot = [&](const double *v) {
+        double t = 0.0;
+        for (int a = 0; a < L; ++a) t += v[a] * p[a];
+        return t;
+      };
+      const double gp = dot(rec), o = rkpm ? w * vol : w;
+      for (int i = 0; i < dim; ++i)
+        g[i] = o * dot(rec + (1 + i) * L) + (rkpm ? gw[i] * vol : gw[i]) * gp;
+      return;
+    }
+  }
+}
 
 void LocalWork::reserve(int n, int dim, int L) {
   (void)dim;

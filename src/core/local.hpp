@@ -2,6 +2,7 @@
 // rows of the value, gradient and Hessian tables for one method.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -53,6 +54,37 @@ struct LocalWork {
 // Compute one site with the configured method and order (no fallback).
 void compute_site(const LocalConfig &cfg, const LocalInput &in, LocalWork &work,
                   LocalOutput &out);
+
+// The kernel at d = x_j - x (dim values) with support h: r = |d|, the value w and its
+// gradient with respect to x, gw = -W'(r) d / r (0 at r = 0), as every table computes
+// them; dw = W'(r), d2w = W''(r).
+inline void kernel_at(const Kernel &k, int dim, const double *d, double h, double &r, double &w,
+                      double &dw, double &d2w, double *gw) {
+  double r2 = 0.0;
+  for (int c = 0; c < dim; ++c) r2 += d[c] * d[c];
+  r = std::sqrt(r2);
+  k.eval(r, h, w, dw, d2w);
+  for (int c = 0; c < dim; ++c) gw[c] = r > 0.0 ? -dw * d[c] / r : 0.0;
+}
+
+// The gradient entry of one neighbour j in a site's row from the site's correction
+// record (LocalOutput::coef, the layout of mfree_approximant_get_correction), with the
+// arithmetic of compute_site's rows: what a process that holds the record but not the
+// site's row (a ghost's owner sent it) computes as the site's table would. For Shepard,
+// MLS/RKPM of order <= 2, Johnson-Beissel, Randles-Libersky and KB Method 1 (cfg.method,
+// cfg.order, cfg.dim, cfg.kernel).
+class RecordGradient {
+ public:
+  explicit RecordGradient(const LocalConfig &cfg);
+  // d = x_j - x (3 values), h the pair's support, vol V_j, hs the site's length scale;
+  // writes dim values to g.
+  void operator()(const double *rec, double hs, const double *d, double h, double vol,
+                  double *g) const;
+
+ private:
+  LocalConfig cfg_;
+  Basis basis_;
+};
 
 // Natural order reported for a method without a polynomial order.
 int fixed_order(int method);

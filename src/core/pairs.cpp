@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "approximant.hpp"
+#include "local.hpp"
 #include "parallel.hpp"
 
 namespace mfree {
@@ -227,17 +228,31 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
   const auto &pst = ps_->site_status();
   // grad_s W(x_s - x_j, h_sj) from the kernel (SPH needs no row)
   auto kernel_gradient = [&](int32_t s, int32_t j, double *g) {
-    double d[3] = {0, 0, 0};
+    double d[3] = {0, 0, 0}, r, w, dw, d2w;
     ps_->displacement(j, s, d);  // x_j - x_s
-    double r2 = 0.0;
-    for (int c = 0; c < dim; ++c) r2 += d[c] * d[c];
-    const double r = std::sqrt(r2);
-    if (r > 0.0) {
-      double w, dw, d2w;
-      kernel_->eval(r, pair_h(s, j), w, dw, d2w);
-      for (int c = 0; c < dim; ++c) g[c] = -dw * d[c] / r;
-    }
+    kernel_at(*kernel_, dim, d, pair_h(s, j), r, w, dw, d2w, g);
   };
+  // Methods with correction records take every side from a record, the sites' own or a
+  // ghost's (set_ghost_correction), so that a side computed where the particle is a
+  // ghost equals the one computed where it is owned, bit for bit. A site whose record
+  // is missing (it fell back to another order) is looked up in its row.
+  const bool by_record = !records_.empty();
+  const int m = by_record ? correction_size() : 0;
+  const int want_order = has_order(method_) ? order_ : fixed_order(method_);
+  auto record_of = [&](int32_t s) -> const double * {
+    if (!by_record) return nullptr;
+    if (s < owned)
+      return status_[s] == 0 && order_used_[s] == want_order ? records_.data() + int64_t{s} * m
+                                                             : nullptr;
+    const int64_t g = s - owned;
+    return ghost_set_ && ghost_valid_[g] ? ghost_records_.data() + g * m : nullptr;
+  };
+  LocalConfig rcfg;
+  rcfg.method = method_;
+  rcfg.dim = dim;
+  rcfg.order = order_;
+  rcfg.kernel = kernel_.get();
+  const RecordGradient record_gradient(rcfg);
   const int nt = num_threads(P);
   if (sph && sym_h) {
     // the kernel gradient, computed as the host computes its dwdx (the table's entries
@@ -254,7 +269,7 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
     });
     return;
   }
-  if (direct && !sph) {
+  if (direct && !sph && !by_record) {
     parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
       // the j side's row is far from the i side's in the tables: its entry is fetched a
       // few pairs ahead (the i sides run through their rows in order)
@@ -300,6 +315,15 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
       kernel_gradient(s, j, g);
       return true;
     }
+    if (const double *rec = record_of(s)) {
+      double d[3] = {0, 0, 0};
+      ps_->displacement(j, s, d);  // x_j - x_s
+      const double vj = vol[j * vstride];
+      record_gradient(rec, site_h(s), d, pair_h(s, j), vj, g);
+      const double iv = 1.0 / vj;
+      for (int c = 0; c < dim; ++c) g[c] *= iv;
+      return true;
+    }
     if (s >= owned || status_[s] != 0) return false;
     const int64_t q = find(s, j, hint);
     if (q >= 0) {
@@ -340,8 +364,67 @@ int Approximant::correction_size() const {
   }
 }
 
+bool Approximant::has_correction() const {
+  switch (method_) {
+    case MFREE_METHOD_SHEPARD:
+    case MFREE_METHOD_JOHNSON_BEISSEL:
+    case MFREE_METHOD_RANDLES_LIBERSKY:
+    case MFREE_METHOD_KB_METHOD1:
+      return true;
+    case MFREE_METHOD_MLS:
+    case MFREE_METHOD_RKPM:
+      return order_ <= 2;
+    default:
+      return false;
+  }
+}
+
 void Approximant::correction(double *out, int64_t ld) const {
   check_pairs_ready("correction data");
+  const int m = correction_size();
+  if (records_.empty()) return compute_records(out, ld);
+  for (int32_t s = 0; s < nsites_; ++s)
+    std::copy_n(records_.data() + int64_t{s} * m, m, out + s * ld);
+}
+
+void Approximant::refresh_records() {
+  ghost_set_ = false;
+  const bool keep = !points_ && method_ != MFREE_METHOD_MPFEM && ps_->has_pairs() &&
+                    (flags_ & MFREE_DERIV_GRADIENT) && has_correction();
+  if (!keep) {
+    records_.clear();
+    return;
+  }
+  const int m = correction_size();
+  records_.resize(static_cast<size_t>(nsites_) * m);
+  compute_records(records_.data(), m);
+}
+
+void Approximant::set_ghost_correction(const double *c, int64_t ld) {
+  check_pairs_ready("ghost correction data");
+  const int m = correction_size();
+  const int64_t ng = ps_->size() - ps_->num_owned();
+  // checked in full before anything is kept: a failed call changes nothing
+  for (int64_t g = 0; g < ng; ++g)
+    for (int a = 0; a < m; ++a)
+      if (!std::isfinite(c[g * ld + a]))
+        throw Error(MFREE_ERR_INPUT, "ghost correction data: value " + std::to_string(a) +
+                                         " of ghost " + std::to_string(g) + " (particle " +
+                                         std::to_string(ps_->num_owned() + g) + ") is not finite");
+  ghost_records_.resize(static_cast<size_t>(ng * m));
+  ghost_valid_.resize(static_cast<size_t>(ng));
+  for (int64_t g = 0; g < ng; ++g) {
+    const double *src = c + g * ld;
+    double *dst = ghost_records_.data() + g * m;
+    bool any = false;
+    for (int a = 0; a < m; ++a) any |= src[a] != 0.0;
+    std::copy_n(src, m, dst);
+    ghost_valid_[g] = any;  // zeros: a site that failed or fell back at its owner
+  }
+  ghost_set_ = true;
+}
+
+void Approximant::compute_records(double *out, int64_t ld) const {
   const int m = correction_size();
   const int dim = ps_->dim();
   LocalConfig cfg;

@@ -11,6 +11,7 @@ program t442
   integer, parameter :: m = 6, n = m * m
   real(c_double), target :: x(3, n), h(n), vol(n), big(4, 4 * n * n)
   real(c_double), allocatable, target :: gi(:, :), gj(:, :), ref(:, :), cor(:, :)
+  real(c_double), allocatable, target :: gg(:, :), ggj(:, :), refj(:, :)
   integer, target :: pi(n * n), pj(n * n), nbrow(n + 1), nbcol(n * n)
   integer(c_int64_t), target :: rowptr(n + 1)
   integer(c_int32_t), target :: cols(n * n)
@@ -18,8 +19,8 @@ program t442
   integer(c_int) :: st
   integer(c_int32_t) :: nc
   type(mfree_context) :: ctx
-  type(mfree_particles) :: ps, pc
-  type(mfree_approximant) :: a
+  type(mfree_particles) :: ps, pc, pg
+  type(mfree_approximant) :: a, ag
   character(len=:), allocatable :: msg
 
   do p = 1, n
@@ -126,6 +127,33 @@ program t442
   k = 1
   call check(maxval(abs(gi(:, k) - matmul(reshape(cor(:, pi(k)), [2, 2]), rl_dwdx(k)))) <= &
              1e-12_c_double * maxval(abs(gi(:, k))), 'RL record: M dwdx')
+
+  ! ---- ghost correction data: the last row of particles as ghosts, their records from a ----
+  ! ---- (where they are owned): too small is refused; a strided section is packed ---------
+  call check_ok(ctx, mfree_particles_create(ctx, 2, n, pg), 'pg create')
+  call check_ok(ctx, mfree_particles_set_num_ghost(pg, m), 'pg ghosts')
+  call check_ok(ctx, mfree_particles_set_positions(pg, x, MFREE_LAYOUT_AOS, 3, MFREE_BORROW), 'pg x')
+  call check_ok(ctx, mfree_particles_set_support(pg, h, 1, MFREE_BORROW), 'pg h')
+  call check_ok(ctx, mfree_particles_set_volumes(pg, vol(1), 0, MFREE_COPY), 'pg volumes')
+  call check_ok(ctx, mfree_particles_set_pairs(pg, niac, pi, pj, 1, MFREE_BORROW), 'pg pairs')
+  call check_ok(ctx, mfree_particles_setup(pg), 'pg setup')
+  call check_ok(ctx, mfree_approximant_create(ctx, pg, MFREE_METHOD_RANDLES_LIBERSKY, ag), 'ag create')
+  call check_ok(ctx, mfree_approximant_set_derivatives(ag, MFREE_DERIV_GRADIENT), 'ag flags')
+  call check_ok(ctx, mfree_approximant_setup(ag), 'ag setup')
+  call check(mfree_approximant_set_ghost_correction(ag, cor(:, n - m + 1:n - 1)) == MFREE_ERR_ARG, &
+             'ghost correction one column short')
+  call check(index(mfree_last_error(ctx), 'are needed') > 0, 'short ghost records: message')
+  call check(mfree_approximant_set_ghost_correction(ag, cor(1:nc - 1, n - m + 1:n)) == MFREE_ERR_ARG, &
+             'ghost correction rows')
+  big(1:nc, 1:2 * m:2) = cor(:, n - m + 1:n)
+  call check_ok(ctx, mfree_approximant_set_ghost_correction(ag, big(1:nc, 1:2 * m:2)), 'ghost records')
+  allocate (gg(3, niac), ggj(3, niac), refj(3, niac))
+  call check_ok(ctx, mfree_approximant_get_pair_gradients(a, ref, refj), 'one set, both sides')
+  call check_ok(ctx, mfree_approximant_get_pair_gradients(ag, gg, ggj), 'ghosts, both sides')
+  call check(all(gg(1:2, :) == ref(1:2, :)) .and. all(ggj(1:2, :) == refj(1:2, :)), &
+             'ghost sides from the records: equal')
+  call check_ok(ctx, mfree_approximant_destroy(ag), 'destroy ag')
+  call check_ok(ctx, mfree_particles_destroy(pg), 'destroy pg')
 
   ! ---- exports: too short or not contiguous -------------------------------------------------
   call check_ok(ctx, mfree_particles_get_neighbor_nnz(ps, rowptr(1)), 'nnz')
