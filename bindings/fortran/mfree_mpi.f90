@@ -18,7 +18,8 @@
 module mfree_mpi
   use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_ptr, &
     c_null_ptr, c_loc, c_f_pointer
-  use mfree, only: mfree_context, MFREE_SUCCESS, mfree_wrapper_check_out, mfree_wrapper_view_dbl
+  use mfree, only: mfree_context, mfree_approximant, MFREE_SUCCESS, mfree_wrapper_check_out, &
+    mfree_wrapper_view_dbl
   implicit none
   private
 
@@ -87,6 +88,13 @@ module mfree_mpi
       integer(c_int64_t), intent(out) :: n_recv
     end function mfree_halo_get_plan_c
 
+    integer(c_int) function mfree_halo_exchange_correction_c(halo, a) &
+        bind(C, name="mfree_halo_exchange_correction")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: halo
+      type(c_ptr), value :: a
+    end function mfree_halo_exchange_correction_c
+
     integer(c_int) function mfree_halo_get_context_c(halo, ctx) &
         bind(C, name="mfree_halo_get_context")
       import :: c_int, c_ptr
@@ -114,10 +122,11 @@ module mfree_mpi
   public :: mfree_halo_get_size_c, mfree_halo_get_global_ids_c
   public :: mfree_halo_get_global_offset_c, mfree_halo_get_plan_c, mfree_halo_exchange_c
   public :: mfree_halo_get_context_c, mfree_halo_set_pending_error_c
+  public :: mfree_halo_exchange_correction_c
   public :: mfree_halo_create, mfree_halo_create_f, mfree_halo_destroy, mfree_halo_setup
   public :: mfree_halo_get_size, mfree_halo_get_global_ids, mfree_halo_get_global_offset
   public :: mfree_halo_get_plan, mfree_halo_exchange, mfree_halo_get_context
-  public :: mfree_halo_set_pending_error
+  public :: mfree_halo_set_pending_error, mfree_halo_exchange_correction
 
   real(c_double), target, save :: empty_dbl(0)
 
@@ -233,6 +242,14 @@ contains
     end if
     st = mfree_halo_exchange_c(halo%ptr, ncomp, pf, ld)
   end function mfree_halo_exchange
+
+  !> The ghosts' correction records of approximant a from their owners (mfree_mpi.h).
+  !> Collective; after every setup or update of a.
+  integer(c_int) function mfree_halo_exchange_correction(halo, a) result(st)
+    type(mfree_halo), intent(in) :: halo
+    type(mfree_approximant), intent(in) :: a
+    st = mfree_halo_exchange_correction_c(halo%ptr, a%ptr)
+  end function mfree_halo_exchange_correction
 
   !> Typed wrapper of mfree_halo_get_context (mfree_mpi.h): the plan's context, borrowed.
   integer(c_int) function mfree_halo_get_context(halo, ctx) result(st)

@@ -9,7 +9,12 @@
  * exclusive scan, and after the particles move and the plan is rebuilt the RL rows again
  * equal a one-rank run of the moved cloud. With a plan two support radii wide and the
  * first layer of ghosts counted as owned, the first layer's rows (RL, KB 1, MLS 2, whose
- * correction matrices and coefficients they hold) are their owners' bits too. */
+ * correction matrices and coefficients they hold) are their owners' bits too.
+ * Pair gradients (a half pair list within kappa (h_i + h_j) / 2 on each rank, every pair
+ * with an owned particle): for SPH, RL, KB Method 1, MLS 1 and MLS 2 both sides (gi, gj)
+ * and the antisymmetrised form of every pair equal the one-rank pair's bit for bit, the
+ * ghost side computed from the ghosts' correction records, which
+ * mfree_halo_exchange_correction brings from their owners. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -114,12 +119,193 @@ static void compare_rows(const rows_t *ref, const rows_t *d, const int64_t *ids,
   }
 }
 
+/* ---- pair gradients ---------------------------------------------------------------- */
+
+/* The methods whose pair gradients are checked: every one with a correction record
+ * (SSPH has none: its ghost side stays 0) and SPH (from the kernel, no record). */
+static const int kPairMethods[] = {0, 1, 2, 3, 4};
+#define NPAIRMETHODS 5
+
+/* A half pair list (cloud indices pi < pj, ascending) and its gradients per method. */
+typedef struct {
+  int64_t np;
+  int32_t *pi, *pj;
+  double *gi[NPAIRMETHODS], *gj[NPAIRMETHODS], *ga[NPAIRMETHODS];
+} pairs_t;
+
+/* a and b pair when closer than kappa (h_a + h_b) / 2 (SYMMETRIC_MEAN); computed in the
+ * same order on every rank (the lower id first) so that the bits agree */
+static int paired(const double *xa, double ha, const double *xb, double hb, int dim) {
+  double r2 = 0;
+  for (int d = 0; d < dim; ++d) r2 += (xa[d] - xb[d]) * (xa[d] - xb[d]);
+  const double reach = KAPPA * 0.5 * (ha + hb);
+  return r2 < reach * reach;
+}
+
+/* A set of n particles (positions every xld doubles, supports and volumes every hs; the
+ * last n_ghost ghosts) with a pair list and global ids, set up. */
+static mfree_particles_t *pair_set(mfree_context_t *ctx, int dim, int n, int n_ghost, const double *x,
+                                   int64_t xld, const double *h, const double *v, int64_t hs,
+                                   const int64_t *ids, int64_t np, const int32_t *pi, const int32_t *pj,
+                                   double width) {
+  mfree_particles_t *ps = NULL;
+  mfree_particles_create(ctx, dim, n, &ps);
+  mfree_particles_set_num_ghost(ps, n_ghost);
+  mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, xld, MFREE_BORROW);
+  mfree_particles_set_support(ps, h, hs, MFREE_BORROW);
+  mfree_particles_set_volumes(ps, v, hs, MFREE_BORROW);
+  mfree_particles_set_global_ids(ps, ids, MFREE_BORROW);
+  mfree_particles_set_search(ps, MFREE_SEARCH_SYMMETRIC_MEAN, KAPPA);
+  mfree_particles_set_pairs(ps, np, pi, pj, 0, MFREE_COPY);
+  if (width > 0) mfree_particles_set_halo_width(ps, width);
+  const mfree_status_t st = mfree_particles_setup(ps);
+  CHECK(st == MFREE_SUCCESS, "pair set setup %d", (int)st);
+  return ps;
+}
+
+/* Pair gradients of method m on ps: gi, gj and the antisymmetrised g, np * dim each. With
+ * a halo, the ghosts' correction records come from their owners first (collective). */
+static void pair_gradients(mfree_context_t *ctx, mfree_particles_t *ps, mfree_halo_t *halo, const method_t *m,
+                           int dim, int64_t np, double **gi, double **gj, double **ga) {
+  mfree_approximant_t *a = NULL;
+  CHECK(mfree_approximant_create(ctx, ps, m->method, &a) == MFREE_SUCCESS, "pairs: create %s", m->name);
+  if (m->order) mfree_approximant_set_order(a, m->order);
+  mfree_approximant_set_derivatives(a, MFREE_DERIV_GRADIENT);
+  mfree_status_t st = mfree_approximant_setup(a);
+  CHECK(st == MFREE_SUCCESS, "pairs: %s setup %d", m->name, (int)st);
+  if (halo && m->method != MFREE_METHOD_SPH) {
+    st = mfree_halo_exchange_correction(halo, a);
+    CHECK(st == MFREE_SUCCESS, "pairs: %s correction exchange %d", m->name, (int)st);
+  }
+  const int64_t cap = np * dim;
+  *gi = malloc(sizeof(double) * (size_t)(cap + 1));
+  *gj = malloc(sizeof(double) * (size_t)(cap + 1));
+  *ga = malloc(sizeof(double) * (size_t)(cap + 1));
+  CHECK(mfree_approximant_get_pair_gradients(a, *gi, *gj, dim, cap) == MFREE_SUCCESS, "pairs: %s gradients",
+        m->name);
+  CHECK(mfree_approximant_get_pair_gradients_antisymmetric(a, *ga, dim, cap) == MFREE_SUCCESS,
+        "pairs: %s antisymmetric", m->name);
+  mfree_approximant_destroy(&a);
+}
+
+static void reference_pairs(mfree_context_t *ctx, const cloud_t *c, pairs_t *p) {
+  const int dim = c->dim;
+  int64_t cap = 64, np = 0;
+  p->pi = malloc(sizeof(int32_t) * (size_t)cap);
+  p->pj = malloc(sizeof(int32_t) * (size_t)cap);
+  for (int i = 0; i < c->n; ++i)
+    for (int j = i + 1; j < c->n; ++j)
+      if (paired(c->x + (size_t)i * dim, c->h[i], c->x + (size_t)j * dim, c->h[j], dim)) {
+        if (np == cap) {
+          cap *= 2;
+          p->pi = realloc(p->pi, sizeof(int32_t) * (size_t)cap);
+          p->pj = realloc(p->pj, sizeof(int32_t) * (size_t)cap);
+        }
+        p->pi[np] = i;
+        p->pj[np++] = j;
+      }
+  p->np = np;
+  mfree_particles_t *ps = pair_set(ctx, dim, c->n, 0, c->x, dim, c->h, c->v, 1, c->id, np, p->pi, p->pj, 0.0);
+  for (int q = 0; q < NPAIRMETHODS; ++q)
+    pair_gradients(ctx, ps, NULL, &kMethods[kPairMethods[q]], dim, np, &p->gi[q], &p->gj[q], &p->ga[q]);
+  mfree_particles_destroy(&ps);
+}
+
+static void free_pairs(pairs_t *p) {
+  free(p->pi);
+  free(p->pj);
+  for (int q = 0; q < NPAIRMETHODS; ++q) {
+    free(p->gi[q]);
+    free(p->gj[q]);
+    free(p->ga[q]);
+  }
+}
+
+/* The rank's pairs (every pair with an owned particle among its n = owned + ghost
+ * particles, the lower id first) against the reference pairs of the same ids. */
+static void check_pairs(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, const pairs_t *ref,
+                        const double *rec, int R, const int64_t *ids, int n_owned, int n, double width,
+                        const char *label) {
+  const int dim = c->dim;
+  int64_t cap = 64, np = 0;
+  int32_t *pi = malloc(sizeof(int32_t) * (size_t)cap), *pj = malloc(sizeof(int32_t) * (size_t)cap);
+  int64_t *at = malloc(sizeof(int64_t) * (size_t)cap); /* the reference pair */
+  int missing = 0;
+  for (int a = 0; a < n_owned; ++a)
+    for (int b = 0; b < n; ++b) {
+      if (b == a || (b < n_owned && b < a)) continue; /* owned pairs once */
+      const int lo = ids[a] < ids[b] ? a : b, hi = lo == a ? b : a;
+      if (!paired(rec + (size_t)lo * R, rec[(size_t)lo * R + dim], rec + (size_t)hi * R, rec[(size_t)hi * R + dim],
+                  dim))
+        continue;
+      if (np == cap) {
+        cap *= 2;
+        pi = realloc(pi, sizeof(int32_t) * (size_t)cap);
+        pj = realloc(pj, sizeof(int32_t) * (size_t)cap);
+        at = realloc(at, sizeof(int64_t) * (size_t)cap);
+      }
+      /* the reference pair of cloud indices (i, j), i < j, by bisection */
+      const int32_t i = (int32_t)((ids[lo] - 5) / 2), j = (int32_t)((ids[hi] - 5) / 2);
+      int64_t k0 = 0, k1 = ref->np;
+      while (k0 < k1) {
+        const int64_t mid = (k0 + k1) / 2;
+        if (ref->pi[mid] < i || (ref->pi[mid] == i && ref->pj[mid] < j)) k0 = mid + 1;
+        else k1 = mid;
+      }
+      if (k0 == ref->np || ref->pi[k0] != i || ref->pj[k0] != j) {
+        ++missing;
+        continue;
+      }
+      pi[np] = lo;
+      pj[np] = hi;
+      at[np++] = k0;
+    }
+  CHECK(missing == 0, "%s: %d pairs of this rank are not pairs of one rank", label, missing);
+  /* every reference pair with an owned particle of this rank is here once */
+  int64_t want = 0;
+  for (int64_t k = 0; k < ref->np; ++k) {
+    int own_i = 0, own_j = 0;
+    for (int a = 0; a < n_owned && !(own_i && own_j); ++a) {
+      own_i = own_i || ids[a] == c->id[ref->pi[k]];
+      own_j = own_j || ids[a] == c->id[ref->pj[k]];
+    }
+    want += own_i || own_j;
+  }
+  CHECK(want == np, "%s: %lld pairs with an owned particle, one rank has %lld", label, (long long)np,
+        (long long)want);
+  mfree_particles_t *ps =
+      pair_set(ctx, dim, n, n - n_owned, rec, R, rec + dim, rec + dim + 1, R, ids, np, pi, pj, width);
+  for (int q = 0; q < NPAIRMETHODS; ++q) {
+    const method_t *m = &kMethods[kPairMethods[q]];
+    double *gi = NULL, *gj = NULL, *ga = NULL;
+    pair_gradients(ctx, ps, halo, m, dim, np, &gi, &gj, &ga);
+    int bad = 0;
+    for (int64_t k = 0; k < np && bad < 3; ++k) {
+      const size_t r = (size_t)at[k] * dim, o = (size_t)k * dim, sz = sizeof(double) * dim;
+      const int ok_i = !memcmp(ref->gi[q] + r, gi + o, sz), ok_j = !memcmp(ref->gj[q] + r, gj + o, sz),
+                ok_a = !memcmp(ref->ga[q] + r, ga + o, sz);
+      CHECK(ok_i && ok_j && ok_a,
+            "%s %s: pair of ids (%lld, %lld)%s differs from one rank:%s%s%s", label, m->name,
+            (long long)ids[pi[k]], (long long)ids[pj[k]], pj[k] >= n_owned ? " (a ghost)" : "",
+            ok_i ? "" : " gi", ok_j ? "" : " gj", ok_a ? "" : " antisymmetric");
+      bad += !(ok_i && ok_j && ok_a);
+    }
+    free(gi);
+    free(gj);
+    free(ga);
+  }
+  mfree_particles_destroy(&ps);
+  free(pi);
+  free(pj);
+  free(at);
+}
+
 /* The distributed run of one decomposition, compared with ref (one per method). */
 /* layers = 2: the plan reaches two support radii and the ghosts within one radius of an
  * owned particle (the first layer) count as owned in the set, so that their rows, and
  * their correction data, are computed here too and must be their owners' bits. */
 static void run(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, const int *part, rows_t *ref,
-                const method_t *methods, int nmethods, int layers, const char *label) {
+                const method_t *methods, int nmethods, int layers, const pairs_t *pref, const char *label) {
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   const int dim = c->dim, R = dim + 2;
@@ -242,6 +428,7 @@ static void run(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, cons
     free_rows(&d);
   }
   mfree_particles_destroy(&ps);
+  if (pref) check_pairs(ctx, halo, c, pref, rec, R, ids, no, n, width, label);
   free(u);
   free(rec);
   free(ids);
@@ -265,6 +452,8 @@ int main(int argc, char **argv) {
     mfree_particles_t *ps = reference_set(ctx, &c);
     rows_t ref[NMETHODS];
     for (int m = 0; m < NMETHODS; ++m) compute_rows(ctx, ps, c.id, c.n, &kMethods[m], &ref[m]);
+    pairs_t pref;
+    reference_pairs(ctx, &c, &pref);
     int *part = malloc(sizeof(int) * (size_t)c.n);
     const char *names[3] = {"slab", "random", "Zoltan RCB"};
     for (int how = 0; how < 3; ++how) {
@@ -274,7 +463,7 @@ int main(int argc, char **argv) {
       }
       char label[64];
       snprintf(label, sizeof label, "%dD %s on %d ranks", dim, names[how], size);
-      run(ctx, halo, &c, part, ref, kMethods, NMETHODS, 1, label);
+      run(ctx, halo, &c, part, ref, kMethods, NMETHODS, 1, &pref, label);
       if (rank == 0) printf("%s: done\n", label);
     }
     /* two layers: the first layer's rows (RL, KB 1, MLS 2: their correction data) too */
@@ -284,7 +473,7 @@ int main(int argc, char **argv) {
       char label[64];
       decompose(&c, DECOMP_SLAB, MPI_COMM_WORLD, part);
       snprintf(label, sizeof label, "%dD slab, two layers, on %d ranks", dim, size);
-      run(ctx, halo, &c, part, ref2, two, 3, 2, label);
+      run(ctx, halo, &c, part, ref2, two, 3, 2, NULL, label);
       if (rank == 0) printf("%s: done\n", label);
     }
     /* the particles move: every rank moves the same cloud, the plan is rebuilt */
@@ -297,9 +486,10 @@ int main(int argc, char **argv) {
     decompose(&c, DECOMP_SLAB, MPI_COMM_WORLD, part);
     char label[64];
     snprintf(label, sizeof label, "%dD moved, slab on %d ranks", dim, size);
-    run(ctx, halo, &c, part, &moved, &kMethods[1], 1, 1, label);
+    run(ctx, halo, &c, part, &moved, &kMethods[1], 1, 1, NULL, label);
     free_rows(&moved);
     for (int m = 0; m < NMETHODS; ++m) free_rows(&ref[m]);
+    free_pairs(&pref);
     free(part);
     mfree_particles_destroy(&ps);
     cloud_free(&c);

@@ -12,6 +12,10 @@
  *    the width at setup, ncomp at exchange: another message size): MFREE_ERR_ARG
  *    everywhere, naming two ranks and their values; an exchange that fails on one rank
  *    (ld below ncomp, a NULL field) fails on every rank; no ghost item is written;
+ *  - mfree_halo_exchange_correction: a method without correction records (SPH), ranks
+ *    with different methods (other record lengths), an approximant on a set that is not
+ *    the plan's on one rank, a NULL approximant on rank 0: every rank returns the status
+ *    of the failing one with its message;
  *  - a halo too narrow for the supports: the particle set that declares the plan's width
  *    returns MFREE_ERR_HALO at setup on every rank, instead of rows that miss ghosts. */
 #include <math.h>
@@ -29,6 +33,47 @@ static void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want
   mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
   CHECK(got == want, "%s: status %d, expected %d (%s)", what, (int)got, (int)want, msg);
   CHECK(!needle || strstr(msg, needle), "%s: message '%s' lacks '%s'", what, msg, needle);
+}
+
+/* The particle set of the plan (owned positions xo and supports ho given; ghosts
+ * exchanged; volumes h^2), set up; the arrays it borrows are returned for freeing. */
+static mfree_particles_t *plan_set(mfree_context_t *ctx, mfree_halo_t *halo, const double *xo, const double *ho,
+                                   double **bufs) {
+  int32_t n_owned = 0, n_ghost = 0;
+  mfree_halo_get_size(halo, &n_owned, &n_ghost);
+  const int nn = n_owned + n_ghost;
+  double *xx = malloc(sizeof(double) * (size_t)(2 * nn + 2)), *hh = malloc(sizeof(double) * (size_t)(nn + 1));
+  double *vv = malloc(sizeof(double) * (size_t)(nn + 1));
+  int64_t *gid = malloc(sizeof(int64_t) * (size_t)(nn + 1));
+  if (n_owned) {
+    memcpy(xx, xo, sizeof(double) * 2 * (size_t)n_owned);
+    memcpy(hh, ho, sizeof(double) * (size_t)n_owned);
+  }
+  mfree_halo_exchange(halo, 2, xx, 2);
+  mfree_halo_exchange(halo, 1, hh, 1);
+  mfree_halo_get_global_ids(halo, gid);
+  for (int i = 0; i < nn; ++i) vv[i] = hh[i] * hh[i];
+  mfree_particles_t *set = NULL;
+  mfree_particles_create(ctx, 2, nn, &set);
+  mfree_particles_set_num_ghost(set, n_ghost);
+  mfree_particles_set_positions(set, xx, MFREE_LAYOUT_AOS, 2, MFREE_BORROW);
+  mfree_particles_set_support(set, hh, 1, MFREE_BORROW);
+  mfree_particles_set_volumes(set, vv, 1, MFREE_BORROW);
+  mfree_particles_set_global_ids(set, gid, MFREE_BORROW);
+  CHECK(mfree_particles_setup(set) == MFREE_SUCCESS, "set of the plan");
+  bufs[0] = xx;
+  bufs[1] = hh;
+  bufs[2] = vv;
+  bufs[3] = (double *)gid;
+  return set;
+}
+
+static mfree_approximant_t *approximant(mfree_context_t *ctx, mfree_particles_t *ps, int method) {
+  mfree_approximant_t *a = NULL;
+  mfree_approximant_create(ctx, ps, method, &a);
+  mfree_approximant_set_derivatives(a, MFREE_DERIV_GRADIENT);
+  CHECK(mfree_approximant_setup(a) == MFREE_SUCCESS, "approximant %d", method);
+  return a;
 }
 
 int main(int argc, char **argv) {
@@ -176,6 +221,54 @@ int main(int argc, char **argv) {
   free(x);
   free(h);
   free(ids);
+
+  /* the ghosts' correction records (mfree_halo_exchange_correction): faults agreed */
+  {
+    double *bufs[4];
+    mfree_particles_t *set = plan_set(ctx, halo, xo, ho, bufs), *other = NULL;
+    int32_t nn = 0;
+    mfree_particles_get_size(set, &nn, NULL);
+    /* the same particles, every one owned: not the plan's layout where there are ghosts */
+    mfree_particles_create(ctx, 2, nn, &other);
+    mfree_particles_set_positions(other, bufs[0], MFREE_LAYOUT_AOS, 2, MFREE_BORROW);
+    mfree_particles_set_support(other, bufs[1], 1, MFREE_BORROW);
+    mfree_particles_set_volumes(other, bufs[2], 1, MFREE_BORROW);
+    CHECK(mfree_particles_setup(other) == MFREE_SUCCESS, "set without ghosts");
+    mfree_approximant_t *rl = approximant(ctx, set, MFREE_METHOD_RANDLES_LIBERSKY);
+    mfree_approximant_t *sph = approximant(ctx, set, MFREE_METHOD_SPH);
+    mfree_approximant_t *mls = approximant(ctx, set, MFREE_METHOD_MLS);
+    mfree_approximant_t *rl_other = approximant(ctx, other, MFREE_METHOD_RANDLES_LIBERSKY);
+    CHECK(mfree_halo_exchange_correction(halo, rl) == MFREE_SUCCESS, "RL records");
+    expect(ctx, mfree_halo_exchange_correction(halo, sph), MFREE_ERR_UNSUPPORTED, "rank 0:",
+           "SPH has no correction records");
+    if (size > 1)
+      expect(ctx, mfree_halo_exchange_correction(halo, rank == last ? mls : rl), MFREE_ERR_ARG,
+             "ranks disagree on ncomp", "MLS on the last rank, RL elsewhere");
+    /* (with more than one rank the last rank has ghosts: a set without them is not the plan's) */
+    if (size > 1)
+      expect(ctx, mfree_halo_exchange_correction(halo, rank == last ? rl_other : rl), MFREE_ERR_ARG, who,
+             "a set that is not the plan's on the last rank");
+    expect(ctx, mfree_halo_exchange_correction(halo, rank == 0 ? NULL : rl), MFREE_ERR_NULL,
+           "rank 0: approximant is NULL", "NULL approximant on rank 0");
+    CHECK(mfree_halo_exchange_correction(halo, rl) == MFREE_SUCCESS, "RL records again");
+    mfree_approximant_destroy(&rl);
+    mfree_approximant_destroy(&sph);
+    mfree_approximant_destroy(&mls);
+    mfree_approximant_destroy(&rl_other);
+    mfree_particles_destroy(&set);
+    mfree_particles_destroy(&other);
+    for (int k = 0; k < 4; ++k) free(bufs[k]);
+    /* a rank without particles takes part */
+    CHECK(mfree_halo_setup(halo, rank == last ? 0 : no, rank == last ? NULL : xo, 2, rank == last ? NULL : io,
+                           width) == MFREE_SUCCESS,
+          "plan with an empty rank");
+    set = plan_set(ctx, halo, xo, ho, bufs);
+    rl = approximant(ctx, set, MFREE_METHOD_RANDLES_LIBERSKY);
+    CHECK(mfree_halo_exchange_correction(halo, rl) == MFREE_SUCCESS, "RL records with an empty rank");
+    mfree_approximant_destroy(&rl);
+    mfree_particles_destroy(&set);
+    for (int k = 0; k < 4; ++k) free(bufs[k]);
+  }
 
   free(xo);
   free(io);

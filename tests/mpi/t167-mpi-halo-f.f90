@@ -5,7 +5,9 @@
 !> The wrappers' array checks: an ids array too short for get_global_ids is MFREE_ERR_ARG
 !> with nothing written; in the collective calls an array too short (or a strided field)
 !> on one rank is MFREE_ERR_ARG on every rank, naming that rank, with no ghost written and
-!> no rank left waiting; a scalar field h(n) is exchanged as it is.
+!> no rank left waiting; a scalar field h(n) is exchanged as it is. The ghosts' correction
+!> records of an RL approximant on the plan's particles come from their owners
+!> (mfree_halo_exchange_correction), and SPH, which has none, fails on every rank.
 program t167_mpi_halo_f
   use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double
   use mpi
@@ -25,6 +27,9 @@ program t167_mpi_halo_f
   integer(c_int64_t), allocatable :: short_ids(:)
   real(c_double), allocatable :: h(:), f(:, :)
   type(mfree_context) :: hctx
+  type(mfree_particles) :: ps
+  type(mfree_approximant) :: rl, sph
+  real(c_double), allocatable :: hs(:), vs(:)
   character(len=16) :: who
 
   call MPI_Init(ierr)
@@ -111,6 +116,37 @@ program t167_mpi_halo_f
              index(mfree_last_error(hctx), 'ids holds') > 0, 'short ids message: '//mfree_last_error(hctx))
   call check(mfree_halo_setup(halo, no, x, 1_c_int64_t, ids(1:no), 3.5_c_double / n) == MFREE_SUCCESS, &
              'setup again')
+
+
+  ! ---- the ghosts' correction records ----
+  call check(mfree_halo_get_size(halo, no, ng) == MFREE_SUCCESS, 'size again')
+  call check(mfree_halo_get_global_ids(halo, ids(1:no + ng)) == MFREE_SUCCESS, 'ids again')
+  call check(mfree_halo_exchange(halo, 1_c_int32_t, x(:, 1:no + ng), 1_c_int64_t) == MFREE_SUCCESS, &
+             'positions again')
+  allocate (hs(no + ng), vs(no + ng))
+  hs = 1.2_c_double / n
+  vs = 1 / n
+  call check(mfree_particles_create(ctx, 1_c_int32_t, no + ng, ps) == MFREE_SUCCESS, 'set')
+  call check(mfree_particles_set_num_ghost(ps, ng) == MFREE_SUCCESS, 'ghosts')
+  call check(mfree_particles_set_positions(ps, x(:, 1:no + ng), MFREE_LAYOUT_AOS, 1_c_int64_t, MFREE_COPY) &
+             == MFREE_SUCCESS, 'positions')
+  call check(mfree_particles_set_support(ps, hs, 1_c_int64_t, MFREE_COPY) == MFREE_SUCCESS, 'support')
+  call check(mfree_particles_set_volumes(ps, vs, 1_c_int64_t, MFREE_COPY) == MFREE_SUCCESS, 'volumes')
+  call check(mfree_particles_set_global_ids(ps, ids(1:no + ng), MFREE_COPY) == MFREE_SUCCESS, 'set ids')
+  call check(mfree_particles_setup(ps) == MFREE_SUCCESS, 'set setup')
+  call check(mfree_approximant_create(ctx, ps, MFREE_METHOD_RANDLES_LIBERSKY, rl) == MFREE_SUCCESS, 'RL')
+  call check(mfree_approximant_create(ctx, ps, MFREE_METHOD_SPH, sph) == MFREE_SUCCESS, 'SPH')
+  call check(mfree_approximant_set_derivatives(rl, MFREE_DERIV_GRADIENT) == MFREE_SUCCESS, 'RL gradient')
+  call check(mfree_approximant_set_derivatives(sph, MFREE_DERIV_GRADIENT) == MFREE_SUCCESS, 'SPH gradient')
+  call check(mfree_approximant_setup(rl) == MFREE_SUCCESS, 'RL setup')
+  call check(mfree_approximant_setup(sph) == MFREE_SUCCESS, 'SPH setup')
+  call check(mfree_halo_exchange_correction(halo, rl) == MFREE_SUCCESS, 'RL records')
+  st_ = mfree_halo_exchange_correction(halo, sph)
+  call check(st_ == MFREE_ERR_UNSUPPORTED .and. index(mfree_last_error(hctx), 'rank 0:') > 0, &
+             'SPH has no records: '//mfree_last_error(hctx))
+  call check(mfree_approximant_destroy(rl) == MFREE_SUCCESS .and. mfree_approximant_destroy(sph) == MFREE_SUCCESS, &
+             'approximants destroy')
+  call check(mfree_particles_destroy(ps) == MFREE_SUCCESS, 'set destroy')
 
   call check(mfree_halo_destroy(halo) == MFREE_SUCCESS, 'destroy')
   call check(mfree_context_destroy(ctx) == MFREE_SUCCESS, 'context destroy')

@@ -202,6 +202,26 @@ MFREE_MPI_API mfree_status_t mfree_halo_set_pending_error(mfree_halo_t *halo);
 MFREE_MPI_API mfree_status_t mfree_halo_exchange(mfree_halo_t *halo, int32_t ncomp, double *field,
                                                  int64_t ld);
 
+/**
+ * The ghosts' correction records from their owners, for the ghost side of pair gradients
+ * (mfree_approximant_get_pair_gradients and _antisymmetric) bitwise equal to one rank's:
+ * each rank's mfree_approximant_get_correction of its owned particles, exchanged like a
+ * field, given to mfree_approximant_set_ghost_correction. Collective. Call it after every
+ * mfree_approximant_setup or _update of a (they drop the ghosts' records). The records
+ * are kept in a buffer of the plan (n_owned + n_ghost records), reused.
+ * @param[in]     halo  a set-up plan
+ * @param[in,out] a     a set-up approximant at a particle set that holds the plan's
+ *                      particles in its order (n_owned owned, then the n_ghost ghosts:
+ *                      else MFREE_ERR_ARG), of one method on every rank, with correction
+ *                      data (MFREE_ERR_UNSUPPORTED for SPH, which needs none, SSPH, MLS and
+ *                      RKPM of order 3, ...)
+ * @return MFREE_SUCCESS; on every rank alike: the failures of mfree_approximant_get_correction
+ *         and _set_ghost_correction on any rank, MFREE_ERR_STATE before a successful setup
+ *         of the plan, MFREE_ERR_ARG, MFREE_ERR_NULL, MFREE_ERR_ALLOC, MFREE_ERR_INTERNAL;
+ *         the message starts with the failing rank
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_exchange_correction(mfree_halo_t *halo, mfree_approximant_t *a);
+
 #ifdef __cplusplus
 }
 #endif

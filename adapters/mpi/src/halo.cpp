@@ -32,6 +32,7 @@ struct mfree_halo {
   std::vector<int32_t> send_idx;                  // owned particles sent, by neighbour
   std::vector<int64_t> ids;                       // owned then ghost global ids
   std::vector<double> sbuf, rbuf, boxes;
+  std::vector<double> corr;  // correction records, owned then ghost (exchange_correction)
 };
 
 namespace {
@@ -134,6 +135,14 @@ Local first_step(mfree_halo_t *h, Body &&body) noexcept {
   } catch (...) {
   }
   return l;
+}
+
+// A failure of a core call inside a local step: its status and the message it left on
+// the context it recorded it on.
+void core_fail(Local &l, mfree_status_t st, mfree_context_t *ctx) {
+  char msg[400] = {0};
+  mfree_context_get_last_error(ctx, nullptr, msg, sizeof msg);
+  l.fail(st, msg);
 }
 
 // An MPI call inside a local step: its failure becomes MFREE_ERR_INTERNAL.
@@ -500,6 +509,48 @@ mfree_status_t mfree_halo_exchange(mfree_halo_t *h, int32_t ncomp, double *field
     for (int32_t g = 0; g < h->n_ghost; ++g)
       std::memcpy(dst + g * ld, &h->rbuf[static_cast<size_t>(g) * ncomp], sizeof(double) * ncomp);
   return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_exchange_correction(mfree_halo_t *h, mfree_approximant_t *a) {
+  const char *fn = "mfree_halo_exchange_correction";
+  if (!h) return MFREE_ERR_NULL;
+  // 1. this rank's records, after checking that a's set is laid out as the plan
+  mfree_context_t *actx = nullptr;
+  int32_t ncoef = 0;
+  Local l = first_step(h, [&](Local &r) {
+    if (!h->ready) return r.fail(MFREE_ERR_STATE, "the plan is not set up");
+    if (!a) return r.fail(MFREE_ERR_NULL, "approximant is NULL");
+    mfree_particles_t *ps = nullptr;
+    int32_t n = 0, ng = 0;
+    mfree_approximant_get_context(a, &actx);
+    mfree_status_t st = mfree_approximant_get_particles(a, &ps);
+    if (st == MFREE_SUCCESS) st = mfree_particles_get_size(ps, &n, &ng);
+    if (st != MFREE_SUCCESS) return core_fail(r, st, actx);
+    if (ng != h->n_ghost || n - ng != h->n_owned)
+      return r.fail(MFREE_ERR_ARG, "the approximant's particle set holds " + std::to_string(n - ng) +
+                                       " owned particles and " + std::to_string(ng) + " ghosts, the plan " +
+                                       std::to_string(h->n_owned) + " and " + std::to_string(h->n_ghost) +
+                                       " (the set must be the plan's particles in its order)");
+    st = mfree_approximant_get_correction_size(a, &ncoef);
+    if (st != MFREE_SUCCESS) return core_fail(r, st, actx);
+    h->corr.resize(static_cast<size_t>(n) * static_cast<size_t>(ncoef));
+    if (h->n_owned == 0) return;  // (a rank without particles still takes part)
+    st = mfree_approximant_get_correction(a, h->corr.data(), ncoef, static_cast<int64_t>(h->n_owned) * ncoef);
+    if (st != MFREE_SUCCESS) return core_fail(r, st, actx);
+  });
+  mfree_status_t st = agree(h, fn, l);
+  if (st != MFREE_SUCCESS) return st;
+  // 2. the ghosts' records from their owners (agrees on ncoef: one method everywhere)
+  st = mfree_halo_exchange(h, ncoef, h->corr.data(), ncoef);
+  if (st != MFREE_SUCCESS) return st;
+  // 3. handed to the approximant; agreed, so that every rank returns alike
+  l = run_local([&](Local &r) {
+    const int64_t off = static_cast<int64_t>(h->n_owned) * ncoef;
+    const mfree_status_t s = mfree_approximant_set_ghost_correction(
+        a, h->n_ghost ? h->corr.data() + off : nullptr, ncoef, static_cast<int64_t>(h->n_ghost) * ncoef);
+    if (s != MFREE_SUCCESS) core_fail(r, s, actx);
+  });
+  return agree(h, fn, l);
 }
 
 }  // extern "C"
