@@ -9,8 +9,9 @@
 !> module's name in every program that uses it.
 module mfree_suitesparse
   use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_ptr, &
-    c_null_ptr, c_loc
-  use mfree, only: mfree_context, mfree_matrix
+    c_null_ptr, c_loc, c_f_pointer
+  use mfree, only: mfree_context, mfree_matrix, MFREE_SUCCESS, mfree_wrapper_check_out, &
+    mfree_wrapper_view_dbl
   implicit none
   private
 
@@ -73,7 +74,7 @@ module mfree_suitesparse
       import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
       type(c_ptr), value :: s
       integer(c_int32_t), value :: nrhs
-      type(c_ptr), value :: b
+      real(c_double), intent(in) :: b(*)
       integer(c_int64_t), value :: ldb
       real(c_double), intent(inout) :: x(*)
       integer(c_int64_t), value :: ldx
@@ -87,16 +88,26 @@ module mfree_suitesparse
       type(c_ptr), value :: factor_nnz
       type(c_ptr), value :: index_width
     end function mfree_suitesparse_get_info_c
+
+    integer(c_int) function mfree_suitesparse_get_context_c(s, ctx) &
+        bind(C, name="mfree_suitesparse_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: s
+      type(c_ptr), intent(out) :: ctx
+    end function mfree_suitesparse_get_context_c
   end interface
   public :: mfree_suitesparse_create_c, mfree_suitesparse_destroy_c
   public :: mfree_suitesparse_set_index_width_c, mfree_suitesparse_setup_c
   public :: mfree_suitesparse_update_c, mfree_suitesparse_solve_c
   public :: mfree_suitesparse_get_info_c, mfree_suitesparse_set_rcond_threshold_c
+  public :: mfree_suitesparse_get_context_c
 
   public :: mfree_suitesparse_create, mfree_suitesparse_destroy
   public :: mfree_suitesparse_set_index_width, mfree_suitesparse_setup
   public :: mfree_suitesparse_update, mfree_suitesparse_solve, mfree_suitesparse_get_info
-  public :: mfree_suitesparse_set_rcond_threshold
+  public :: mfree_suitesparse_set_rcond_threshold, mfree_suitesparse_get_context
+
+  real(c_double), target, save :: empty_dbl(0)
 
 contains
 
@@ -142,22 +153,54 @@ contains
     st = mfree_suitesparse_update_c(s%ptr, A%ptr)
   end function mfree_suitesparse_update
 
-  !> Solve A X = B, column-major b(ldb, nrhs), x(ldx, nrhs). Omit b to solve in place
-  !> (x holds B on entry; ldb is then ldx): st = mfree_suitesparse_solve(s, nrhs,
-  !> ldb=n, x=x, ldx=n). Passing the same array as b and x would alias two Fortran
-  !> dummy arguments, which the standard forbids.
+  !> Solve A X = B, column-major b(ldb, nrhs), x(ldx, nrhs), arrays of any rank. Omit b
+  !> to solve in place (x holds B on entry; ldb is then ldx): st =
+  !> mfree_suitesparse_solve(s, nrhs, ldb=n, x=x, ldx=n). Passing the same array as b and
+  !> x would alias two Fortran dummy arguments, which the standard forbids. x must be
+  !> contiguous and hold ldx * nrhs values, b ldb * nrhs (a non-contiguous b is packed
+  !> first): else MFREE_ERR_ARG, nothing written.
   integer(c_int) function mfree_suitesparse_solve(s, nrhs, b, ldb, x, ldx) result(st)
     type(mfree_solver), intent(in) :: s
     integer(c_int32_t), intent(in) :: nrhs
-    real(c_double), intent(in), optional, target :: b(*)
+    real(c_double), intent(in), optional, target :: b(..)
     integer(c_int64_t), intent(in) :: ldb, ldx
-    real(c_double), intent(inout), target :: x(*)
+    real(c_double), intent(inout), target :: x(..)
+    character(len=*), parameter :: fn = 'mfree_suitesparse_solve'
+    real(c_double), allocatable, target :: tb(:)
+    real(c_double), pointer :: pb(:), px(:)
+    integer(c_int64_t) :: k
+    k = max(int(nrhs, c_int64_t), 0_c_int64_t)
+    st = mfree_wrapper_check_out(solver_ctx(s), fn, 'x', is_contiguous(x), size(x, kind=c_int64_t), &
+                                 max(ldx, 0_c_int64_t) * k)
+    if (st == MFREE_SUCCESS .and. present(b)) &
+      st = mfree_wrapper_check_out(solver_ctx(s), fn, 'b', .true., size(b, kind=c_int64_t), &
+                                   max(ldb, 0_c_int64_t) * k)
+    if (st /= MFREE_SUCCESS) return
+    px => empty_dbl
+    if (size(x) > 0) call c_f_pointer(c_loc(x), px, [size(x)])
     if (present(b)) then
-      st = mfree_suitesparse_solve_c(s%ptr, nrhs, c_loc(b), ldb, x, ldx)
+      call mfree_wrapper_view_dbl(b, tb, pb)
     else
-      st = mfree_suitesparse_solve_c(s%ptr, nrhs, c_loc(x), ldx, x, ldx)
+      pb => px
     end if
+    st = mfree_suitesparse_solve_c(s%ptr, nrhs, pb, merge(ldb, ldx, present(b)), px, ldx)
   end function mfree_suitesparse_solve
+
+  !> Typed wrapper of mfree_suitesparse_get_context (mfree_suitesparse.h): the solver's
+  !> context, borrowed.
+  integer(c_int) function mfree_suitesparse_get_context(s, ctx) result(st)
+    type(mfree_solver), intent(in) :: s
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_suitesparse_get_context_c(s%ptr, ctx%ptr)
+  end function mfree_suitesparse_get_context
+
+  !> The solver's context (NULL for a NULL handle), where the wrappers record failures.
+  type(c_ptr) function solver_ctx(s) result(ctx)
+    type(mfree_solver), intent(in) :: s
+    integer(c_int) :: st
+    ctx = c_null_ptr
+    st = mfree_suitesparse_get_context_c(s%ptr, ctx)
+  end function solver_ctx
 
   !> Facts about the current factorisation; each output optional.
   integer(c_int) function mfree_suitesparse_get_info(s, rcond, factor_nnz, index_width) &

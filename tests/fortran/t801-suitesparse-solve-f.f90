@@ -123,7 +123,7 @@ contains
     type(mfree_matrix) :: K
     type(mfree_solver) :: s
     integer(c_int32_t) :: ndofs
-    real(c_double), allocatable, target :: f(:), u(:)
+    real(c_double), allocatable, target :: f(:), u(:), f2(:, :), u2(:, :)
     real(c_double) :: exact(1), err, rcond
     integer(c_int32_t) :: width
     integer :: q
@@ -144,7 +144,7 @@ contains
     call check_ok(ctx, mfree_assembler_get_size(as, ndofs), 'size')
     call check(ndofs == n, 'one unknown per particle')
     call check_ok(ctx, mfree_assembler_assemble_matrix(as, K), 'assemble K')
-    allocate (f(ndofs), u(ndofs))
+    allocate (f(ndofs), u(ndofs), f2(ndofs, 2), u2(ndofs, 2))
     call check_ok(ctx, mfree_assembler_assemble_rhs(as, f), 'assemble f')
 
     call check_ok(ctx, mfree_suitesparse_create(ctx, kind, s), 'solver')
@@ -169,6 +169,26 @@ contains
       err = max(err, abs(u(q) - exact(1)))
     end do
     call check(err < 1e-9_c_double, 'in-place solve gives the same solution')
+
+    ! arrays too short for ldx * nrhs (x) or ldb * nrhs (b), x not contiguous: MFREE_ERR_ARG,
+    ! nothing written; two right-hand sides in one rank-2 array
+    u2 = -7
+    call check(mfree_suitesparse_solve(s, 1_c_int32_t, f, int(ndofs, c_int64_t), u2(1:ndofs - 1, 1), &
+                                       int(ndofs, c_int64_t)) == MFREE_ERR_ARG, 'x one short')
+    call check(index(mfree_last_error(ctx), 'are needed') > 0, 'x one short: message')
+    call check(mfree_suitesparse_solve(s, 2_c_int32_t, f, int(ndofs, c_int64_t), u2, &
+                                       int(ndofs, c_int64_t)) == MFREE_ERR_ARG, 'b one column short')
+    call check(mfree_suitesparse_solve(s, 1_c_int32_t, f, int(ndofs, c_int64_t), u2(1, :), &
+                                       1_c_int64_t) == MFREE_ERR_ARG, 'x not contiguous')
+    call check(index(mfree_last_error(ctx), 'not contiguous') > 0, 'x not contiguous: message')
+    call check(all(u2 == -7), 'nothing written')
+    f2(:, 1) = f
+    f2(:, 2) = 2 * f
+    call check_ok(ctx, mfree_suitesparse_solve(s, 2_c_int32_t, f2, int(ndofs, c_int64_t), u2, &
+                                               int(ndofs, c_int64_t)), 'two right-hand sides')
+    call check(maxval(abs(u2(:, 1) - u)) <= 1e-12_c_double * maxval(abs(u)) .and. &
+               maxval(abs(u2(:, 2) - 2 * u)) <= 1e-12_c_double * maxval(abs(u)), &
+               'two right-hand sides: both solutions')
     call check_ok(ctx, mfree_suitesparse_get_info(s, rcond=rcond, index_width=width), 'info')
     call check(rcond > 0 .and. width == 32, 'rcond > 0, 32-bit indices')
     call residual_check(K, u, f)

@@ -173,6 +173,16 @@ MFREE_SUITESPARSE_API mfree_status_t mfree_suitesparse_get_info(const mfree_suit
                                                                 int64_t *factor_nnz,
                                                                 int32_t *index_width);
 
+/**
+ * The context a solver was created on, for bindings that check arguments themselves
+ * (the Fortran module does) and record their failures with mfree_context_set_error.
+ * @param[in]  s    the solver
+ * @param[out] ctx  its context, borrowed: the solver keeps it alive; never destroy it
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (without a message) for a NULL handle or output
+ */
+MFREE_SUITESPARSE_API mfree_status_t mfree_suitesparse_get_context(const mfree_suitesparse_t *s,
+                                                                   mfree_context_t **ctx);
+
 #ifdef __cplusplus
 }
 #endif

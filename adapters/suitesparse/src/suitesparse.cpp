@@ -1015,4 +1015,10 @@ mfree_status_t mfree_suitesparse_get_info(const mfree_suitesparse_t *s, double *
   });
 }
 
+mfree_status_t mfree_suitesparse_get_context(const mfree_suitesparse_t *s, mfree_context_t **ctx) {
+  if (!s || !ctx) return MFREE_ERR_NULL;
+  *ctx = s->ctx;
+  return MFREE_SUCCESS;
+}
+
 }  // extern "C"
