@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <type_traits>
 
@@ -597,6 +598,18 @@ Report Approximant::compute(const char *what) {
     ft.val = fv ? val_.data() : nullptr;
     ft.grad = fg ? grad_.data() : nullptr;
   }
+  // The sites' correction records for the pair gradients (pair-list sets): written by
+  // the fast path or compute_site alongside the rows where they can, the rest after
+  // the rows (a NaN marks a record not written).
+  const bool recs = keeps_records();
+  const int ncoef = recs ? correction_size() : 0;
+  if (recs) {
+    records_.assign(static_cast<size_t>(nsites_) * ncoef, std::numeric_limits<double>::quiet_NaN());
+    ft.coef = records_.data();
+    ft.ncoef = ncoef;
+  } else {
+    records_.clear();
+  }
   const auto &pst = ps_->site_status();
   FastSites fs;
   fs.status = status_.data();
@@ -636,6 +649,7 @@ Report Approximant::compute(const char *what) {
       out.phi = fv ? val_.data() + k0 : nullptr;
       out.grad = fg ? grad_.data() + k0 * dim : nullptr;
       out.hess = fh ? hess_.data() + k0 * nh : nullptr;
+      out.coef = recs ? records_.data() + int64_t{s} * ncoef : nullptr;
       cfg.method = method_;
       cfg.order = order_;
       compute_site(cfg, in, w.work, out);
@@ -666,6 +680,7 @@ Report Approximant::compute(const char *what) {
     bad = screen_sites(b, e);
     if (bad) nfailed += bad;
   });
+  if (recs) compute_records(records_.data(), ncoef, true);
 
   Report rep;
   if (nfailed) {
@@ -743,7 +758,7 @@ Report Approximant::setup() {
   Report rep = compute("setup");
   record_set_state();
   setup_done_ = true;
-  refresh_records();
+  ghost_set_ = false;
   return rep;
 }
 
@@ -754,7 +769,7 @@ Report Approximant::update() {
   validate_config();
   pack();
   Report rep = compute("update");
-  refresh_records();
+  ghost_set_ = false;
   return rep;
 }
 

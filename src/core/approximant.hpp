@@ -133,11 +133,13 @@ class Approximant {
   const double *packed_volumes(int64_t &stride) const;
   // Whether the method has correction data (correction_size() does not throw).
   bool has_correction() const;
-  // The records of the sites (correction()) computed into c, every ld doubles.
-  void compute_records(double *c, int64_t ld) const;
-  // After a setup/update: the sites' records kept for the pair gradients when the set
-  // has a pair list (records_), the ghosts' dropped.
-  void refresh_records();
+  // Whether setup and update keep the sites' records (records_) for the pair gradients:
+  // a pair-list set, a gradient table, a method with correction data.
+  bool keeps_records() const;
+  // The records of the sites (correction()) computed into c, every ld doubles; with
+  // missing_only, only those whose first value is NaN (not written with the rows), and
+  // zeros for failed or fallen-back sites.
+  void compute_records(double *c, int64_t ld, bool missing_only = false) const;
 
   const ParticleSet *ps_;
   int method_;

@@ -585,42 +585,40 @@ RecordGradient::RecordGradient(const LocalConfig &cfg)
     : cfg_(cfg),
       basis_(cfg.dim, cfg.method == MFREE_METHOD_MLS || cfg.method == MFREE_METHOD_RKPM ? cfg.order : 0) {}
 
-void RecordGradient::operator()(const double *rec, double hs, const double *d, double h,
-                                double vol, double *g) const {
+void RecordGradient::operator()(const double *rec, double hs, const double *d, double w,
+                                const double *gw, double vol, double *g) const {
   const int dim = cfg_.dim;
-  double r, w, dw, d2w, gw[3] = {0, 0, 0};
-  kernel_at(*cfg_.kernel, dim, d, h, r, w, dw, d2w, gw);
-  // each case repeats the arithmetic of its rows in run() (and shepard(), mls_fixed())
   switch (cfg_.method) {
-    case MFREE_METHOD_SHEPARD: {
-      const double iS = 1.0 / rec[0];
-      for (int c = 0; c < dim; ++c) g[c] = gw[c] * iS - w * rec[1 + c] * iS * iS;
+    case MFREE_METHOD_SHEPARD: {  // grad (w / S) / V
+      const double iS = 1.0 / rec[0], iv = 1.0 / vol;
+      for (int c = 0; c < dim; ++c) g[c] = (gw[c] * iS - w * rec[1 + c] * iS * iS) * iv;
       return;
     }
-    case MFREE_METHOD_JOHNSON_BEISSEL:
-      for (int c = 0; c < dim; ++c) g[c] = rec[c] * gw[c] * vol;
+    case MFREE_METHOD_JOHNSON_BEISSEL:  // beta_c grad_c w
+      for (int c = 0; c < dim; ++c) g[c] = rec[c] * gw[c];
       return;
-    case MFREE_METHOD_RANDLES_LIBERSKY:
-    case MFREE_METHOD_KB_METHOD1: {
-      const double ih = 1.0 / hs;
-      double q[3];
-      if (cfg_.method == MFREE_METHOD_RANDLES_LIBERSKY) {
-        for (int c = 0; c < dim; ++c) q[c] = gw[c] * vol * hs;
-      } else {  // the Shepard function's gradient, from S and grad S after M
-        const double *S = rec + dim * dim, iS = 1.0 / S[0];
-        for (int c = 0; c < dim; ++c) q[c] = (gw[c] * iS - w * S[1 + c] * iS * iS) * hs;
+    case MFREE_METHOD_RANDLES_LIBERSKY:  // M grad w
+      for (int a = 0; a < dim; ++a) {
+        double f = 0.0;
+        for (int b = 0; b < dim; ++b) f += rec[a + b * dim] * gw[b];
+        g[a] = f;
       }
+      return;
+    case MFREE_METHOD_KB_METHOD1: {  // M grad (w / S) / V, S and grad S after M
+      const double *S = rec + dim * dim, iS = 1.0 / S[0], iv = 1.0 / vol;
+      double q[3];
+      for (int c = 0; c < dim; ++c) q[c] = gw[c] * iS - w * S[1 + c] * iS * iS;
       for (int a = 0; a < dim; ++a) {
         double f = 0.0;
         for (int b = 0; b < dim; ++b) f += rec[a + b * dim] * q[b];
-        g[a] = f * ih;
+        g[a] = f * iv;
       }
       return;
     }
     default: {  // MLS, RKPM: gamma, then d gamma / dx_c
       const bool rkpm = cfg_.method == MFREE_METHOD_RKPM;
       const int L = basis_.size();
-      const double ih = 1.0 / hs;
+      const double ih = 1.0 / hs, iv = 1.0 / vol;
       double sj[3] = {0, 0, 0}, p[kMaxBasis];
       for (int c = 0; c < dim; ++c) sj[c] = d[c] * ih;
       basis_.eval(sj, p);
@@ -629,9 +627,11 @@ void RecordGradient::operator()(const double *rec, double hs, const double *d, d
         for (int a = 0; a < L; ++a) t += v[a] * p[a];
         return t;
       };
-      const double gp = dot(rec), o = rkpm ? w * vol : w;
-      for (int i = 0; i < dim; ++i)
-        g[i] = o * dot(rec + (1 + i) * L) + (rkpm ? gw[i] * vol : gw[i]) * gp;
+      const double gp = dot(rec);
+      if (rkpm)  // o = w V: the volume cancels
+        for (int i = 0; i < dim; ++i) g[i] = w * dot(rec + (1 + i) * L) + gw[i] * gp;
+      else
+        for (int i = 0; i < dim; ++i) g[i] = (w * dot(rec + (1 + i) * L) + gw[i] * gp) * iv;
       return;
     }
   }

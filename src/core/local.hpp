@@ -67,19 +67,20 @@ inline void kernel_at(const Kernel &k, int dim, const double *d, double h, doubl
   for (int c = 0; c < dim; ++c) gw[c] = r > 0.0 ? -dw * d[c] / r : 0.0;
 }
 
-// The gradient entry of one neighbour j in a site's row from the site's correction
-// record (LocalOutput::coef, the layout of mfree_approximant_get_correction), with the
-// arithmetic of compute_site's rows: what a process that holds the record but not the
-// site's row (a ghost's owner sent it) computes as the site's table would. For Shepard,
-// MLS/RKPM of order <= 2, Johnson-Beissel, Randles-Libersky and KB Method 1 (cfg.method,
-// cfg.order, cfg.dim, cfg.kernel).
+// The gradient of one neighbour j's shape function at a site per unit volume (the row's
+// entry divided by V_j) from the site's correction record (LocalOutput::coef, the
+// layout of mfree_approximant_get_correction) and the kernel at the pair: what a
+// process that holds the record but not the site's row (a ghost's owner sent it)
+// computes as well as the owner. Equal to the rows' entries / V_j to round-off. For
+// Shepard, MLS/RKPM of order <= 2, Johnson-Beissel, Randles-Libersky and KB Method 1
+// (cfg.method, cfg.order, cfg.dim).
 class RecordGradient {
  public:
   explicit RecordGradient(const LocalConfig &cfg);
-  // d = x_j - x (3 values), h the pair's support, vol V_j, hs the site's length scale;
-  // writes dim values to g.
-  void operator()(const double *rec, double hs, const double *d, double h, double vol,
-                  double *g) const;
+  // d = x_j - x (3 values), w and gw the kernel and its gradient there (kernel_at), vol
+  // V_j, hs the site's length scale; writes dim values to g.
+  void operator()(const double *rec, double hs, const double *d, double w, const double *gw,
+                  double vol, double *g) const;
 
  private:
   LocalConfig cfg_;

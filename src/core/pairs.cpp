@@ -315,15 +315,6 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
       kernel_gradient(s, j, g);
       return true;
     }
-    if (const double *rec = record_of(s)) {
-      double d[3] = {0, 0, 0};
-      ps_->displacement(j, s, d);  // x_j - x_s
-      const double vj = vol[j * vstride];
-      record_gradient(rec, site_h(s), d, pair_h(s, j), vj, g);
-      const double iv = 1.0 / vj;
-      for (int c = 0; c < dim; ++c) g[c] *= iv;
-      return true;
-    }
     if (s >= owned || status_[s] != 0) return false;
     const int64_t q = find(s, j, hint);
     if (q >= 0) {
@@ -335,8 +326,25 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
   parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
     for (int64_t k = b; k < e; ++k) {
       const int32_t i = pi[k] - base, j = pj[k] - base;
-      double a[3], c[3];
-      const bool ha = side(i, j, off[2 * k], a), hc = side(j, i, off[2 * k + 1], c);
+      double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+      const bool ok = pst[i] == 0 && pst[j] == 0;
+      const double *ri = ok ? record_of(i) : nullptr, *rj = ok ? record_of(j) : nullptr;
+      if (ri || rj) {  // the kernel once for both sides where h_ij is symmetric
+        double d[3] = {0, 0, 0}, r, w, dw, d2w, gw[3] = {0, 0, 0};
+        ps_->displacement(j, i, d);  // x_j - x_i
+        kernel_at(*kernel_, dim, d, pair_h(i, j), r, w, dw, d2w, gw);
+        if (ri) record_gradient(ri, site_h(i), d, w, gw, vol[j * vstride], a);
+        if (rj) {  // x_i - x_j and its gradient are the negatives, exactly
+          for (int q = 0; q < dim; ++q) d[q] = -d[q];
+          if (sym_h)
+            for (int q = 0; q < dim; ++q) gw[q] = -gw[q];
+          else
+            kernel_at(*kernel_, dim, d, pair_h(j, i), r, w, dw, d2w, gw);
+          record_gradient(rj, site_h(j), d, w, gw, vol[i * vstride], c);
+        }
+      }
+      const bool ha = ri ? true : side(i, j, off[2 * k], a);
+      const bool hc = rj ? true : side(j, i, off[2 * k + 1], c);
       write_pair(dim, antisym, a, ha, c, hc, gi + k * ld, gj ? gj + k * ld : nullptr);
     }
   });
@@ -387,17 +395,9 @@ void Approximant::correction(double *out, int64_t ld) const {
     std::copy_n(records_.data() + int64_t{s} * m, m, out + s * ld);
 }
 
-void Approximant::refresh_records() {
-  ghost_set_ = false;
-  const bool keep = !points_ && method_ != MFREE_METHOD_MPFEM && ps_->has_pairs() &&
-                    (flags_ & MFREE_DERIV_GRADIENT) && has_correction();
-  if (!keep) {
-    records_.clear();
-    return;
-  }
-  const int m = correction_size();
-  records_.resize(static_cast<size_t>(nsites_) * m);
-  compute_records(records_.data(), m);
+bool Approximant::keeps_records() const {
+  return !points_ && method_ != MFREE_METHOD_MPFEM && ps_->has_pairs() &&
+         (flags_ & MFREE_DERIV_GRADIENT) && has_correction();
 }
 
 void Approximant::set_ghost_correction(const double *c, int64_t ld) {
@@ -424,7 +424,7 @@ void Approximant::set_ghost_correction(const double *c, int64_t ld) {
   ghost_set_ = true;
 }
 
-void Approximant::compute_records(double *out, int64_t ld) const {
+void Approximant::compute_records(double *out, int64_t ld, bool missing_only) const {
   const int m = correction_size();
   const int dim = ps_->dim();
   LocalConfig cfg;
@@ -439,12 +439,20 @@ void Approximant::compute_records(double *out, int64_t ld) const {
   const int nt = num_threads(nnz());
   parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
     const size_t row = static_cast<size_t>(std::max(maxrow_, 1));
-    std::vector<double> d(3 * row), v(row), h(row), g(3 * row);  // (a call, not a step)
+    std::vector<double> d, v, h, g;  // sized at the first site computed here
     LocalWork work;
     for (int64_t s = b; s < e; ++s) {
       double *c = out + s * ld;
+      const bool keep = status_[s] == 0 && order_used_[s] == want_order;  // not failed, nor fell back
+      if (keep && missing_only && !std::isnan(c[0])) continue;
       std::fill(c, c + m, 0.0);
-      if (status_[s] != 0 || order_used_[s] != want_order) continue;  // failed, or fell back
+      if (!keep) continue;
+      if (d.empty()) {
+        d.resize(3 * row);
+        v.resize(row);
+        h.resize(row);
+        g.resize(3 * row);
+      }
       const int32_t site = static_cast<int32_t>(s);
       site_input(site, d.data(), v.data(), h.data());
       LocalInput in;

@@ -37,6 +37,12 @@ struct FastTables {
   double period[3] = {0, 0, 0};
   double *val = nullptr;   // nullptr when the value table is not built
   double *grad = nullptr;  // nullptr when the gradient table is not built
+  // When set, the sites' correction records (ncoef doubles each, the layout of
+  // mfree_approximant_get_correction) of Shepard, Johnson-Beissel, Randles-Libersky and
+  // KB Method 1, written by the sites the fast path finishes outside the fused rows;
+  // the others' are left as they were.
+  double *coef = nullptr;
+  int64_t ncoef = 0;
 };
 
 // Per-thread scratch, sized for the longest row before the sites are computed: fourteen

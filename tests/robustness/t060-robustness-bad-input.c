@@ -378,6 +378,11 @@ static void rows_pairs(void) {
   ROW(MFREE_ERR_ARG, mfree_approximant_get_correction(F.a, cor, 9, -1));
   ROW(MFREE_ERR_STATE, mfree_approximant_get_correction(F.a_new, cor, 9, 9 * N));
   ROW(MFREE_SUCCESS, mfree_approximant_get_correction(F.a, cor, 9, 9 * N));
+  ROW0(MFREE_ERR_NULL, mfree_approximant_set_ghost_correction(NULL, cor, 9, 9 * N));
+  ROW(MFREE_ERR_ARG, mfree_approximant_set_ghost_correction(F.a, cor, 8, 9 * N));
+  ROW(MFREE_ERR_ARG, mfree_approximant_set_ghost_correction(F.a, cor, 9, -1));
+  ROW(MFREE_ERR_STATE, mfree_approximant_set_ghost_correction(F.a_new, cor, 9, 9 * N));
+  ROW(MFREE_SUCCESS, mfree_approximant_set_ghost_correction(F.a, cor, 9, 9 * N));
   /* a pair-list set of its own, for the buffer checks of the pair gradients */
   mfree_particles_t *ps = NULL;
   mfree_approximant_t *ap = NULL, *sph = NULL;
