@@ -38,8 +38,8 @@ struct FastTables {
   double *val = nullptr;   // nullptr when the value table is not built
   double *grad = nullptr;  // nullptr when the gradient table is not built
   // When set, the sites' correction records (ncoef doubles each, the layout of
-  // mfree_approximant_get_correction) of Shepard, Johnson-Beissel, Randles-Libersky and
-  // KB Method 1, written by the sites the fast path finishes outside the fused rows;
+  // mfree_approximant_get_correction) of Shepard, MLS/RKPM, Johnson-Beissel,
+  // Randles-Libersky and KB Method 1, written by the sites the fast path finishes outside the fused rows;
   // the others' are left as they were.
   double *coef = nullptr;
   int64_t ncoef = 0;
