@@ -257,15 +257,7 @@ void Approximant::site_displacement(int32_t s, int32_t j, double *d) const {
 }
 
 double Approximant::pair_h(int32_t s, int32_t j) const {
-  const double hs = site_h(s);
-  switch (ps_->search_convention()) {
-    case MFREE_SEARCH_SYMMETRIC_MAX:
-      return std::max(hs, ps_->h(j));
-    case MFREE_SEARCH_SYMMETRIC_MEAN:
-      return 0.5 * (hs + ps_->h(j));
-    default:
-      return hs;
-  }
+  return pair_support(ps_->search_convention(), site_h(s), ps_->h(j));
 }
 
 void Approximant::pack() {
@@ -680,7 +672,13 @@ Report Approximant::compute(const char *what) {
     bad = screen_sites(b, e);
     if (bad) nfailed += bad;
   });
-  if (recs) compute_records(records_.data(), ncoef, true);
+  if (recs) {
+    compute_records(records_.data(), ncoef, true);
+    const int want = has_order(method_) ? order_ : fixed_order(method_);
+    rec_ok_.assign(static_cast<size_t>(ps_->size()), 0);
+    for (int32_t s = 0; s < nsites_; ++s)
+      rec_ok_[s] = pst[s] == 0 && status_[s] == 0 && order_used_[s] == want;
+  }
 
   Report rep;
   if (nfailed) {

@@ -17,6 +17,19 @@ namespace mfree {
 
 class Mesh;
 
+// The pair support h_sj of a site with support hs and a neighbour with hj under a search
+// convention (MFREE_SEARCH_*).
+inline double pair_support(int convention, double hs, double hj) {
+  switch (convention) {
+    case MFREE_SEARCH_SYMMETRIC_MAX:
+      return hs < hj ? hj : hs;  // std::max
+    case MFREE_SEARCH_SYMMETRIC_MEAN:
+      return 0.5 * (hs + hj);
+    default:
+      return hs;
+  }
+}
+
 // Everything that defines an approximant apart from its particle set and sites; the
 // assembler clones it onto its own quadrature points.
 struct ApproxConfig {
@@ -191,6 +204,9 @@ class Approximant {
   // failed at its owner, and for all after a setup/update).
   HVec<double> records_, ghost_records_;
   HVec<uint8_t> ghost_valid_;
+  // per particle: 1 when its pair-gradient side comes from a record (records_ for the
+  // owned ones, ghost_records_ for the ghosts), kept with them
+  HVec<uint8_t> rec_ok_;
   bool ghost_set_ = false;
   int32_t set_owned_ = 0;
 };

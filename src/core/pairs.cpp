@@ -238,14 +238,10 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
   // is missing (it fell back to another order) is looked up in its row.
   const bool by_record = !records_.empty();
   const int m = by_record ? correction_size() : 0;
-  const int want_order = has_order(method_) ? order_ : fixed_order(method_);
+  const uint8_t *rok = rec_ok_.data();
   auto record_of = [&](int32_t s) -> const double * {
-    if (!by_record) return nullptr;
-    if (s < owned)
-      return status_[s] == 0 && order_used_[s] == want_order ? records_.data() + int64_t{s} * m
-                                                             : nullptr;
-    const int64_t g = s - owned;
-    return ghost_set_ && ghost_valid_[g] ? ghost_records_.data() + g * m : nullptr;
+    if (!by_record || !rok[s]) return nullptr;
+    return s < owned ? records_.data() + int64_t{s} * m : ghost_records_.data() + int64_t{s - owned} * m;
   };
   LocalConfig rcfg;
   rcfg.method = method_;
@@ -323,10 +319,39 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
     }
     return true;
   };
+  // Both sides from records, without periodic images: the packed particle data (the
+  // same numbers as the set's), the dimension fixed; else the general case below.
+  bool periodic = false;
+  for (int q = 0; q < dim; ++q) periodic = periodic || ps_->periodic(q);
+  const int conv = ps_->search_convention();
+  const double *pk = pack_.data();
+  const int64_t S = vstride;  // the packed record length
+  const double *ph = pk + (dim == 3 ? S * ps_->size() : dim + 1);
+  const int64_t hst = dim == 3 ? 1 : S;
+  auto both = [&](auto dc, int32_t i, int32_t j, double *a, double *c) {
+    constexpr int D = decltype(dc)::value;
+    const double *xi = pk + i * S, *xj = pk + j * S, hi = ph[i * hst], hj = ph[j * hst];
+    double d[3] = {0, 0, 0}, r, w, dw, d2w, gw[3] = {0, 0, 0};
+    for (int q = 0; q < D; ++q) d[q] = xj[q] - xi[q];
+    kernel_at(*kernel_, D, d, pair_support(conv, hi, hj), r, w, dw, d2w, gw);
+    record_gradient(record_of(i), hi, d, w, gw, xj[D], a);
+    for (int q = 0; q < D; ++q) d[q] = -d[q];
+    if (sym_h)
+      for (int q = 0; q < D; ++q) gw[q] = -gw[q];
+    else
+      kernel_at(*kernel_, D, d, pair_support(conv, hj, hi), r, w, dw, d2w, gw);
+    record_gradient(record_of(j), hj, d, w, gw, xi[D], c);
+  };
   parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
     for (int64_t k = b; k < e; ++k) {
       const int32_t i = pi[k] - base, j = pj[k] - base;
       double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+      if (by_record && !periodic && rok[i] && rok[j] && dim >= 2) {
+        if (dim == 2) both(std::integral_constant<int, 2>(), i, j, a, c);
+        else both(std::integral_constant<int, 3>(), i, j, a, c);
+        write_pair(dim, antisym, a, true, c, true, gi + k * ld, gj ? gj + k * ld : nullptr);
+        continue;
+      }
       const bool ok = pst[i] == 0 && pst[j] == 0;
       const double *ri = ok ? record_of(i) : nullptr, *rj = ok ? record_of(j) : nullptr;
       if (ri || rj) {  // the kernel once for both sides where h_ij is symmetric
@@ -421,6 +446,9 @@ void Approximant::set_ghost_correction(const double *c, int64_t ld) {
     std::copy_n(src, m, dst);
     ghost_valid_[g] = any;  // zeros: a site that failed or fell back at its owner
   }
+  if (!records_.empty())
+    for (int64_t g = 0; g < ng; ++g)
+      rec_ok_[ps_->num_owned() + g] = ghost_valid_[g] && ps_->site_status()[ps_->num_owned() + g] == 0;
   ghost_set_ = true;
 }
 
