@@ -2,14 +2,18 @@
 # Build and run host programs against an *installed* mfree, the way users consume it.
 #
 # usage: consumers.sh BUILD_DIR SCRATCH_DIR SOURCE_DIR C_COMPILER [MODE]
-#   MODE  pkgconfig  cc + pkg-config, shared and forced-static (default: both modes)
+#   MODE  pkgconfig  cc + pkg-config, shared and forced-static (default: all modes)
 #         cmake      find_package(mfree) with mfree::mfree and mfree::mfree_static
+#         serial     find_package(mfree) in hosts where MPI cannot be found (C with
+#                    CMAKE_DISABLE_FIND_PACKAGE_MPI, C++ alone), from the same tree as
+#                    the adapters: mfree::mfree and mfree::mfree_static, no MPI target,
+#                    the mpi component refused by name (or left out when optional)
 #   SCRATCH_DIR must lie under BUILD_DIR; it is wiped first, so reruns start clean.
 # The cmake consumer uses $CMAKE (default: cmake on PATH).
 set -euo pipefail
 
 if [[ $# -lt 4 || $# -gt 5 ]]; then
-  echo "usage: $0 BUILD_DIR SCRATCH_DIR SOURCE_DIR C_COMPILER [pkgconfig|cmake]" >&2
+  echo "usage: $0 BUILD_DIR SCRATCH_DIR SOURCE_DIR C_COMPILER [pkgconfig|cmake|serial]" >&2
   exit 2
 fi
 build=$(cd "$1" && pwd)
@@ -111,10 +115,72 @@ consumer_cmake() {
   run_consumer "CMake mfree::mfree_static" "$out/consumer_static"
 }
 
+consumer_serial() {
+  local cfg cfgdir lang out
+  cfg=$(find "$prefix" -name mfreeConfig.cmake -print -quit)
+  [[ -n "$cfg" ]] || fail "no mfreeConfig.cmake under $prefix"
+  cfgdir=$(dirname "$cfg")
+  step "the core's targets file names no adapter and no adapter's dependency"
+  if grep -nE 'MPI::|PkgConfig::|SUNDIALS::|mfree_(mpi|petsc|suitesparse|sundials)' \
+    "$cfgdir"/mfreeTargets*.cmake; then
+    fail "mfreeTargets.cmake names an adapter or a dependency of one"
+  fi
+  for lang in C CXX; do
+    out=$scratch/serial-$lang
+    local args=("-DCONSUMER_LANGUAGE=$lang" -DEXPECT_SERIAL=ON)
+    if [[ $lang == C ]]; then
+      args+=(-DCMAKE_C_COMPILER="$cc" -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON)
+    fi
+    step "CMake, $lang only (${args[*]}): find_package(mfree), mfree::mfree"
+    "$cmake_cmd" -S "$consumer" -B "$out" -DCMAKE_PREFIX_PATH="$prefix" \
+      -DCMAKE_BUILD_TYPE=Release "${args[@]}" >"$out.log" 2>&1 ||
+      { cat "$out.log" >&2; fail "configuring the $lang-only consumer"; }
+    "$cmake_cmd" --build "$out" >>"$out.log" 2>&1 ||
+      { cat "$out.log" >&2; fail "building the $lang-only consumer"; }
+    run_consumer "$lang-only mfree::mfree" "$out/consumer_shared"
+    run_consumer "$lang-only mfree::mfree_static" "$out/consumer_static"
+  done
+
+  # The mpi component in a C host where MPI is disabled: optional, it is left out;
+  # required, the package is not found and says why (not CMake's error for a REQUIRED
+  # search of a disabled package).
+  local comp=$scratch/serial-components expected
+  mkdir -p "$comp"
+  cat >"$comp/CMakeLists.txt" <<'END'
+cmake_minimum_required(VERSION 3.16)
+project(mfree_serial_components LANGUAGES C)
+if(REQUIRE_MPI)
+  find_package(mfree REQUIRED COMPONENTS mpi)
+else()
+  find_package(mfree REQUIRED OPTIONAL_COMPONENTS mpi)
+endif()
+if(mfree_mpi_FOUND OR TARGET mfree::mfree_mpi OR NOT TARGET mfree::mfree)
+  message(FATAL_ERROR "OPTIONAL_COMPONENTS mpi without MPI: mfree_mpi_FOUND '${mfree_mpi_FOUND}'")
+endif()
+END
+  step "CMake, C with MPI disabled: find_package(mfree OPTIONAL_COMPONENTS mpi)"
+  "$cmake_cmd" -S "$comp" -B "$comp/optional" -DCMAKE_PREFIX_PATH="$prefix" \
+    -DCMAKE_C_COMPILER="$cc" -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON >"$comp/optional.log" 2>&1 ||
+    { cat "$comp/optional.log" >&2; fail "find_package(mfree OPTIONAL_COMPONENTS mpi) without MPI"; }
+  step "CMake, C with MPI disabled: find_package(mfree REQUIRED COMPONENTS mpi) refused"
+  if "$cmake_cmd" -S "$comp" -B "$comp/required" -DCMAKE_PREFIX_PATH="$prefix" \
+    -DCMAKE_C_COMPILER="$cc" -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON -DREQUIRE_MPI=ON \
+    >"$comp/required.log" 2>&1; then
+    fail "find_package(mfree REQUIRED COMPONENTS mpi) succeeded without MPI"
+  fi
+  expected="this installation was built without libmfree_mpi"
+  if [[ -f "$cfgdir/mfree_mpiTargets.cmake" ]]; then
+    expected="component 'mpi' needs MPI::MPI_C"
+  fi
+  grep -qF "$expected" "$comp/required.log" ||
+    { cat "$comp/required.log" >&2; fail "the refusal does not say: $expected"; }
+}
+
 case "$mode" in
   pkgconfig) consumer_pkgconfig ;;
   cmake) consumer_cmake ;;
-  all) consumer_pkgconfig; consumer_cmake ;;
-  *) fail "unknown mode '$mode' (pkgconfig or cmake)" ;;
+  serial) consumer_serial ;;
+  all) consumer_pkgconfig; consumer_cmake; consumer_serial ;;
+  *) fail "unknown mode '$mode' (pkgconfig, cmake or serial)" ;;
 esac
 echo "consumers.sh: $mode consumers passed"
