@@ -149,6 +149,8 @@ contains
     st = mfree_halo_create_f_c(ctx%ptr, fcomm, dim, halo%ptr)
   end function mfree_halo_create_f
 
+  !> Free the plan. Collective: every rank of the plan's communicator calls it (plans in
+  !> the same order on every rank), before mpi_finalize or, memory only, after it.
   integer(c_int) function mfree_halo_destroy(halo) result(st)
     type(mfree_halo), intent(inout) :: halo
     st = mfree_halo_destroy_c(halo%ptr)

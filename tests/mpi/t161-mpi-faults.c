@@ -17,7 +17,8 @@
  *    the plan's on one rank, a NULL approximant on rank 0: every rank returns the status
  *    of the failing one with its message;
  *  - a halo too narrow for the supports: the particle set that declares the plan's width
- *    returns MFREE_ERR_HALO at setup on every rank, instead of rows that miss ghosts. */
+ *    returns MFREE_ERR_HALO at setup on every rank, instead of rows that miss ghosts;
+ *  - a plan destroyed after MPI_Finalize: its memory freed, no MPI call (no abort). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -276,8 +277,20 @@ int main(int argc, char **argv) {
   free(part);
   cloud_free(&c);
   mfree_halo_destroy(&halo);
-  mfree_context_destroy(&ctx);
-  const int rc = mpitest_finish("t161-mpi-faults");
+
+  /* A plan set up (so with its neighbourhood graph) and destroyed after MPI_Finalize,
+   * as a host's late clean-up does: only its memory is freed, no MPI call is made. */
+  mfree_halo_t *late = NULL;
+  const double xl[2] = {(double)rank, 0.0};
+  CHECK(mfree_halo_create(ctx, MPI_COMM_WORLD, 2, &late) == MFREE_SUCCESS &&
+            mfree_halo_setup(late, 1, xl, 2, NULL, 1.5) == MFREE_SUCCESS,
+        "the plan destroyed after MPI_Finalize");
+  mfree_context_destroy(&ctx); /* the plan keeps the context alive */
+  int rc = mpitest_finish("t161-mpi-faults");
   MPI_Finalize();
+  if (mfree_halo_destroy(&late) != MFREE_SUCCESS || late) {
+    fprintf(stderr, "t161-mpi-faults: rank %d: mfree_halo_destroy after MPI_Finalize failed\n", rank);
+    rc = 1;
+  }
   return rc;
 }

@@ -81,8 +81,15 @@ MFREE_MPI_API mfree_status_t mfree_halo_create_f(mfree_context_t *ctx, int32_t f
                                                  mfree_halo_t **halo);
 
 /**
- * Free a plan (not collective).
- * @param[in,out] halo  may be NULL or point to NULL; set to NULL
+ * Free a plan. Collective over the plan's communicator: the plan holds a duplicate of
+ * comm and, once set up, a neighbourhood graph, which it frees with MPI_Comm_free, a
+ * collective call in the MPI standard. Every rank of comm destroys the plan (a rank
+ * must not skip it, nor destroy a plan that others keep), and a host with several plans
+ * destroys them in the same order on every rank, like any collective call. After
+ * MPI_Finalize (MPI_Finalized) only the plan's memory is freed, on each rank alone: its
+ * communicators went with MPI, so a host whose clean-up runs after MPI_Finalize (C++
+ * destructors, Fortran finalization at program end) may still call it.
+ * @param[in,out] halo  may be NULL or point to NULL (nothing to do); set to NULL
  * @return MFREE_SUCCESS
  */
 MFREE_MPI_API mfree_status_t mfree_halo_destroy(mfree_halo_t **halo);

@@ -218,8 +218,14 @@ mfree_status_t mfree_halo_create_f(mfree_context_t *ctx, int32_t fcomm, int32_t 
 mfree_status_t mfree_halo_destroy(mfree_halo_t **halo) {
   if (!halo || !*halo) return MFREE_SUCCESS;
   mfree_halo_t *h = *halo;
-  free_graph(h);
-  if (h->comm != MPI_COMM_NULL) MPI_Comm_free(&h->comm);
+  // MPI_Comm_free after MPI_Finalize is erroneous (Open MPI aborts); MPI released the
+  // plan's communicators at MPI_Finalize, so only the memory is left to free.
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (!finalized) {
+    free_graph(h);
+    if (h->comm != MPI_COMM_NULL) MPI_Comm_free(&h->comm);
+  }
   mfree_matrix_t *ref = h->ctx_ref;
   delete h;
   mfree_matrix_destroy(&ref);
