@@ -1111,8 +1111,8 @@ MFREE_API mfree_status_t mfree_approximant_get_site_order(const mfree_approximan
  * gj = -gi exactly when h_ij is symmetric (search convention SYMMETRIC_MEAN or _MAX, or
  * one h for all). Corrected gradients are not antisymmetric: gj != -gi. For the methods
  * with correction data (mfree_approximant_get_correction) each side is computed from its
- * particle's record with the arithmetic of the table's rows (equal to the table entry
- * divided by the volume to round-off). A side whose particle has no row (a ghost, an
+ * particle's record and the pair's kernel gradient (RL: M grad w), equal to the table
+ * entry divided by the volume to round-off. A side whose particle has no row (a ghost, an
  * isolated particle, a failed site) is 0, except for SPH, which needs no row, and a
  * ghost whose record was given (mfree_approximant_set_ghost_correction); a pair outside
  * the kernel's support is 0. No allocation.
