@@ -192,7 +192,7 @@ program t442
   call check_ok(ctx, mfree_particles_destroy(pc), 'destroy pc')
   call check_ok(ctx, mfree_particles_destroy(ps), 'destroy ps')
   call check_ok(ctx, mfree_context_destroy(ctx), 'destroy ctx')
-  deallocate (gi, gj, ref, cor, msg)  ! (a main program's allocatables live to the end)
+  deallocate (gi, gj, ref, cor, gg, ggj, refj, msg)  ! (a main program's allocatables live to the end)
   call finish('t442')
 
 contains
