@@ -60,12 +60,15 @@ for h in "${harnesses[@]}"; do
   work=build/fuzz/tests/robustness/fuzz/corpus/$h
   mkdir -p "$work"
   log="$out/$h.log"
+  # (libFuzzer exits on a missing directory: a harness may have no regression inputs yet)
+  inputs=("$work" "fuzz/corpus/$h")
+  [[ -d fuzz/regressions/$h ]] && inputs+=("fuzz/regressions/$h")
   echo "==== $h: $minutes min"
   set +e
   ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 UBSAN_OPTIONS=print_stacktrace=1 \
     nice -n 19 "$bin" -max_total_time=$((minutes * 60)) -timeout=20 -rss_limit_mb=3072 \
     -print_final_stats=1 -print_coverage=1 -artifact_prefix="build/fuzz/tests/robustness/fuzz/$h-" \
-    "$work" "fuzz/corpus/$h" "fuzz/regressions/$h" >"$log" 2>&1
+    "${inputs[@]}" >"$log" 2>&1
   rc=$?
   set -e
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$' || true)
@@ -91,8 +94,8 @@ if [[ "${COVERAGE:-0}" == 1 ]]; then
     nice -n 19 cmake --build "$cov" -j"${MFREE_FUZZ_JOBS:-1}" --target "mfree_fuzz_replay_$h" >/dev/null || continue
     files=$(target_files "$h")
     rm -f "$cov"/"$h".prof*
-    find build/fuzz/tests/robustness/fuzz/corpus/"$h" fuzz/corpus/"$h" fuzz/regressions/"$h" -type f 2>/dev/null |
-      xargs -r -n 500 env LLVM_PROFILE_FILE="$cov/$h.prof-%p.profraw" nice -n 19 "$cov/tests/robustness/fuzz/mfree_fuzz_replay_$h" >/dev/null 2>&1 || true
+    find build/fuzz/tests/robustness/fuzz/corpus/"$h" fuzz/corpus/"$h" fuzz/regressions/"$h" -type f -print0 2>/dev/null |
+      xargs -0 -r -n 500 env LLVM_PROFILE_FILE="$cov/$h.prof-%p.profraw" nice -n 19 "$cov/tests/robustness/fuzz/mfree_fuzz_replay_$h" >/dev/null 2>&1 || true
     "$llvm_bin/llvm-profdata" merge -o "$cov/$h.profdata" "$cov"/"$h".prof-*.profraw
     objs=("$cov/tests/robustness/fuzz/mfree_fuzz_replay_$h" -object "$cov/src/libmfree.so")
     [[ $h == adapters ]] && objs+=(-object "$cov/adapters/suitesparse/libmfree_suitesparse.so" -object "$cov/adapters/sundials/libmfree_sundials.so")
