@@ -16,7 +16,7 @@
 #endif
 
 /* The triad's arrays on transparent huge pages where the kernel offers them (madvise), like
- * mfree's own tables without an allocator hook (src/core/alloc.hpp), so that the ratio is
+ * mfree's own tables without an allocator hook (src/core/base/alloc.hpp), so that the ratio is
  * not skewed by the triad's TLB misses; MFREE_HUGEPAGES=0 turns both off. */
 static double *triad_array(size_t len) {
   void *p = NULL;

@@ -24,11 +24,11 @@ fi
 # The files each harness targets (its API family), for the coverage figures.
 target_files() {
   case $1 in
-    particles) echo "src/core/particles.cpp src/core/neighbors.cpp src/capi/particles.cpp" ;;
-    approximant) echo "src/core/approximant.cpp src/core/apply.cpp src/core/local.cpp src/core/shape_fast.cpp src/capi/approximant.cpp" ;;
-    mpfem) echo "src/core/mpfem.cpp src/capi/mesh.cpp" ;;
-    assembly) echo "src/core/assembler.cpp src/core/matrix.cpp src/capi/assembler.cpp src/capi/matrix.cpp" ;;
-    system) echo "src/core/fluid.cpp src/core/fluid_wall.cpp src/core/elastodynamics.cpp src/capi/system.cpp" ;;
+    particles) echo "src/core/particles/particles.cpp src/core/particles/neighbors.cpp src/capi/particles.cpp" ;;
+    approximant) echo "src/core/shape/approximant.cpp src/core/shape/apply.cpp src/core/shape/local.cpp src/core/shape/shape_fast.cpp src/capi/approximant.cpp" ;;
+    mpfem) echo "src/core/shape/mpfem.cpp src/capi/mesh.cpp" ;;
+    assembly) echo "src/core/discretize/assembler.cpp src/core/discretize/matrix.cpp src/capi/assembler.cpp src/capi/matrix.cpp" ;;
+    system) echo "src/core/systems/fluid.cpp src/core/systems/fluid_wall.cpp src/core/systems/elastodynamics.cpp src/capi/system.cpp" ;;
     adapters) echo "adapters/suitesparse/src/suitesparse.cpp adapters/sundials/src/sundials.cpp" ;;
   esac
 }

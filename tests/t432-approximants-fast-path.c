@@ -1,4 +1,4 @@
-/* The specialised value + gradient path (src/core/shape_fast.cpp, issue 8) against the
+/* The specialised value + gradient path (src/core/shape/shape_fast.cpp, issue 8) against the
  * general per-site path of local.cpp. Asking also for the Hessian table routes every
  * site of an approximant through the general path, so the same configuration set up
  * with MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT (fast) and with | MFREE_DERIV_HESSIAN
@@ -16,7 +16,7 @@
  * the lower-order fallback, which the fast path hands to the general path.
  * Randles-Libersky and KB Method 1 have no Hessian; t404 checks them against an O(N^2)
  * oracle. The fast path's row kernels exist twice (baseline and AVX2 + FMA, chosen from
- * the CPU, src/core/simd.hpp): the whole group runs again with MFREE_SIMD=baseline, so
+ * the CPU, src/core/base/simd.hpp): the whole group runs again with MFREE_SIMD=baseline, so
  * that both copies are checked on a machine with AVX2. The pattern copied from the set's
  * rows (kernel support = search radius) equals the filtered one (test_shared_pattern). */
 #include <math.h>

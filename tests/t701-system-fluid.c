@@ -202,7 +202,7 @@ static void test_failures(void **s) {
   y[4 * N + 5] = -1.0;
   assert_error(ctx, mfree_system_rhs(sys, 0.0, y, yd), MFREE_FAIL_INVALID_DATA, "particle 5");
   y[4 * N + 5] = keep;
-  /* the state check's fast path (src/core/fluid.cpp) works on pairs of densities and
+  /* the state check's fast path (src/core/systems/fluid.cpp) works on pairs of densities and
    * whole particles: the last particle, an infinite density, a position, two at once */
   keep = y[4 * N + N - 1];
   y[4 * N + N - 1] = INFINITY;

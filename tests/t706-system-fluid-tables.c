@@ -1,4 +1,4 @@
-/* The Galerkin-SPH fluid's own shape-function tables (src/core/fluid.cpp: linear MLS
+/* The Galerkin-SPH fluid's own shape-function tables (src/core/systems/fluid.cpp: linear MLS
  * with the cubic spline, rebuilt at every evaluation on Verlet candidate lists that are
  * reused while no particle has moved more than half the skin) against independent
  * references, on a jittered patch in a shear flow that moves the particles by about

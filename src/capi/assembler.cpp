@@ -1,4 +1,4 @@
-#include "core/assembler.hpp"
+#include "core/discretize/assembler.hpp"
 #include "handles.hpp"
 
 void mfree::release(mfree_assembler_t *a) {

@@ -8,14 +8,14 @@
 #include <new>
 #include <string>
 
-#include "core/alloc.hpp"
-#include "core/approximant.hpp"
-#include "core/assembler.hpp"
-#include "core/error.hpp"
-#include "core/parallel.hpp"
-#include "core/matrix.hpp"
-#include "core/mpfem.hpp"
-#include "core/particles.hpp"
+#include "core/base/alloc.hpp"
+#include "core/shape/approximant.hpp"
+#include "core/discretize/assembler.hpp"
+#include "core/base/error.hpp"
+#include "core/base/parallel.hpp"
+#include "core/discretize/matrix.hpp"
+#include "core/shape/mpfem.hpp"
+#include "core/particles/particles.hpp"
 #include "mfree.h"
 
 struct mfree_context {

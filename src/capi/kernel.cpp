@@ -1,6 +1,6 @@
 #include <cmath>
 
-#include "core/kernel.hpp"
+#include "core/base/kernel.hpp"
 #include "handles.hpp"
 
 extern "C" {

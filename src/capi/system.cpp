@@ -1,5 +1,5 @@
-#include "core/elastodynamics.hpp"
-#include "core/fluid.hpp"
+#include "core/systems/elastodynamics.hpp"
+#include "core/systems/fluid.hpp"
 #include "handles.hpp"
 
 struct mfree_system {

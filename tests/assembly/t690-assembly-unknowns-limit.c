@@ -3,7 +3,7 @@
  * int32_t indices of mfree_matrix_t, so mfree_assembler_setup refuses more than
  * INT32_MAX of them with MFREE_ERR_ARG and a message. Reaching that through the API
  * would take about 7e8 particles, so this test checks the rule the assembler calls,
- * mfree_core_count_unknowns (src/core/unknowns.h), at and beyond the limit, and that a
+ * mfree_core_count_unknowns (src/core/discretize/unknowns.h), at and beyond the limit, and that a
  * real assembly's size is the count the rule gives (and, found on the way, that nodal
  * quadrature on a particle set without volumes is MFREE_ERR_STATE with a message; it
  * dereferenced the missing arrays before). The SuiteSparse adapter's own limit
@@ -11,7 +11,7 @@
 #include <stdint.h>
 
 #include "testutil.h"
-#include "unknowns.h"
+#include "core/discretize/unknowns.h"
 
 static void test_limit(void **state) {
   (void)state;

@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "core/alloc.hpp"
+#include "core/base/alloc.hpp"
 
 namespace {
 int failures = 0;

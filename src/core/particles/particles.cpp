@@ -1,11 +1,11 @@
-#include "particles.hpp"
+#include "core/particles/particles.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
-#include "parallel.hpp"
+#include "core/base/parallel.hpp"
 
 namespace mfree {
 

@@ -1,4 +1,4 @@
-#include "matrix.hpp"
+#include "core/discretize/matrix.hpp"
 
 #include <cmath>
 #include <limits>

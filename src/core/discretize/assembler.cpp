@@ -1,12 +1,12 @@
-#include "assembler.hpp"
+#include "core/discretize/assembler.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "basis.hpp"
-#include "quadrature.hpp"
-#include "unknowns.h"
+#include "core/base/basis.hpp"
+#include "core/base/quadrature.hpp"
+#include "core/discretize/unknowns.h"
 
 namespace mfree {
 

@@ -1,4 +1,4 @@
-#include "mpfem.hpp"
+#include "core/shape/mpfem.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -7,9 +7,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "approximant.hpp"
-#include "basis.hpp"
-#include "quadrature.hpp"
+#include "core/shape/approximant.hpp"
+#include "core/base/basis.hpp"
+#include "core/base/quadrature.hpp"
 
 namespace mfree {
 

@@ -7,9 +7,9 @@
 #include <sstream>
 #include <type_traits>
 
-#include "approximant.hpp"
-#include "local.hpp"
-#include "parallel.hpp"
+#include "core/shape/approximant.hpp"
+#include "core/shape/local.hpp"
+#include "core/base/parallel.hpp"
 
 namespace mfree {
 

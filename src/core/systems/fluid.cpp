@@ -1,4 +1,4 @@
-#include "fluid.hpp"
+#include "core/systems/fluid.hpp"
 
 #include <algorithm>
 #include <cfloat>
@@ -6,9 +6,9 @@
 #include <sstream>
 #include <type_traits>
 
-#include "kernel.hpp"
-#include "parallel.hpp"
-#include "simd.hpp"
+#include "core/base/kernel.hpp"
+#include "core/base/parallel.hpp"
+#include "core/base/simd.hpp"
 
 #ifdef __SSE2__
 #include <emmintrin.h>

@@ -4,8 +4,8 @@
 
 #include <cstdint>
 
-#include "error.hpp"
-#include "matrix.hpp"
+#include "core/base/error.hpp"
+#include "core/discretize/matrix.hpp"
 #include "mfree.h"
 
 namespace mfree {

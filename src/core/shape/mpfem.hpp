@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "error.hpp"
-#include "kernel.hpp"
-#include "particles.hpp"
+#include "core/base/error.hpp"
+#include "core/base/kernel.hpp"
+#include "core/particles/particles.hpp"
 
 namespace mfree {
 

@@ -3,10 +3,10 @@
 #include <cstring>
 #include <string>
 
-#include "approximant.hpp"
-#include "basis.hpp"
-#include "parallel.hpp"
-#include "simd.hpp"
+#include "core/shape/approximant.hpp"
+#include "core/base/basis.hpp"
+#include "core/base/parallel.hpp"
+#include "core/base/simd.hpp"
 
 #if MFREE_SIMD_X86
 #include <immintrin.h>

@@ -5,7 +5,7 @@
 #include <mutex>
 #include <vector>
 
-#include "error.hpp"
+#include "core/base/error.hpp"
 
 namespace mfree {
 

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <exception>
 
-#include "alloc.hpp"
+#include "core/base/alloc.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>

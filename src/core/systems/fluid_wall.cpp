@@ -15,9 +15,9 @@
 #include <cmath>
 #include <string>
 
-#include "fluid.hpp"
-#include "kernel.hpp"
-#include "parallel.hpp"
+#include "core/systems/fluid.hpp"
+#include "core/base/kernel.hpp"
+#include "core/base/parallel.hpp"
 
 namespace mfree {
 

@@ -5,7 +5,7 @@
 // hw_j = grad_x grad_x w_j. Volumes V_j enter where the method says so (SPH, RKPM, SSPH,
 // MSPH, Randles-Libersky, Johnson-Beissel); MLS, Shepard and the Krongauz-Belytschko
 // corrections use plain weights as in paper 000.
-#include "local.hpp"
+#include "core/shape/local.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "approximant.hpp"
+#include "core/shape/approximant.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -8,8 +8,8 @@
 #include <sstream>
 #include <type_traits>
 
-#include "basis.hpp"
-#include "parallel.hpp"
+#include "core/base/basis.hpp"
+#include "core/base/parallel.hpp"
 
 namespace mfree {
 

@@ -10,7 +10,7 @@
 // binom(2K+D, D) moments of w and the binom(2K+1+D, D) moments of gf (for 2D order 2:
 // 15 + 21 sums instead of 3 x 21 matrix entries), in loops of fixed even length that the
 // compiler vectorises.
-#include "shape_fast.hpp"
+#include "core/shape/shape_fast.hpp"
 
 #include <algorithm>
 #include <cfloat>
@@ -18,8 +18,8 @@
 #include <cstring>
 #include <type_traits>
 
-#include "local.hpp"
-#include "simd.hpp"
+#include "core/shape/local.hpp"
+#include "core/base/simd.hpp"
 
 #if MFREE_SIMD_X86
 #include <immintrin.h>
@@ -70,7 +70,7 @@ namespace {
 // so every thread of a call runs the same code.
 #define MFREE_ROWS_AVX2 0
 namespace base {
-#include "shape_fast_rows.inc"
+#include "core/shape/shape_fast_rows.inc"
 }  // namespace base
 #undef MFREE_ROWS_AVX2
 
@@ -78,7 +78,7 @@ namespace base {
 #define MFREE_ROWS_AVX2 1
 MFREE_AVX2_BEGIN
 namespace avx2 {
-#include "shape_fast_rows.inc"
+#include "core/shape/shape_fast_rows.inc"
 
 // The caller (baseline code) goes on with SSE instructions: return with the upper
 // halves of the vector registers zeroed.

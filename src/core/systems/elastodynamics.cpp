@@ -1,10 +1,10 @@
-#include "elastodynamics.hpp"
+#include "core/systems/elastodynamics.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "basis.hpp"
+#include "core/base/basis.hpp"
 
 namespace mfree {
 

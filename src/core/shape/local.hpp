@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "alloc.hpp"
-#include "basis.hpp"
-#include "kernel.hpp"
+#include "core/base/alloc.hpp"
+#include "core/base/basis.hpp"
+#include "core/base/kernel.hpp"
 #include "mfree.h"
 
 namespace mfree {

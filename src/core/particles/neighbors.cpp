@@ -33,11 +33,11 @@
 #include <type_traits>
 #include <utility>
 
-#include "approximant.hpp"
-#include "kernel.hpp"
-#include "parallel.hpp"
-#include "particles.hpp"
-#include "simd.hpp"
+#include "core/shape/approximant.hpp"
+#include "core/base/kernel.hpp"
+#include "core/base/parallel.hpp"
+#include "core/particles/particles.hpp"
+#include "core/base/simd.hpp"
 
 #if MFREE_SIMD_X86
 #include <immintrin.h>

@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "error.hpp"
-#include "kernel.hpp"
-#include "local.hpp"
-#include "particles.hpp"
-#include "shape_fast.hpp"
+#include "core/base/error.hpp"
+#include "core/base/kernel.hpp"
+#include "core/shape/local.hpp"
+#include "core/particles/particles.hpp"
+#include "core/shape/shape_fast.hpp"
 
 namespace mfree {
 

@@ -5,12 +5,12 @@
 #include <memory>
 #include <vector>
 
-#include "alloc.hpp"
-#include "approximant.hpp"
-#include "error.hpp"
-#include "matrix.hpp"
+#include "core/base/alloc.hpp"
+#include "core/shape/approximant.hpp"
+#include "core/base/error.hpp"
+#include "core/discretize/matrix.hpp"
 #include "mfree.h"
-#include "particles.hpp"
+#include "core/particles/particles.hpp"
 
 namespace mfree {
 

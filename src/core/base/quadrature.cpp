@@ -1,4 +1,4 @@
-#include "quadrature.hpp"
+#include "core/base/quadrature.hpp"
 
 #include <cmath>
 

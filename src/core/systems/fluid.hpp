@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "approximant.hpp"
-#include "error.hpp"
-#include "fluid_wall.hpp"
-#include "matrix.hpp"
+#include "core/shape/approximant.hpp"
+#include "core/base/error.hpp"
+#include "core/systems/fluid_wall.hpp"
+#include "core/discretize/matrix.hpp"
 #include "mfree.h"
-#include "particles.hpp"
-#include "system.hpp"
+#include "core/particles/particles.hpp"
+#include "core/systems/system.hpp"
 
 namespace mfree {
 

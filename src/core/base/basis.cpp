@@ -1,4 +1,4 @@
-#include "basis.hpp"
+#include "core/base/basis.hpp"
 
 namespace mfree {
 

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "alloc.hpp"
+#include "core/base/alloc.hpp"
 
 namespace mfree {
 

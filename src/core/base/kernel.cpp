@@ -1,11 +1,11 @@
-#include "kernel.hpp"
+#include "core/base/kernel.hpp"
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "error.hpp"
-#include "quadrature.hpp"
+#include "core/base/error.hpp"
+#include "core/base/quadrature.hpp"
 
 namespace mfree {
 

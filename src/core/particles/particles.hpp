@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "alloc.hpp"
-#include "error.hpp"
+#include "core/base/alloc.hpp"
+#include "core/base/error.hpp"
 #include "mfree.h"
 
 namespace mfree {

@@ -11,8 +11,8 @@
 
 #include <cstdint>
 
-#include "alloc.hpp"
-#include "kernel.hpp"
+#include "core/base/alloc.hpp"
+#include "core/base/kernel.hpp"
 
 namespace mfree {
 

@@ -10,8 +10,8 @@
 #include <memory>
 #include <vector>
 
-#include "assembler.hpp"
-#include "system.hpp"
+#include "core/discretize/assembler.hpp"
+#include "core/systems/system.hpp"
 
 namespace mfree {
 
