@@ -7,6 +7,7 @@
 #include "core/base/basis.hpp"
 #include "core/base/quadrature.hpp"
 #include "core/discretize/unknowns.h"
+#include "core/particles/neighbors.hpp"
 
 namespace mfree {
 

@@ -41,7 +41,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "core/shape/approximant.hpp"
+#include "core/particles/neighbors.hpp"
 #include "core/base/kernel.hpp"
 #include "core/base/parallel.hpp"
 #include "core/particles/particles.hpp"

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/base/parallel.hpp"
+#include "core/particles/neighbors.hpp"
 
 namespace mfree {
 

@@ -47,7 +47,7 @@ struct Csr {
   int64_t nnz() const { return rowptr.empty() ? 0 : rowptr.back(); }
 };
 
-// Grid and buffers of the cell-list search, kept between searches (neighbors.cpp).
+// Grid and buffers of the cell-list search, kept between searches (neighbors.hpp).
 struct NeighborScratch;
 struct NeighborScratchDeleter {
   void operator()(NeighborScratch *s) const;
@@ -233,14 +233,5 @@ void ParticleSet::check_halo(Radius r, const char *what) const {
                                       " (mfree_particles_set_halo_width): rows would miss ghosts");
   }
 }
-
-// Cell-list search over the valid particles of ps (site_status[i] == 0); fills rows for
-// the owned particles, sorted. Throws Error on a periodic box too small for the supports;
-// on any exception out is unchanged, except when memory ran out after the one-thread
-// search began to write it in place: out then has no rows (rowptr {0}). scratch holds
-// the grid and buffers between calls.
-NeighborScratch *new_neighbor_scratch();
-void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &site_status, NeighborScratch &scratch,
-                    Csr &out);
 
 }  // namespace mfree

@@ -10,6 +10,7 @@
 
 #include "core/base/basis.hpp"
 #include "core/base/parallel.hpp"
+#include "core/particles/neighbors.hpp"
 
 namespace mfree {
 

@@ -211,9 +211,4 @@ class Approximant {
   int32_t set_owned_ = 0;
 };
 
-// Neighbours among the particles of ps for each host point (site support hp, the set's
-// convention and kappa), skipping particles with a nonzero status.
-void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status,
-                          int32_t npts, const VectorArray &x, const ScalarArray &h, Csr &out);
-
 }  // namespace mfree

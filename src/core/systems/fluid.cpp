@@ -9,6 +9,7 @@
 #include "core/base/kernel.hpp"
 #include "core/base/parallel.hpp"
 #include "core/base/simd.hpp"
+#include "core/particles/neighbors.hpp"
 
 #ifdef __SSE2__
 #include <emmintrin.h>
