@@ -70,10 +70,9 @@ struct alignas(16) BlockHeader {
 static_assert(sizeof(BlockHeader) % 16 == 0, "header keeps 16-byte alignment");
 
 // Huge-page blocks (no hook installed, Linux). On a virtual machine every first touch of
-// a 4 KiB page is a fault plus, often, a fill of the host's page tables (~2 us each on
-// the issue-8 machine: the first neighbour search of a set spent a third of its time
-// there); a 2 MiB transparent huge page costs one fault and a 2 MiB clear (~0.2 ms
-// against ~1 ms for its 512 small pages). So a block of at least kHugeMin bytes gets a
+// a 4 KiB page is a fault plus, often, a fill of the host's page tables (a large share of
+// the first neighbour search of a set); a 2 MiB transparent huge page costs one fault and
+// a clear, less than its 512 small pages. So a block of at least kHugeMin bytes gets a
 // mapping of its own, aligned to 2 MiB and advised MADV_HUGEPAGE; its header records the
 // mapping (user == huge_tag(), bytes = mapped length) and freeing it unmaps it. The
 // length is rounded up to whole huge pages when that adds at most an eighth (a touched
@@ -180,8 +179,8 @@ inline void hook_deallocate(void *p) noexcept {
 
 // Faults in the whole pages of [p, p + bytes) in one system call (MADV_POPULATE_WRITE,
 // Linux 5.14), for a block about to be written front to back for the first time: the
-// kernel fills the page tables in one pass instead of one trap per 4 KiB page (~1.5
-// against ~2.3 us per page on the issue-8 VM; ~2.2 against ~2.6-4 when the host must
+// kernel fills the page tables in one pass instead of one trap per 4 KiB page (cheaper
+// per page than the traps, on a virtual machine also when the host must
 // back them anew). Only without a hook (a host's memory is the host's business) and for
 // at least 64 KiB; a kernel without it (EINVAL) is remembered. Contents are unchanged
 // (pages already present stay as they are; new ones are zero).
@@ -210,10 +209,9 @@ inline void prefault(void *p, std::size_t bytes) noexcept {
 // (malloc) however big they are; with a hook installed nothing changes (every block is
 // the host's). For blocks whose first touch matters more than the TLB reach of later
 // reads: on a virtual machine with free-page reporting a huge page comes from memory the
-// host has taken back (order-9 blocks are what the guest reports) and cost 5-17 ms to
-// fault on the issue-8 VM, ~2.5 ms per MB, while small pages mostly come from memory the
-// host still backs (~0.6 ms per MB); recycled huge pages (freed within the last seconds)
-// cost ~0.1 ms per MB.
+// host has taken back (order-9 blocks are what the guest reports) and costs several
+// times more to fault than small pages, which mostly come from memory the host still
+// backs; only huge pages freed within the last seconds are cheaper.
 class SmallPages {
  public:
   SmallPages() { ++detail::small_pages_depth(); }

@@ -26,7 +26,7 @@
 // (_mm256_zeroupper() before returning to a baseline caller, as shape_fast.cpp does):
 // the compiler does this inside the AVX2 copy, but not at an indirect return to
 // baseline SSE code, and on this project's machines the dirty state made the baseline
-// code after it 30-50 % slower (Randles-Libersky setup: 34 ms with, 22 ms without).
+// code after it markedly slower (seen in the Randles-Libersky setup).
 //
 // Choose with simd::use_avx2() once per call (not per site): the answer depends only on
 // the CPU and the environment, so every thread of a call runs the same copy and results
