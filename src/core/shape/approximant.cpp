@@ -649,6 +649,11 @@ Report Approximant::compute(const char *what) {
       if (out.status && fallback_ == MFREE_FALLBACK_LOWER_ORDER) {
         const int first_status = out.status;
         const double first_cond = out.cond;
+        // A site that falls back gets a record of zeros (mfree.h): a lower order's or
+        // Shepard's record has another layout, and Shepard's (1 + dim values) is longer
+        // than Johnson-Beissel's or Randles-Libersky's, so it would run into the next one.
+        if (out.coef) std::fill_n(out.coef, ncoef, 0.0);
+        out.coef = nullptr;
         if (has_order(method_))
           for (int o = order_ - 1; o >= min_order(method_) && out.status; --o) {
             cfg.order = o;
