@@ -1,5 +1,5 @@
 /*
- * t204: the huge-page path of the internal allocator (issue 8, src/core/base/alloc.hpp).
+ * t204: the huge-page path of the internal allocator (src/core/base/alloc.hpp).
  *
  * Without an allocator hook, blocks of 2 MiB and more (here the neighbour lists of a
  * 10^5-particle set) get mappings of their own, advised MADV_HUGEPAGE, and are unmapped

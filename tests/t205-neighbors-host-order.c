@@ -1,6 +1,6 @@
 /*
  * t205: the one-thread host-order neighbour search against the general cell-order one
- * on the same points (issue 8, src/core/particles/neighbors.cpp).
+ * on the same points (src/core/particles/neighbors.cpp).
  *
  * A one-thread search of particles stored in spatial order (on x86 with AVX2; elsewhere,
  * or with MFREE_SIMD=baseline, both sides below take the general path and the test

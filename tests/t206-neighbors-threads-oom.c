@@ -1,5 +1,5 @@
 /*
- * t206: running out of memory in a neighbour search with two threads (issue 8; the
+ * t206: running out of memory in a neighbour search with two threads (the
  * one-thread case is t205's test_allocation_failure).
  *
  * The context's allocator hook is called from both threads at once here, so the hook

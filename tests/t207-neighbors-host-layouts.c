@@ -1,6 +1,6 @@
 /*
- * t207: the host-order neighbour search's strided reads and four-lane scans (issue 8,
- * src/core/particles/neighbors.cpp: query2_avx2 in 2D, query_avx2_t in 3D, on x86 with AVX2;
+ * t207: the host-order neighbour search's strided reads and four-lane scans
+ * (src/core/particles/neighbors.cpp: query2_avx2 in 2D, query_avx2_t in 3D, on x86 with AVX2;
  * elsewhere, or with MFREE_SIMD=baseline, the general path, and the test checks that).
  *
  * Jittered lattices stored in lattice order (host order = spatial order), gather

@@ -1,5 +1,5 @@
 /*
- * t208: the host-order search on several threads (issue 8, src/core/particles/neighbors.cpp,
+ * t208: the host-order search on several threads (src/core/particles/neighbors.cpp,
  * host_order_blocks) gives the one-thread lists bit for bit while the particles move
  * so that some blocks of rows grow and others shrink.
  *

@@ -2,7 +2,7 @@
  * shape-function tables come from it, every block goes back to the allocator that made
  * it, an allocation failure is MFREE_ERR_ALLOC with a message, and after the first
  * setup mfree_particles_update, mfree_approximant_update and mfree_approximant_apply
- * allocate nothing through the hook (issue 8), for every method family, with one thread
+ * allocate nothing through the hook, for every method family, with one thread
  * and with two. Allocations through the C++ standard library, which the hook cannot see,
  * are counted by tests/heap/t433. */
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-/* Results do not depend on the thread count (issue 8): neighbour lists, shape-function
+/* Results do not depend on the thread count: neighbour lists, shape-function
  * tables (at the particles and at host points), site data and applied operators are
  * bitwise identical with 1 and 2 threads (and with 0 = all cores), for every method
  * family, in 2D and 3D. Sets are above the size from which mfree starts threads. Without

@@ -1,4 +1,4 @@
-/* The specialised value + gradient path (src/core/shape/shape_fast.cpp, issue 8) against the
+/* The specialised value + gradient path (src/core/shape/shape_fast.cpp) against the
  * general per-site path of local.cpp. Asking also for the Hessian table routes every
  * site of an approximant through the general path, so the same configuration set up
  * with MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT (fast) and with | MFREE_DERIV_HESSIAN

@@ -1,6 +1,6 @@
 // After the first step, a Galerkin-SPH fluid step (mfree_system_integrate, leap-frog and
 // predictor-corrector, walls, 1 and 2 threads) makes no heap allocation while its
-// neighbour lists are reused (issue 8): neither through the context's allocator hook nor
+// neighbour lists are reused: neither through the context's allocator hook nor
 // through the C++ standard library (global operator new replaced and counted). A column
 // of fluid at rest under gravity moves far less than the lists' skin in the steps below,
 // so no list is rebuilt (a rebuild re-runs the search, whose buffers grow only with the

@@ -1,5 +1,5 @@
 // After the first setup, mfree_particles_update, mfree_approximant_update and
-// mfree_approximant_apply make no heap allocation at all (issue 8): neither through the
+// mfree_approximant_apply make no heap allocation at all: neither through the
 // context's allocator hook (counted by the hook below) nor through the C++ standard
 // library (counted by replacing the global operator new, which every std::vector and
 // std::string in libmfree reaches). One and two threads, 2D and 3D, positions moved
