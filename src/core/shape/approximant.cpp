@@ -261,6 +261,18 @@ double Approximant::pair_h(int32_t s, int32_t j) const {
   return pair_support(ps_->search_convention(), site_h(s), ps_->h(j));
 }
 
+LocalConfig Approximant::local_config(bool value, bool grad, bool hess) const {
+  LocalConfig cfg;
+  cfg.method = method_;
+  cfg.dim = ps_->dim();
+  cfg.order = order_;
+  cfg.want_value = value;
+  cfg.want_grad = grad;
+  cfg.want_hess = hess;
+  cfg.kernel = kernel_.get();
+  return cfg;
+}
+
 void Approximant::pack() {
   const int dim = ps_->dim();
   const int32_t np = ps_->size();
@@ -539,14 +551,7 @@ Report Approximant::compute(const char *what) {
   order_used_.resize(nsites_);
   find_bad_particles();
 
-  LocalConfig base;
-  base.method = method_;
-  base.dim = dim;
-  base.order = order_;
-  base.want_value = fv;
-  base.want_grad = fg;
-  base.want_hess = fh;
-  base.kernel = kernel_.get();
+  const LocalConfig base = local_config(fv, fg, fh);
 
   // Per-thread scratch sized for the longest row before the threads start, so that no
   // site allocates; sites are split statically and are independent, so the tables do

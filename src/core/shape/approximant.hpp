@@ -137,6 +137,8 @@ class Approximant {
   int32_t site_particle(int32_t s) const { return points_ ? -1 : s; }
   void site_displacement(int32_t s, int32_t j, double *d) const;
   double pair_h(int32_t s, int32_t j) const;
+  // the local solve's configuration for this approximant, with the outputs wanted
+  LocalConfig local_config(bool value, bool grad, bool hess) const;
   // The general path's input of site s: displacements x_j - x_s (3 per neighbour),
   // volumes and pair supports of its row.
   void site_input(int32_t s, double *d, double *v, double *h) const;

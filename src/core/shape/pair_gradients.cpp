@@ -88,12 +88,7 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
     if (!by_record || !rok[s]) return nullptr;
     return s < owned ? records_.data() + int64_t{s} * m : ghost_records_.data() + int64_t{s - owned} * m;
   };
-  LocalConfig rcfg;
-  rcfg.method = method_;
-  rcfg.dim = dim;
-  rcfg.order = order_;
-  rcfg.kernel = kernel_.get();
-  const RecordGradient record_gradient(rcfg);
+  const RecordGradient record_gradient(local_config(true, true, false));
   const int nt = num_threads(P);
   if (sph && sym_h) {
     // the kernel gradient, computed as the host computes its dwdx (the table's entries
@@ -220,9 +215,10 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
   });
 }
 
-int Approximant::correction_size() const {
-  const int dim = ps_->dim();
-  switch (method_) {
+// Doubles of a record (the layouts of mfree_approximant_get_correction), 0 for none.
+namespace {
+int correction_length(int method, int dim, int order) {
+  switch (method) {
     case MFREE_METHOD_SHEPARD:
       return 1 + dim;
     case MFREE_METHOD_JOHNSON_BEISSEL:
@@ -233,28 +229,25 @@ int Approximant::correction_size() const {
       return dim * dim + 1 + dim;
     case MFREE_METHOD_MLS:
     case MFREE_METHOD_RKPM:
-      if (order_ <= 2) return (1 + dim) * basis_size(dim, order_);
-      throw Error(MFREE_ERR_UNSUPPORTED, "correction data of MLS/RKPM are defined up to order 2");
+      return order <= 2 ? (1 + dim) * basis_size(dim, order) : 0;
     default:
-      throw Error(MFREE_ERR_UNSUPPORTED,
-                  "correction data are defined for Shepard, MLS/RKPM, Johnson-Beissel, "
-                  "Randles-Libersky and KB Method 1");
+      return 0;
   }
+}
+}  // namespace
+
+int Approximant::correction_size() const {
+  const int m = correction_length(method_, ps_->dim(), order_);
+  if (m > 0) return m;
+  if (method_ == MFREE_METHOD_MLS || method_ == MFREE_METHOD_RKPM)
+    throw Error(MFREE_ERR_UNSUPPORTED, "correction data of MLS/RKPM are defined up to order 2");
+  throw Error(MFREE_ERR_UNSUPPORTED,
+              "correction data are defined for Shepard, MLS/RKPM, Johnson-Beissel, "
+              "Randles-Libersky and KB Method 1");
 }
 
 bool Approximant::has_correction() const {
-  switch (method_) {
-    case MFREE_METHOD_SHEPARD:
-    case MFREE_METHOD_JOHNSON_BEISSEL:
-    case MFREE_METHOD_RANDLES_LIBERSKY:
-    case MFREE_METHOD_KB_METHOD1:
-      return true;
-    case MFREE_METHOD_MLS:
-    case MFREE_METHOD_RKPM:
-      return order_ <= 2;
-    default:
-      return false;
-  }
+  return correction_length(method_, ps_->dim(), order_) > 0;
 }
 
 void Approximant::correction(double *out, int64_t ld) const {
@@ -299,15 +292,7 @@ void Approximant::set_ghost_correction(const double *c, int64_t ld) {
 
 void Approximant::compute_records(double *out, int64_t ld, bool missing_only) const {
   const int m = correction_size();
-  const int dim = ps_->dim();
-  LocalConfig cfg;
-  cfg.method = method_;
-  cfg.dim = dim;
-  cfg.order = order_;
-  cfg.want_value = false;
-  cfg.want_grad = true;
-  cfg.want_hess = false;
-  cfg.kernel = kernel_.get();
+  const LocalConfig cfg = local_config(false, true, false);
   const int want_order = has_order(method_) ? order_ : fixed_order(method_);
   const int nt = num_threads(nnz());
   parallel_blocks(nsites_, nt, [&](int, int64_t b, int64_t e) {
