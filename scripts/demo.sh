@@ -22,7 +22,7 @@ data="$root/data/martin_moyce_1952.csv"
 mkdir -p "$out"
 echo
 echo "== Dam break (Galerkin SPH) vs Martin & Moyce (1952)"
-"$root/build/default/examples/dam_break/mfree_dam_break" --nx 30 --out "$out" --data "$data" "$@"
+"$root/build/default/examples/dam_break/mfree_dam_break" --nx 30 --out "$out" --vtu "$out" --data "$data" "$@"
 
 echo
 if command -v gnuplot >/dev/null 2>&1; then

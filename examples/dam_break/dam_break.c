@@ -21,12 +21,16 @@
  * cell of width d around it, so Z = 1 at t = 0), against T = t sqrt(2 g / a). The front
  * of the particles touching the floor (z_i < 1.5 d) is written to the CSV too.
  *
- * Output in DIR (--out, default dam_break_out): dam_break.pvd indexing dam_break_NNNN.vtu
- * (ASCII VTU: position, velocity = interpolated v_hat, pressure, density), front.csv,
- * front.gp and front.png (gnuplot on PATH, not --no-plot). With --json one JSON object on
- * stdout: {"front":[[T,Z],...],"max_rel_dev":..,"particles":..,"steps":..,
- * "wall_seconds":..,...}, where max_rel_dev is the largest |Z - Z_exp| / Z_exp over the
- * data points with 1 <= T <= 3 (Z linearly interpolated in T); -1 when no data file. */
+ * Output in DIR (--out, default dam_break_out): front.csv, front.gp and front.png (gnuplot
+ * on PATH, not --no-plot) and the JSON summary dam_break.json (--json: on stdout too):
+ * {"front":[[T,Z],...],"front_floor":[[T,Z_floor],...],"max_rel_dev":..,"compared":..,
+ * "particles":..,"steps":..,"wall_seconds":..,"mass_rel_error":..,"status":..,"error":..,
+ * "t_end":..}, where max_rel_dev is the largest |Z - Z_exp| / Z_exp over the data points
+ * with 1 <= T <= 3 (Z linearly interpolated in T; -1 when no data file) and t_end the T
+ * reached. With --vtu DIR (or --vtu-every T): dam_break.pvd indexing dam_break_NNNN.vtu
+ * (position, velocity = interpolated v_hat, pressure, density) every 0.25 in T. A run that
+ * stops on an error (a particle leaving the tank, a non-finite state) says so on stderr
+ * and exits with status 3. */
 #define _XOPEN_SOURCE 700
 #include <math.h>
 #include <stdio.h>
@@ -38,14 +42,16 @@
 
 #include <mfree.h>
 
+#include "fluid_common.h"
 #include "util.h"
 
 static const double kG = 9.81, kRho0 = 1000.0, kGamma = 7.0;
 
 typedef struct {
-  double a, tank, t_end, cfl, mu, strength, offset, out_dt, vtu_dt;
-  int nx, json, quiet, plot, vtu, scheme, lumping;
-  const char *out_dir, *data;
+  double a, tank, t_end, cfl, mu, strength, offset, out_dt;
+  int nx, scheme, lumping;
+  const char *data;
+  fc_run_t run;
 } options_t;
 
 static void usage(FILE *f) {
@@ -62,24 +68,21 @@ static void usage(FILE *f) {
           "  --scheme S      leapfrog (default) | pc (predictor-corrector)\n"
           "  --lumping L     galerkin (default, 003 eq 56) | physical (eq 58)\n"
           "  --data PATH     Martin & Moyce CSV (default: the repository's data/martin_moyce_1952.csv)\n"
-          "  --out DIR       output directory (default dam_break_out)\n"
-          "  --vtu-every T   VTU interval in units of T (default 0.25; 0 = no VTU)\n"
-          "  --no-plot       do not run gnuplot\n"
-          "  --quiet         no progress bar\n"
-          "  --json          one JSON object on stdout\n");
+          "  (--vtu-every in units of T, default 0.25)\n");
+  fc_run_usage(f);
 }
 
 static int parse(int argc, char **argv, options_t *o) {
   for (int i = 1; i < argc; ++i) {
     const char *s = argv[i];
     const int has = i + 1 < argc;
+    const int r = fc_run_option(argc, argv, &i, &o->run);
+    if (r < 0) return 0;
+    if (r > 0) continue;
     if (!strcmp(s, "--help")) {
       usage(stdout);
       exit(0);
-    } else if (!strcmp(s, "--json")) o->json = 1;
-    else if (!strcmp(s, "--quiet")) o->quiet = 1;
-    else if (!strcmp(s, "--no-plot")) o->plot = 0;
-    else if (!strcmp(s, "--nx") && has) o->nx = atoi(argv[++i]);
+    } else if (!strcmp(s, "--nx") && has) o->nx = atoi(argv[++i]);
     else if (!strcmp(s, "--a") && has) o->a = atof(argv[++i]);
     else if (!strcmp(s, "--tank") && has) o->tank = atof(argv[++i]);
     else if (!strcmp(s, "--tend") && has) o->t_end = atof(argv[++i]);
@@ -88,8 +91,6 @@ static int parse(int argc, char **argv, options_t *o) {
     else if (!strcmp(s, "--strength") && has) o->strength = atof(argv[++i]);
     else if (!strcmp(s, "--offset") && has) o->offset = atof(argv[++i]);
     else if (!strcmp(s, "--data") && has) o->data = argv[++i];
-    else if (!strcmp(s, "--out") && has) o->out_dir = argv[++i];
-    else if (!strcmp(s, "--vtu-every") && has) o->vtu_dt = atof(argv[++i]);
     else if (!strcmp(s, "--scheme") && has) {
       const char *v = argv[++i];
       if (!strcmp(v, "leapfrog")) o->scheme = MFREE_INTEGRATOR_LEAPFROG;
@@ -103,7 +104,7 @@ static int parse(int argc, char **argv, options_t *o) {
     } else return 0;
   }
   return o->nx >= 2 && o->a > 0 && o->tank > 1 && o->t_end > 0 && o->cfl > 0 && o->cfl <= 1 &&
-         o->mu >= 0 && o->strength >= 0 && o->offset >= 0 && o->vtu_dt >= 0;
+         o->mu >= 0 && o->strength >= 0 && o->offset >= 0;
 }
 
 /* Martin & Moyce points (T, Z); returns the count, 0 if the file is missing. */
@@ -125,32 +126,6 @@ static int read_data(const char *path, double *T, double *Z, int cap) {
   return n;
 }
 
-static int write_vtu(const char *path, int n, const double *y, const double *vhat, const double *p) {
-  FILE *f = fopen(path, "w");
-  if (!f) return 1;
-  fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
-             "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"%d\" "
-             "NumberOfCells=\"%d\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" "
-             "format=\"ascii\">\n", n, n);
-  for (int i = 0; i < n; ++i) fprintf(f, "%.9g %.9g 0\n", y[2 * i], y[2 * i + 1]);
-  fprintf(f, "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int32\" Name=\"connectivity\" "
-             "format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%d\n", i);
-  fprintf(f, "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%d\n", i + 1);
-  fprintf(f, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "1\n");
-  fprintf(f, "</DataArray>\n</Cells>\n<PointData Scalars=\"pressure\" Vectors=\"velocity\">\n"
-             "<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%.6g %.6g 0\n", vhat[2 * i], vhat[2 * i + 1]);
-  fprintf(f, "</DataArray>\n<DataArray type=\"Float64\" Name=\"pressure\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%.6g\n", p[i]);
-  fprintf(f, "</DataArray>\n<DataArray type=\"Float64\" Name=\"density\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%.8g\n", y[4 * n + i]);
-  fprintf(f, "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-  return fclose(f) != 0;
-}
-
 #define CHECK(call)                                                               \
   do {                                                                            \
     const mfree_status_t st_ = (call);                                            \
@@ -158,18 +133,15 @@ static int write_vtu(const char *path, int n, const double *y, const double *vha
   } while (0)
 
 int main(int argc, char **argv) {
-  options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 0.05, 0.25,
-                 24,      0,   0,   1,   1,   MFREE_INTEGRATOR_LEAPFROG, MFREE_LUMP_GALERKIN,
-                 "dam_break_out", MFREE_DATA_DIR "/martin_moyce_1952.csv"};
+  options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 0.05, 24, MFREE_INTEGRATOR_LEAPFROG,
+                 MFREE_LUMP_GALERKIN, MFREE_DATA_DIR "/martin_moyce_1952.csv", {0}};
+  fc_run_init(&o.run, "dam_break", 0.25);
   if (!parse(argc, argv, &o)) {
     usage(stderr);
     return 2;
   }
-  o.vtu = o.vtu_dt > 0;
-  if (mkdir(o.out_dir, 0777) != 0 && access(o.out_dir, W_OK) != 0) {
-    fprintf(stderr, "mfree_dam_break: cannot create or write %s\n", o.out_dir);
-    return 1;
-  }
+  if (fc_run_prepare(&o.run)) return 1;
+  const char *out_dir = o.run.out;
 
   /* ---- geometry and initial state (spec 003 section 3.1) ---- */
   const double a = o.a, H = 2.0 * a, L = o.tank * a, d = a / o.nx, h = 1.5 * d;
@@ -177,7 +149,6 @@ int main(int argc, char **argv) {
   const double tscale = sqrt(2.0 * kG / a);                   /* T = t sqrt(2 g / a) */
   const int nx = o.nx, nz = 2 * o.nx, n = nx * nz;
   double *y = calloc(5 * (size_t)n, sizeof *y), *m = malloc((size_t)n * sizeof *m);
-  double *vhat = malloc(2 * (size_t)n * sizeof *vhat), *p = malloc((size_t)n * sizeof *p);
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i) {
       const int q = j * nx + i;
@@ -226,30 +197,30 @@ int main(int argc, char **argv) {
   /* ---- run ---- */
   double dT[64], dZ[64];
   const int ndata = read_data(o.data, dT, dZ, 64);
-  if (!ndata && !o.quiet)
+  if (!ndata && !o.run.quiet)
     fprintf(stderr, "mfree_dam_break: no Martin & Moyce data at %s; the comparison is skipped\n", o.data);
   char path[4096];
-  snprintf(path, sizeof path, "%s/front.csv", o.out_dir);
+  ex_join(path, sizeof path, out_dir, "front.csv");
   FILE *csv = fopen(path, "w");
-  snprintf(path, sizeof path, "%s/dam_break.pvd", o.out_dir);
-  FILE *pvd = o.vtu ? fopen(path, "w") : NULL;
-  if (!csv || (o.vtu && !pvd)) {
-    fprintf(stderr, "mfree_dam_break: cannot write in %s\n", o.out_dir);
+  if (!csv) {
+    fprintf(stderr, "mfree_dam_break: error: cannot write %s\n", path);
     return 1;
   }
+  fc_vtu_t vtu;
+  if (fc_vtu_open(&vtu, fc_run_vtu_dir(&o.run), "dam_break", o.run.vtu_every)) return 1;
   fprintf(csv, "# Martin & Moyce dam break, a = %g m, nx = %d, %d particles\n"
                "# T = t sqrt(2 g / a), Z = (max x + d/2) / a, Z_floor: particles with z < 1.5 d\n"
                "T,Z,Z_floor,t,steps\n", a, nx, n);
-  if (pvd) fprintf(pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
 
   const int nout = (int)floor(o.t_end / o.out_dt + 1e-9);
   double *fT = malloc((size_t)(nout + 1) * sizeof *fT), *fZ = malloc((size_t)(nout + 1) * sizeof *fZ);
-  int nf = 0, nvtu = 0;
-  double t = 0.0, next_vtu = 0.0;
+  double *fZf = malloc((size_t)(nout + 1) * sizeof *fZf);
+  int nf = 0;
+  double t = 0.0;
   int64_t steps = 0;
   mfree_status_t run = MFREE_SUCCESS;
   ex_progress_t prog;
-  ex_progress_init(&prog, o.quiet, 0.0, o.t_end / tscale);
+  ex_progress_init(&prog, o.run.quiet, 0.0, o.t_end / tscale);
   struct timespec c0, c1;
   clock_gettime(CLOCK_MONOTONIC, &c0);
   for (int io = 0; io <= nout; ++io) {
@@ -269,46 +240,24 @@ int main(int argc, char **argv) {
     }
     const double T = t * tscale, Z = (xmax + 0.5 * d) / a, Zf = (xfloor + 0.5 * d) / a;
     fT[nf] = T;
+    fZf[nf] = Zf;
     fZ[nf++] = Z;
     fprintf(csv, "%.4f,%.5f,%.5f,%.6f,%lld\n", T, Z, Zf, t, (long long)steps);
-    if (pvd && T >= next_vtu - 1e-9) {
-      CHECK(mfree_system_get_velocity(sys, y, vhat));
-      CHECK(mfree_system_get_pressure(sys, y, p));
-      snprintf(path, sizeof path, "%s/dam_break_%04d.vtu", o.out_dir, nvtu);
-      if (write_vtu(path, n, y, vhat, p)) {
-        fprintf(stderr, "mfree_dam_break: cannot write %s\n", path);
-        return 1;
-      }
-      fprintf(pvd, "<DataSet timestep=\"%.6f\" group=\"\" part=\"0\" file=\"dam_break_%04d.vtu\"/>\n", t, nvtu);
-      ++nvtu;
-      next_vtu += o.vtu_dt;
-    }
+    if (fc_vtu_maybe(&vtu, sys, T, t, n, y, NULL)) return 1;
     if (L - xmax < 2.0 * d) break; /* the front reached the far wall */
   }
   clock_gettime(CLOCK_MONOTONIC, &c1);
   const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
   ex_progress_done(&prog, "mfree_dam_break", t);
   fclose(csv);
-  if (pvd) {
-    fprintf(pvd, "</Collection>\n</VTKFile>\n");
-    fclose(pvd);
-  }
+  if (fc_vtu_close(&vtu)) return 1;
   char msg[1024] = "";
-  if (run != MFREE_SUCCESS) mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  const int exit_status = run == MFREE_SUCCESS ? 0 : fc_run_error(ctx, &o.run, run, "T", t * tscale, msg, sizeof msg);
 
   /* ---- mass: constant particle masses, none lost (the box), and the Galerkin lumped
    * masses summing to the total (003 eq 57) ---- */
-  mfree_matrix_t *M = NULL;
-  double lumped = 0.0, mass1 = 0.0;
-  for (int q = 0; q < n; ++q) mass1 += m[q];
-  CHECK(mfree_system_assemble_mass(sys, y, 0, &M));
-  const int64_t *rp;
-  const int32_t *ci;
-  const double *mv;
-  CHECK(mfree_matrix_get_csr(M, &rp, &ci, &mv));
-  for (int q = 0; q < n; ++q) lumped += mv[rp[2 * n + 2 * q]];
-  mfree_matrix_destroy(&M);
-  const double mass_err = fmax(fabs(mass1 - mass0), fabs(lumped - mass0)) / mass0;
+  double mass_err = 0.0;
+  CHECK(fc_mass_error(sys, y, n, m, mass0, &mass_err));
 
   /* ---- comparison with Martin & Moyce (1 <= T <= 3) ---- */
   double maxdev = -1.0;
@@ -328,10 +277,10 @@ int main(int argc, char **argv) {
 
   /* ---- plot: the front against the experiment ---- */
   char gp_path[4096] = "", png_path[4096] = "", csv_path[4096] = "";
-  ex_join(gp_path, sizeof gp_path, o.out_dir, "front.gp");
-  ex_join(png_path, sizeof png_path, o.out_dir, "front.png");
-  ex_join(csv_path, sizeof csv_path, o.out_dir, "front.csv");
-  if (o.plot && ex_plot_path_ok(png_path) && ex_plot_path_ok(o.data)) {
+  ex_join(gp_path, sizeof gp_path, out_dir, "front.gp");
+  ex_join(png_path, sizeof png_path, out_dir, "front.png");
+  ex_join(csv_path, sizeof csv_path, out_dir, "front.csv");
+  if (o.run.plot && ex_plot_path_ok(png_path) && ex_plot_path_ok(o.data)) {
     FILE *gp = fopen(gp_path, "w");
     if (gp) {
       fprintf(gp, "set terminal pngcairo size 800,560\nset output '%s'\nset datafile separator ','\n"
@@ -344,32 +293,47 @@ int main(int argc, char **argv) {
       if (ndata) fprintf(gp, ", '%s' using 1:2 with points pt 7 title 'Martin and Moyce (1952), n^2 = 2'", o.data);
       fprintf(gp, "\n");
       fclose(gp);
-      ex_plot(gp_path, png_path, csv_path, o.json ? stderr : stdout);
+      ex_plot(gp_path, png_path, csv_path, o.run.json_stdout ? stderr : stdout);
     }
   }
 
-  if (o.json) {
-    printf("{\"front\":[");
-    for (int q = 0; q < nf; ++q) printf("%s[%.4f,%.5f]", q ? "," : "", fT[q], fZ[q]);
-    printf("],\"max_rel_dev\":%.5f,\"compared\":%d,\"particles\":%d,\"steps\":%lld,\"wall_seconds\":%.2f,"
-           "\"mass_rel_error\":%.3e,\"a\":%g,\"nx\":%d,\"status\":%d,\"t_end\":%.5f}\n",
-           maxdev, compared, n, (long long)steps, wall, mass_err, a, nx, (int)run, t * tscale);
-  } else {
+  fc_json_t js;
+  fc_json_init(&js);
+  double *rows = malloc(2 * (size_t)(nf + 1) * sizeof *rows);
+  if (!rows) return 1;
+  for (int q = 0; q < nf; ++q) rows[2 * q] = fT[q], rows[2 * q + 1] = fZ[q];
+  fc_json_table(&js, "front", nf, 2, rows);
+  for (int q = 0; q < nf; ++q) rows[2 * q + 1] = fZf[q];
+  fc_json_table(&js, "front_floor", nf, 2, rows);
+  free(rows);
+  fc_json_num(&js, "max_rel_dev", maxdev);
+  fc_json_int(&js, "compared", compared);
+  fc_json_int(&js, "particles", n);
+  fc_json_int(&js, "steps", steps);
+  fc_json_num(&js, "wall_seconds", wall);
+  fc_json_num(&js, "mass_rel_error", mass_err);
+  fc_json_num(&js, "a", a);
+  fc_json_int(&js, "nx", nx);
+  fc_json_num(&js, "cfl", o.cfl);
+  fc_json_str(&js, "scheme", o.scheme == MFREE_INTEGRATOR_LEAPFROG ? "leapfrog" : "pc");
+  fc_json_int(&js, "status", (int)run);
+  fc_json_str(&js, "error", run == MFREE_SUCCESS ? NULL : msg);
+  fc_json_num(&js, "t_end", t * tscale);
+  if (fc_json_finish(&js, &o.run)) return 1;
+  if (!o.run.json_stdout) {
     printf("dam break: a = %g m, %d particles, %lld steps, %.1f s\n", a, n, (long long)steps, wall);
     for (int q = 0; q < nf; q += 4) printf("  T = %5.2f  Z = %6.3f\n", fT[q], fZ[q]);
     if (maxdev >= 0) printf("max |Z - Z_exp| / Z_exp over 1 <= T <= 3: %.3f (%d points)\n", maxdev, compared);
-    printf("mass: relative error %.2e; output in %s\n", mass_err, o.out_dir);
+    printf("mass: relative error %.2e; output in %s\n", mass_err, out_dir);
   }
-  if (run != MFREE_SUCCESS) fprintf(stderr, "mfree_dam_break: stopped at T = %.3f: %s\n", t * tscale, msg);
   mfree_system_destroy(&sys);
   mfree_context_destroy(&ctx);
   free(y);
   free(m);
-  free(vhat);
-  free(p);
   free(wx);
   free(wn);
   free(fT);
   free(fZ);
-  return run == MFREE_SUCCESS ? 0 : 3;
+  free(fZf);
+  return exit_status;
 }

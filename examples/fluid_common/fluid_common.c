@@ -1,8 +1,15 @@
 #define _XOPEN_SOURCE 700
 #include "fluid_common.h"
 
+#include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "util.h"
 
 int fc_walls_segment(fc_walls_t *w, double x0, double z0, double x1, double z1, double ds, double nx,
                      double nz, int skip_first) {
@@ -36,6 +43,79 @@ void fc_walls_free(fc_walls_t *w) {
   w->n = w->cap = 0;
 }
 
+/* ---- run options ---- */
+
+void fc_run_init(fc_run_t *r, const char *name, double vtu_every) {
+  static char out[128];
+  snprintf(out, sizeof out, "%s_out", name);
+  r->name = name;
+  r->out = out;
+  r->vtu_dir = NULL;
+  r->vtu_every = vtu_every;
+  r->vtu_every_set = 0;
+  r->json_path = NULL;
+  r->json_stdout = 0;
+  r->quiet = 0;
+  r->plot = 1;
+}
+
+int fc_run_option(int argc, char **argv, int *i, fc_run_t *r) {
+  const char *s = argv[*i];
+  const int has = *i + 1 < argc;
+  if (ex_plot_option(argc, argv, i, &r->out, &r->plot)) return 1;
+  if (!strcmp(s, "--json")) r->json_stdout = 1;
+  else if (!strcmp(s, "--quiet")) r->quiet = 1;
+  else if (!strcmp(s, "--vtu") || !strcmp(s, "--json-file") || !strcmp(s, "--vtu-every")) {
+    if (!has) return -1;
+    const char *v = argv[++*i];
+    if (!strcmp(s, "--vtu")) r->vtu_dir = v;
+    else if (!strcmp(s, "--json-file")) r->json_path = v;
+    else {
+      char *end = NULL;
+      r->vtu_every = strtod(v, &end);
+      r->vtu_every_set = 1;
+      if (end == v || *end || !(r->vtu_every >= 0)) return -1;
+    }
+  } else return 0;
+  return 1;
+}
+
+void fc_run_usage(FILE *f) {
+  fprintf(f, "  --out DIR       data, plots and the JSON summary (default <example>_out)\n"
+             "  --vtu DIR       write a VTU series for ParaView into DIR (default: none)\n"
+             "  --vtu-every T   its interval (without --vtu: into the --out directory; 0 = none)\n"
+             "  --json-file F   the JSON summary (default DIR/<example>.json of --out)\n"
+             "  --json          print the JSON summary on stdout as well\n"
+             "  --no-plot       do not run gnuplot\n"
+             "  --quiet         no progress bar (it is drawn only on a terminal)\n");
+}
+
+const char *fc_run_vtu_dir(const fc_run_t *r) {
+  if (!(r->vtu_every > 0)) return NULL;
+  if (r->vtu_dir) return r->vtu_dir;
+  return r->vtu_every_set ? r->out : NULL;
+}
+
+static int make_dir(const char *name, const char *dir) {
+  if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+    fprintf(stderr, "mfree_%s: error: cannot create %s: %s\n", name, dir, strerror(errno));
+    return 1;
+  }
+  if (access(dir, W_OK) != 0) {
+    fprintf(stderr, "mfree_%s: error: cannot write in %s\n", name, dir);
+    return 1;
+  }
+  return 0;
+}
+
+int fc_run_prepare(fc_run_t *r) {
+  if (make_dir(r->name, r->out)) return 1;
+  const char *v = fc_run_vtu_dir(r);
+  return v ? make_dir(r->name, v) : 0;
+}
+
+/* ---- VTU ---- */
+
 int fc_write_vtu(const char *path, int n, const double *y, const double *vhat, const double *p,
                  const int *tag) {
   FILE *f = fopen(path, "w");
@@ -65,23 +145,217 @@ int fc_write_vtu(const char *path, int n, const double *y, const double *vhat, c
     for (int i = 0; i < n; ++i) fprintf(f, "%d\n", tag[i]);
   }
   fprintf(f, "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-  return fclose(f) != 0;
+  const int bad = ferror(f);
+  return (fclose(f) != 0) || bad;
 }
 
-int fc_snapshot(mfree_system_t *sys, const char *dir, const char *prefix, int index, double t, int n,
-                const double *y, const int *tag, FILE *pvd) {
-  double *vhat = malloc(2 * (size_t)n * sizeof *vhat), *p = malloc((size_t)n * sizeof *p);
+int fc_vtu_open(fc_vtu_t *v, const char *dir, const char *prefix, double every) {
+  memset(v, 0, sizeof *v);
+  if (!dir) return 0;
+  snprintf(v->dir, sizeof v->dir, "%s", dir);
+  snprintf(v->prefix, sizeof v->prefix, "%s", prefix);
+  v->every = every;
+  char path[4096];
+  snprintf(path, sizeof path, "%s/%s.pvd", dir, prefix);
+  v->pvd = fopen(path, "w");
+  if (!v->pvd) {
+    fprintf(stderr, "mfree_%s: error: cannot write %s\n", prefix, path);
+    return 1;
+  }
+  fprintf(v->pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
+  return 0;
+}
+
+int fc_vtu_maybe(fc_vtu_t *v, mfree_system_t *sys, double T, double t, int n, const double *y,
+                 const int *tag) {
+  if (!v->pvd || T < v->next - 1e-9 * (1.0 + fabs(T))) return 0;
+  double *vhat = malloc(2 * (size_t)n * sizeof *vhat + 1), *p = malloc((size_t)n * sizeof *p + 1);
+  char path[4096];
+  snprintf(path, sizeof path, "%s/%s_%04d.vtu", v->dir, v->prefix, v->count);
   int rc = !vhat || !p;
   if (!rc) rc = mfree_system_get_velocity(sys, y, vhat) != MFREE_SUCCESS;
   if (!rc) rc = mfree_system_get_pressure(sys, y, p) != MFREE_SUCCESS;
-  char path[4096];
-  if (!rc) {
-    snprintf(path, sizeof path, "%s/%s_%04d.vtu", dir, prefix, index);
-    rc = fc_write_vtu(path, n, y, vhat, p, tag);
-  }
-  if (!rc && pvd)
-    fprintf(pvd, "<DataSet timestep=\"%.6f\" group=\"\" part=\"0\" file=\"%s_%04d.vtu\"/>\n", t, prefix, index);
+  if (!rc) rc = fc_write_vtu(path, n, y, vhat, p, tag);
   free(vhat);
   free(p);
+  if (rc) {
+    fprintf(stderr, "mfree_%s: error: cannot write %s\n", v->prefix, path);
+    return 1;
+  }
+  fprintf(v->pvd, "<DataSet timestep=\"%.9g\" group=\"\" part=\"0\" file=\"%s_%04d.vtu\"/>\n", t, v->prefix,
+          v->count);
+  ++v->count;
+  while (v->next <= T + 1e-9 * (1.0 + fabs(T))) v->next += v->every;
+  return 0;
+}
+
+int fc_vtu_close(fc_vtu_t *v) {
+  if (!v->pvd) return 0;
+  fprintf(v->pvd, "</Collection>\n</VTKFile>\n");
+  const int bad = ferror(v->pvd);
+  const int rc = (fclose(v->pvd) != 0) || bad;
+  v->pvd = NULL;
+  if (rc) fprintf(stderr, "mfree_%s: error: cannot write %s/%s.pvd\n", v->prefix, v->dir, v->prefix);
   return rc;
+}
+
+/* ---- JSON ---- */
+
+static void json_raw(fc_json_t *j, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static void json_raw(fc_json_t *j, const char *fmt, ...) {
+  if (j->err) return;
+  for (;;) {
+    va_list ap;
+    va_start(ap, fmt);
+    const int k = vsnprintf(j->s ? j->s + j->len : NULL, j->s ? j->cap - j->len : 0, fmt, ap);
+    va_end(ap);
+    if (k < 0) {
+      j->err = 1;
+      return;
+    }
+    if (j->s && j->len + (size_t)k < j->cap) {
+      j->len += (size_t)k;
+      return;
+    }
+    const size_t cap = 2 * (j->cap + (size_t)k + 64);
+    char *s = realloc(j->s, cap);
+    if (!s) {
+      j->err = 1;
+      return;
+    }
+    j->s = s;
+    j->cap = cap;
+  }
+}
+
+static void json_key(fc_json_t *j, const char *key) { json_raw(j, "%s\"%s\":", j->items++ ? "," : "", key); }
+
+static void json_number(fc_json_t *j, double v) {
+  if (isfinite(v)) json_raw(j, "%.10g", v);
+  else json_raw(j, "null");
+}
+
+void fc_json_init(fc_json_t *j) {
+  memset(j, 0, sizeof *j);
+  json_raw(j, "{");
+}
+
+void fc_json_num(fc_json_t *j, const char *key, double v) {
+  json_key(j, key);
+  json_number(j, v);
+}
+
+void fc_json_int(fc_json_t *j, const char *key, long long v) {
+  json_key(j, key);
+  json_raw(j, "%lld", v);
+}
+
+void fc_json_str(fc_json_t *j, const char *key, const char *v) {
+  json_key(j, key);
+  if (!v) {
+    json_raw(j, "null");
+    return;
+  }
+  json_raw(j, "\"");
+  for (const unsigned char *c = (const unsigned char *)v; *c; ++c) {
+    if (*c == '"' || *c == '\\') json_raw(j, "\\%c", *c);
+    else if (*c < 0x20) json_raw(j, "\\u%04x", *c);
+    else json_raw(j, "%c", *c);
+  }
+  json_raw(j, "\"");
+}
+
+void fc_json_table(fc_json_t *j, const char *key, int rows, int width, const double *v) {
+  json_key(j, key);
+  json_raw(j, "[");
+  for (int r = 0; r < rows; ++r) {
+    json_raw(j, "%s%s", r ? "," : "", width > 1 ? "[" : "");
+    for (int c = 0; c < width; ++c) {
+      if (c) json_raw(j, ",");
+      json_number(j, v[(size_t)r * width + c]);
+    }
+    if (width > 1) json_raw(j, "]");
+  }
+  json_raw(j, "]");
+}
+
+int fc_json_finish(fc_json_t *j, const fc_run_t *r) {
+  json_raw(j, "}");
+  char path[4096];
+  if (r->json_path) snprintf(path, sizeof path, "%s", r->json_path);
+  else {
+    char file[128];
+    snprintf(file, sizeof file, "%s.json", r->name);
+    ex_join(path, sizeof path, r->out, file);
+  }
+  int rc = j->err;
+  if (rc) fprintf(stderr, "mfree_%s: error: out of memory for the JSON summary\n", r->name);
+  else {
+    FILE *f = fopen(path, "w");
+    rc = !f;
+    if (f) {
+      fprintf(f, "%s\n", j->s);
+      rc = ferror(f) | (fclose(f) != 0);
+    }
+    if (rc) fprintf(stderr, "mfree_%s: error: cannot write %s\n", r->name, path);
+    if (r->json_stdout) printf("%s\n", j->s);
+  }
+  free(j->s);
+  memset(j, 0, sizeof *j);
+  return rc;
+}
+
+/* ---- errors and series ---- */
+
+int fc_run_error(mfree_context_t *ctx, const fc_run_t *r, mfree_status_t st, const char *unit, double t,
+                 char *msg, size_t size) {
+  msg[0] = '\0';
+  mfree_context_get_last_error(ctx, NULL, msg, size);
+  fprintf(stderr, "mfree_%s: error: the run stopped at %s = %.4g (%s): %s\n", r->name, unit, t,
+          mfree_status_string(st), msg);
+  return 3;
+}
+
+mfree_status_t fc_lumped_masses(mfree_system_t *sys, const double *y, int n, double *lumped) {
+  mfree_matrix_t *M = NULL;
+  mfree_status_t st = mfree_system_assemble_mass(sys, y, 0, &M);
+  const int64_t *rp;
+  const int32_t *ci;
+  const double *mv;
+  if (st == MFREE_SUCCESS) st = mfree_matrix_get_csr(M, &rp, &ci, &mv);
+  if (st == MFREE_SUCCESS)
+    for (int q = 0; q < n; ++q) lumped[q] = mv[rp[2 * n + 2 * q]];
+  mfree_matrix_destroy(&M);
+  return st;
+}
+
+mfree_status_t fc_mass_error(mfree_system_t *sys, const double *y, int n, const double *m, double mass0,
+                             double *err) {
+  double *lumped = malloc((size_t)n * sizeof *lumped + 1);
+  if (!lumped) return MFREE_ERR_ALLOC;
+  const mfree_status_t st = fc_lumped_masses(sys, y, n, lumped);
+  double sum_m = 0.0, sum_l = 0.0;
+  for (int q = 0; q < n; ++q) sum_m += m[q], sum_l += lumped[q];
+  free(lumped);
+  *err = fmax(fabs(sum_m - mass0), fabs(sum_l - mass0)) / mass0;
+  return st;
+}
+
+int fc_series_push(fc_series_t *s, int width, const double *row) {
+  if (s->n + width > s->cap) {
+    const int cap = 2 * (s->n + width) + 64;
+    double *v = realloc(s->v, (size_t)cap * sizeof *v);
+    if (!v) return 1;
+    s->v = v;
+    s->cap = cap;
+  }
+  memcpy(s->v + s->n, row, (size_t)width * sizeof *row);
+  s->n += width;
+  return 0;
+}
+
+void fc_series_free(fc_series_t *s) {
+  free(s->v);
+  memset(s, 0, sizeof *s);
 }

@@ -26,12 +26,14 @@
  * has travelled L1 - D (or at --tend).
  *
  * Output in --out DIR (default gravity_current_out): head.csv and head.png (the head's
- * travel against Rottman & Simpson's speed; gnuplot on PATH, not --no-plot),
- * gravity_current.pvd with VTU snapshots every --vtu-every s (default 0.05, 0 = none;
- * point data "fluid" = 1 or 2).
- * --json: {"status":..,"t":..,"steps":..,"particles":..,"head_speed":..,"reference":0.217,
- * "rel_dev":..,"fit_points":..,"mass_rel_error":..,"wall_seconds":..} (head_speed and
- * rel_dev null when fewer than 3 head positions fell in the window). */
+ * travel against Rottman & Simpson's speed; gnuplot on PATH, not --no-plot), and the JSON
+ * summary gravity_current.json (--json: on stdout too): {"status":..,"error":..,"t":..,
+ * "steps":..,"particles":..,"head_speed":..,"reference":0.217,"rel_dev":..,"fit_points":..,
+ * "fit_window":[lo,hi],"head":[[t,x_head],...],"mass_rel_error":..,"wall_seconds":..}
+ * (head_speed and rel_dev null when fewer than 3 head positions fell in the window). With
+ * --vtu DIR (or --vtu-every T): gravity_current.pvd with VTU snapshots every 0.05 s (point
+ * data "fluid" = 1 or 2). A run that stops on an error says so on stderr and exits with
+ * status 3. */
 #define _XOPEN_SOURCE 700
 #include <math.h>
 #include <stdio.h>
@@ -49,20 +51,25 @@ static const double kG = 9.81, kGamma = 7.0, kD = 0.06, kRho1 = 1000.0, kRho2 = 
 static void usage(FILE *f) {
   fprintf(f, "usage: mfree_gravity_current [--nz N (34)] [--light L1 (0.12 m)] [--tend T (s; default: until\n"
              "       the head has travelled L1 - D, at most 1.5 s)] [--mu MU (0.01)] [--cfl C (0.25)]\n"
-             "       [--out DIR] [--vtu-every T (0.05 s; 0 = none)] [--no-plot] [--quiet] [--json]\n");
+             "       [run options; --vtu-every in s, default 0.05]\n");
+  fc_run_usage(f);
 }
 
 int main(int argc, char **argv) {
-  int nz = 34, json = 0, quiet = 0, plot = 1;
-  double light = 2.0 * kD, t_end = 1.5, mu = 0.01, cfl = 0.25, vtu_dt = 0.05;
-  const char *out = "gravity_current_out";
+  int nz = 34;
+  double light = 2.0 * kD, t_end = 1.5, mu = 0.01, cfl = 0.25;
+  fc_run_t ro;
+  fc_run_init(&ro, "gravity_current", 0.05);
   for (int i = 1; i < argc; ++i) {
     const char *s = argv[i];
     const int has = i + 1 < argc;
-    if (!strcmp(s, "--json")) json = 1;
-    else if (!strcmp(s, "--no-plot")) plot = 0;
-    else if (!strcmp(s, "--quiet")) quiet = 1;
-    else if (!strcmp(s, "--help")) {
+    const int r = fc_run_option(argc, argv, &i, &ro);
+    if (r < 0) {
+      usage(stderr);
+      return 2;
+    }
+    if (r > 0) continue;
+    if (!strcmp(s, "--help")) {
       usage(stdout);
       return 0;
     } else if (!strcmp(s, "--nz") && has) nz = atoi(argv[++i]);
@@ -70,21 +77,17 @@ int main(int argc, char **argv) {
     else if (!strcmp(s, "--tend") && has) t_end = atof(argv[++i]);
     else if (!strcmp(s, "--mu") && has) mu = atof(argv[++i]);
     else if (!strcmp(s, "--cfl") && has) cfl = atof(argv[++i]);
-    else if (!strcmp(s, "--out") && has) out = argv[++i];
-    else if (!strcmp(s, "--vtu-every") && has) vtu_dt = atof(argv[++i]);
     else {
       usage(stderr);
       return 2;
     }
   }
-  if (nz < 4 || !(light >= kD) || !(t_end > 0) || !(mu >= 0) || !(cfl > 0 && cfl <= 1) || !(vtu_dt >= 0)) {
+  if (nz < 4 || !(light >= kD) || !(t_end > 0) || !(mu >= 0) || !(cfl > 0 && cfl <= 1)) {
     usage(stderr);
     return 2;
   }
-  if (mkdir(out, 0777) != 0 && access(out, W_OK) != 0) {
-    fprintf(stderr, "mfree_gravity_current: cannot create or write %s\n", out);
-    return 1;
-  }
+  if (fc_run_prepare(&ro)) return 1;
+  const char *out = ro.out;
   const double d = kD / nz, h = 1.5 * d, off = 0.5 * d, ds = d / 3.0;
   const int n1 = (int)lround(light / d), n2 = nz, nx = n1 + n2, n = nx * nz;
   const double L = nx * d, xlock = n1 * d;
@@ -132,21 +135,17 @@ int main(int argc, char **argv) {
   char path[4096];
   snprintf(path, sizeof path, "%s/head.csv", out);
   FILE *csv = fopen(path, "w");
-  FILE *pvd = NULL;
   if (!csv) return 1;
   fprintf(csv, "t,x_head,travel\n");
-  if (vtu_dt > 0) {
-    snprintf(path, sizeof path, "%s/gravity_current.pvd", out);
-    pvd = fopen(path, "w");
-    if (!pvd) return 1;
-    fprintf(pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
-  }
+  fc_vtu_t vtu;
+  if (fc_vtu_open(&vtu, fc_run_vtu_dir(&ro), "gravity_current", ro.vtu_every)) return 1;
+  fc_series_t head = {NULL, 0, 0};
   const double out_dt = 0.005;
   ex_progress_t prog;
-  ex_progress_init(&prog, quiet || json, 0.0, t_end);
-  double t = 0.0, next_vtu = 0.0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  ex_progress_init(&prog, ro.quiet, 0.0, t_end);
+  double t = 0.0, sx = 0, sy = 0, sxx = 0, sxy = 0;
   int64_t steps = 0;
-  int nvtu = 0, nfit = 0;
+  int nfit = 0;
   mfree_status_t run = MFREE_SUCCESS;
   struct timespec c0, c1;
   clock_gettime(CLOCK_MONOTONIC, &c0);
@@ -164,6 +163,8 @@ int main(int argc, char **argv) {
       if (tag[q] == 2) xh = fmin(xh, y[2 * q] - 0.5 * d);
     const double travel = xlock - xh;
     fprintf(csv, "%.4f,%.6f,%.6f\n", t, xh, travel);
+    const double row[2] = {t, xh};
+    if (fc_series_push(&head, 2, row)) return 1;
     if (travel >= 0.5 * kD && travel <= light - kD) {
       sx += t;
       sy += xh;
@@ -171,22 +172,16 @@ int main(int argc, char **argv) {
       sxy += t * xh;
       ++nfit;
     }
-    if (pvd && t >= next_vtu - 1e-9) {
-      if (fc_snapshot(sys, out, "gravity_current", nvtu++, t, n, y, tag, pvd)) return 1;
-      next_vtu += vtu_dt;
-    }
+    if (fc_vtu_maybe(&vtu, sys, t, t, n, y, tag)) return 1;
     if (travel > light - kD) break; /* past the measuring window */
   }
   clock_gettime(CLOCK_MONOTONIC, &c1);
   const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
   ex_progress_done(&prog, "mfree_gravity_current", t);
   fclose(csv);
-  if (pvd) {
-    fprintf(pvd, "</Collection>\n</VTKFile>\n");
-    fclose(pvd);
-  }
+  if (fc_vtu_close(&vtu)) return 1;
   char msg[1024] = "";
-  if (run != MFREE_SUCCESS) mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  const int exit_status = run == MFREE_SUCCESS ? 0 : fc_run_error(ctx, &ro, run, "t", t, msg, sizeof msg);
   const double speed = nfit >= 3 ? -(nfit * sxy - sx * sy) / (nfit * sxx - sx * sx) : NAN;
   const double ref = 0.4 * sqrt(kG * kD * (kRho2 - kRho1) / kRho1); /* 003 eq 126 */
   double mass1 = 0.0;
@@ -198,7 +193,7 @@ int main(int argc, char **argv) {
   ex_join(gp_path, sizeof gp_path, out, "head.gp");
   ex_join(png_path, sizeof png_path, out, "head.png");
   ex_join(csv_path, sizeof csv_path, out, "head.csv");
-  FILE *gp = plot && ex_plot_path_ok(png_path) ? fopen(gp_path, "w") : NULL;
+  FILE *gp = ro.plot && ex_plot_path_ok(png_path) ? fopen(gp_path, "w") : NULL;
   if (gp) {
     fprintf(gp, "set terminal pngcairo size 800,560\nset output '%s'\nset datafile separator ','\n"
                 "set key top left\nset grid\nset xlabel 't (s)'\nset ylabel 'distance travelled by the head (m)'\n"
@@ -210,26 +205,33 @@ int main(int argc, char **argv) {
               xlock - sy / nfit, ref, sx / nfit, ref);
     fprintf(gp, "\n");
     fclose(gp);
-    ex_plot(gp_path, png_path, csv_path, json ? stderr : stdout);
+    ex_plot(gp_path, png_path, csv_path, ro.json_stdout ? stderr : stdout);
   }
-  if (json) {
-    char sp[32] = "null", dv[32] = "null"; /* JSON has no NaN: null without a fit */
-    if (nfit >= 3) {
-      snprintf(sp, sizeof sp, "%.5f", speed);
-      snprintf(dv, sizeof dv, "%.4f", (speed - ref) / ref);
-    }
-    printf("{\"status\":%d,\"t\":%.5f,\"steps\":%lld,\"particles\":%d,\"head_speed\":%s,\"reference\":%.5f,"
-           "\"rel_dev\":%s,\"fit_points\":%d,\"mass_rel_error\":%.3e,\"wall_seconds\":%.2f}\n",
-           (int)run, t, (long long)steps, n, sp, ref, dv, nfit, merr, wall);
-  }
-  else {
+  fc_json_t js;
+  fc_json_init(&js);
+  fc_json_int(&js, "status", (int)run);
+  fc_json_str(&js, "error", run == MFREE_SUCCESS ? NULL : msg);
+  fc_json_num(&js, "t", t);
+  fc_json_int(&js, "steps", steps);
+  fc_json_int(&js, "particles", n);
+  fc_json_num(&js, "head_speed", nfit >= 3 ? speed : NAN);
+  fc_json_num(&js, "reference", ref);
+  fc_json_num(&js, "rel_dev", nfit >= 3 ? (speed - ref) / ref : NAN);
+  fc_json_int(&js, "fit_points", nfit);
+  const double window[2] = {0.5 * kD, light - kD};
+  fc_json_table(&js, "fit_window", 2, 1, window);
+  fc_json_table(&js, "head", head.n / 2, 2, head.v);
+  fc_json_num(&js, "mass_rel_error", merr);
+  fc_json_num(&js, "cfl", cfl);
+  fc_json_num(&js, "wall_seconds", wall);
+  if (fc_json_finish(&js, &ro)) return 1;
+  if (!ro.json_stdout) {
     printf("gravity current: %d particles, t = %.3f s, %lld steps, %.1f s\n", n, t, (long long)steps, wall);
     printf("head speed %.4f m/s over %d samples; Rottman & Simpson 0.4 (g D drho/rho0)^1/2 = %.4f m/s (%+.1f %%)\n",
            speed, nfit, ref, 100.0 * (speed - ref) / ref);
-    printf("head history: %s/head.csv%s%s%s\n", out, pvd ? "; VTU series: " : "", pvd ? out : "",
-           pvd ? "/gravity_current.pvd" : "");
+    printf("head history: %s/head.csv%s%s%s\n", out, vtu.count ? "; VTU series: " : "", vtu.count ? vtu.dir : "",
+           vtu.count ? "/gravity_current.pvd" : "");
   }
-  if (run != MFREE_SUCCESS) fprintf(stderr, "mfree_gravity_current: stopped at t = %.4f s: %s\n", t, msg);
   mfree_system_destroy(&sys);
   mfree_context_destroy(&ctx);
   fc_walls_free(&w);
@@ -237,5 +239,6 @@ int main(int argc, char **argv) {
   free(m);
   free(rho0);
   free(tag);
-  return run == MFREE_SUCCESS ? 0 : 3;
+  fc_series_free(&head);
+  return exit_status;
 }

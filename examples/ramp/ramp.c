@@ -16,11 +16,12 @@
  * particle crosses a wall (every particle stays above the floor and ramp and inside the
  * side walls), the mass is exact, and the front has run down the ramp.
  *
- * Output in --out DIR (default ramp_out): ramp.pvd and ramp_NNNN.vtu every --vtu-every
- * seconds (default 0.019 s, 0 = none). --json prints {"status":..,"t":..,"steps":..,
- * "particles":..,"mass_rel_error":..,"front_x":..,"min_clearance":..,"wall_seconds":..}:
- * min_clearance is the smallest distance of a particle above the floor/ramp line (m;
- * negative = a particle crossed a wall). */
+ * Output in --out DIR (default ramp_out): the JSON summary ramp.json (--json: on stdout
+ * too) {"status":..,"error":..,"t":..,"steps":..,"particles":..,"mass_rel_error":..,
+ * "front_x":..,"min_clearance":..,"wall_seconds":..}: min_clearance is the smallest
+ * distance of a particle above the floor/ramp line (m; negative = a particle crossed a
+ * wall). With --vtu DIR (or --vtu-every T): ramp.pvd and ramp_NNNN.vtu every 0.019 s. A
+ * run that stops on an error says so on stderr and exits with status 3. */
 #define _XOPEN_SOURCE 700
 #include <math.h>
 #include <stdio.h>
@@ -45,40 +46,41 @@ static double ground(double x) {
 
 static void usage(FILE *f) {
   fprintf(f, "usage: mfree_ramp [--nx N (50)] [--tend T (0.2 s)] [--cfl C (0.5)] [--mu MU (0.5)]\n"
-             "                  [--out DIR (ramp_out)] [--vtu-every T (0.019 s; 0 = none)] [--quiet] [--json]\n");
+             "                  [run options; --vtu-every in s, default 0.019]\n");
+  fc_run_usage(f);
 }
 
 int main(int argc, char **argv) {
-  int nx = 50, json = 0, quiet = 0;
-  double t_end = 0.2, cfl = 0.5, mu = 0.5, vtu_dt = 0.019;
-  const char *out = "ramp_out";
+  int nx = 50;
+  double t_end = 0.2, cfl = 0.5, mu = 0.5;
+  fc_run_t ro;
+  fc_run_init(&ro, "ramp", 0.019);
   for (int i = 1; i < argc; ++i) {
     const char *s = argv[i];
     const int has = i + 1 < argc;
-    if (!strcmp(s, "--json")) json = 1;
-    else if (!strcmp(s, "--quiet")) quiet = 1;
-    else if (!strcmp(s, "--help")) {
+    const int r = fc_run_option(argc, argv, &i, &ro);
+    if (r < 0) {
+      usage(stderr);
+      return 2;
+    }
+    if (r > 0) continue;
+    if (!strcmp(s, "--help")) {
       usage(stdout);
       return 0;
     } else if (!strcmp(s, "--nx") && has) nx = atoi(argv[++i]);
     else if (!strcmp(s, "--tend") && has) t_end = atof(argv[++i]);
     else if (!strcmp(s, "--cfl") && has) cfl = atof(argv[++i]);
     else if (!strcmp(s, "--mu") && has) mu = atof(argv[++i]);
-    else if (!strcmp(s, "--out") && has) out = argv[++i];
-    else if (!strcmp(s, "--vtu-every") && has) vtu_dt = atof(argv[++i]);
     else {
       usage(stderr);
       return 2;
     }
   }
-  if (nx < 2 || !(t_end > 0) || !(cfl > 0 && cfl <= 1) || !(mu >= 0) || !(vtu_dt >= 0)) {
+  if (nx < 2 || !(t_end > 0) || !(cfl > 0 && cfl <= 1) || !(mu >= 0)) {
     usage(stderr);
     return 2;
   }
-  if (vtu_dt > 0 && mkdir(out, 0777) != 0 && access(out, W_OK) != 0) {
-    fprintf(stderr, "mfree_ramp: cannot create or write %s\n", out);
-    return 1;
-  }
+  if (fc_run_prepare(&ro)) return 1;
   const double d = kH / nx, h = 1.5 * d, off = 0.5 * d, ds = d / 3.0;
   const double kappa = 100.0 * kRho0 * 2.0 * kG * kH / kGamma; /* 003 eq 125 */
   const int n = nx * nx;
@@ -122,73 +124,63 @@ int main(int argc, char **argv) {
   double mass0 = 0.0;
   for (int q = 0; q < n; ++q) mass0 += m[q];
 
-  char path[4096];
-  FILE *pvd = NULL;
-  if (vtu_dt > 0) {
-    snprintf(path, sizeof path, "%s/ramp.pvd", out);
-    pvd = fopen(path, "w");
-    if (!pvd) return 1;
-    fprintf(pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
-  }
+  fc_vtu_t vtu;
+  if (fc_vtu_open(&vtu, fc_run_vtu_dir(&ro), "ramp", ro.vtu_every)) return 1;
   ex_progress_t prog;
-  ex_progress_init(&prog, quiet || json, 0.0, t_end);
+  ex_progress_init(&prog, ro.quiet, 0.0, t_end);
   double t = 0.0;
   int64_t steps = 0;
-  int nvtu = 0;
   mfree_status_t run = MFREE_SUCCESS;
   struct timespec c0, c1;
   clock_gettime(CLOCK_MONOTONIC, &c0);
-  if (pvd && fc_snapshot(sys, out, "ramp", nvtu++, t, n, y, NULL, pvd)) return 1;
+  if (fc_vtu_maybe(&vtu, sys, t, t, n, y, NULL)) return 1;
   while (t < t_end && run == MFREE_SUCCESS) {
-    const double target = vtu_dt > 0 ? fmin(t_end, (nvtu)*vtu_dt) : t_end;
+    const double target = vtu.pvd ? fmin(t_end, vtu.next) : t_end;
     int64_t ns = 0;
     run = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, target, cfl, 0.0, ex_progress, &prog, &ns);
     steps += ns;
     ex_progress_steps(&prog, ns);
-    if (pvd && fc_snapshot(sys, out, "ramp", nvtu++, t, n, y, NULL, pvd)) return 1;
+    if (fc_vtu_maybe(&vtu, sys, t, t, n, y, NULL)) return 1;
   }
   clock_gettime(CLOCK_MONOTONIC, &c1);
   const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
   ex_progress_done(&prog, "mfree_ramp", t);
-  if (pvd) {
-    fprintf(pvd, "</Collection>\n</VTKFile>\n");
-    fclose(pvd);
-  }
+  if (fc_vtu_close(&vtu)) return 1;
   char msg[1024] = "";
-  if (run != MFREE_SUCCESS) mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  const int exit_status = run == MFREE_SUCCESS ? 0 : fc_run_error(ctx, &ro, run, "t", t, msg, sizeof msg);
 
-  double front = -1e300, clear = 1e300, mass1 = 0.0, lumped = 0.0;
+  double front = -1e300, clear = 1e300;
   for (int q = 0; q < n; ++q) {
     front = fmax(front, y[2 * q]);
     clear = fmin(clear, y[2 * q + 1] - ground(y[2 * q]));
     clear = fmin(clear, y[2 * q]);          /* left wall */
     clear = fmin(clear, kEnd - y[2 * q]);   /* end wall */
-    mass1 += m[q];
   }
-  mfree_matrix_t *M = NULL;
-  CHECK(mfree_system_assemble_mass(sys, y, 0, &M));
-  const int64_t *rp;
-  const int32_t *ci;
-  const double *mv;
-  CHECK(mfree_matrix_get_csr(M, &rp, &ci, &mv));
-  for (int q = 0; q < n; ++q) lumped += mv[rp[2 * n + 2 * q]];
-  mfree_matrix_destroy(&M);
-  const double merr = fmax(fabs(mass1 - mass0), fabs(lumped - mass0)) / mass0;
-  if (json)
-    printf("{\"status\":%d,\"t\":%.6f,\"steps\":%lld,\"particles\":%d,\"mass_rel_error\":%.3e,\"front_x\":%.5f,"
-           "\"min_clearance\":%.3e,\"wall_seconds\":%.2f}\n",
-           (int)run, t, (long long)steps, n, merr, front, clear, wall);
-  else {
+  double merr = 0.0;
+  CHECK(fc_mass_error(sys, y, n, m, mass0, &merr));
+  fc_json_t js;
+  fc_json_init(&js);
+  fc_json_int(&js, "status", (int)run);
+  fc_json_str(&js, "error", run == MFREE_SUCCESS ? NULL : msg);
+  fc_json_num(&js, "t", t);
+  fc_json_int(&js, "steps", steps);
+  fc_json_int(&js, "particles", n);
+  fc_json_num(&js, "mass_rel_error", merr);
+  fc_json_num(&js, "front_x", front);
+  fc_json_num(&js, "min_clearance", clear);
+  fc_json_num(&js, "cfl", cfl);
+  fc_json_num(&js, "wall_seconds", wall);
+  if (fc_json_finish(&js, &ro)) return 1;
+  if (!ro.json_stdout) {
     printf("ramp: %d particles, t = %.4f s, %lld steps, %.1f s\n", n, t, (long long)steps, wall);
     printf("front at x = %.4f m; smallest clearance above floor/ramp/walls %.2e m; mass error %.2e\n", front, clear,
            merr);
-    if (vtu_dt > 0) printf("VTU series: %s/ramp.pvd\n", out);
+    if (vtu.count) printf("VTU series: %s/ramp.pvd\n", vtu.dir);
   }
-  if (run != MFREE_SUCCESS) fprintf(stderr, "mfree_ramp: stopped at t = %.4f s: %s\n", t, msg);
   mfree_system_destroy(&sys);
   mfree_context_destroy(&ctx);
   fc_walls_free(&w);
   free(y);
   free(m);
-  return run == MFREE_SUCCESS ? 0 : 3;
+  return exit_status;
 }
