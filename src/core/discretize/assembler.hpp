@@ -14,6 +14,13 @@
 
 namespace mfree {
 
+// Methods defined at the particles only (their derivatives correct SPH's at the
+// particles; they have no values between them).
+inline bool is_particles_only(int m) {
+  return m == MFREE_METHOD_SPH_SYMMETRIC || m == MFREE_METHOD_JOHNSON_BEISSEL ||
+         m == MFREE_METHOD_RANDLES_LIBERSKY;
+}
+
 class Assembler {
  public:
   Assembler(const ParticleSet *ps, const ApproxConfig &trial, const ApproxConfig &test, bool bubnov,
