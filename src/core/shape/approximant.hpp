@@ -30,6 +30,9 @@ inline double pair_support(int convention, double hs, double hj) {
   }
 }
 
+// The method's name in messages ("MLS", "Randles-Libersky", ...).
+const char *method_name(int method);
+
 // Everything that defines an approximant apart from its particle set and sites; the
 // assembler clones it onto its own quadrature points.
 struct ApproxConfig {
@@ -196,7 +199,7 @@ class Approximant {
   };
   HVec<SiteScratch> scratch_;
   // AoS copies: particles (dim coordinates, volume, support; in 3D the supports after
-  // 32-byte records x y z vol, see record_length in approximant.cpp) and host points
+  // 32-byte records x y z vol, see record_length in approximant_pack.hpp) and host points
   // (dim coordinates, support)
   HVec<double> pack_, spack_;
   HVec<int32_t> pbad_;  // find_bad_particles
