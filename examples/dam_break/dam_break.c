@@ -72,39 +72,27 @@ static void usage(FILE *f) {
   fc_run_usage(f);
 }
 
+/* Returns 0 to go on, -1 after --help, 2 for bad options. */
 static int parse(int argc, char **argv, options_t *o) {
-  for (int i = 1; i < argc; ++i) {
-    const char *s = argv[i];
-    const int has = i + 1 < argc;
-    const int r = fc_run_option(argc, argv, &i, &o->run);
-    if (r < 0) return 0;
-    if (r > 0) continue;
-    if (!strcmp(s, "--help")) {
-      usage(stdout);
-      exit(0);
-    } else if (!strcmp(s, "--nx") && has) o->nx = atoi(argv[++i]);
-    else if (!strcmp(s, "--a") && has) o->a = atof(argv[++i]);
-    else if (!strcmp(s, "--tank") && has) o->tank = atof(argv[++i]);
-    else if (!strcmp(s, "--tend") && has) o->t_end = atof(argv[++i]);
-    else if (!strcmp(s, "--cfl") && has) o->cfl = atof(argv[++i]);
-    else if (!strcmp(s, "--mu") && has) o->mu = atof(argv[++i]);
-    else if (!strcmp(s, "--strength") && has) o->strength = atof(argv[++i]);
-    else if (!strcmp(s, "--offset") && has) o->offset = atof(argv[++i]);
-    else if (!strcmp(s, "--data") && has) o->data = argv[++i];
-    else if (!strcmp(s, "--scheme") && has) {
-      const char *v = argv[++i];
-      if (!strcmp(v, "leapfrog")) o->scheme = MFREE_INTEGRATOR_LEAPFROG;
-      else if (!strcmp(v, "pc")) o->scheme = MFREE_INTEGRATOR_PREDICTOR_CORRECTOR;
-      else return 0;
-    } else if (!strcmp(s, "--lumping") && has) {
-      const char *v = argv[++i];
-      if (!strcmp(v, "galerkin")) o->lumping = MFREE_LUMP_GALERKIN;
-      else if (!strcmp(v, "physical")) o->lumping = MFREE_LUMP_PHYSICAL;
-      else return 0;
-    } else return 0;
-  }
-  return o->nx >= 2 && o->a > 0 && o->tank > 1 && o->t_end > 0 && o->cfl > 0 && o->cfl <= 1 &&
+  const char *scheme = "leapfrog", *lumping = "galerkin";
+  const fc_option_t opts[] = {{"--nx", 'i', &o->nx},           {"--a", 'd', &o->a},
+                              {"--tank", 'd', &o->tank},       {"--tend", 'd', &o->t_end},
+                              {"--cfl", 'd', &o->cfl},         {"--mu", 'd', &o->mu},
+                              {"--strength", 'd', &o->strength}, {"--offset", 'd', &o->offset},
+                              {"--data", 's', &o->data},       {"--scheme", 's', &scheme},
+                              {"--lumping", 's', &lumping},    {NULL, 0, NULL}};
+  const int parsed = fc_parse(argc, argv, &o->run, opts, usage);
+  if (parsed) return parsed;
+  if (!strcmp(scheme, "leapfrog")) o->scheme = MFREE_INTEGRATOR_LEAPFROG;
+  else if (!strcmp(scheme, "pc")) o->scheme = MFREE_INTEGRATOR_PREDICTOR_CORRECTOR;
+  else o->scheme = -1;
+  if (!strcmp(lumping, "galerkin")) o->lumping = MFREE_LUMP_GALERKIN;
+  else if (!strcmp(lumping, "physical")) o->lumping = MFREE_LUMP_PHYSICAL;
+  else o->lumping = -1;
+  const int ok = o->scheme >= 0 && o->lumping >= 0 && o->nx >= 2 && o->a > 0 && o->tank > 1 && o->t_end > 0 && o->cfl > 0 && o->cfl <= 1 &&
          o->mu >= 0 && o->strength >= 0 && o->offset >= 0;
+  if (!ok) usage(stderr);
+  return ok ? 0 : 2;
 }
 
 /* Martin & Moyce points (T, Z); returns the count, 0 if the file is missing. */
@@ -136,10 +124,8 @@ int main(int argc, char **argv) {
   options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 0.05, 24, MFREE_INTEGRATOR_LEAPFROG,
                  MFREE_LUMP_GALERKIN, MFREE_DATA_DIR "/martin_moyce_1952.csv", {0}};
   fc_run_init(&o.run, "dam_break", 0.25);
-  if (!parse(argc, argv, &o)) {
-    usage(stderr);
-    return 2;
-  }
+  const int parsed = parse(argc, argv, &o);
+  if (parsed) return parsed < 0 ? 0 : parsed;
   if (fc_run_prepare(&o.run)) return 1;
   const char *out_dir = o.run.out;
 
@@ -149,15 +135,8 @@ int main(int argc, char **argv) {
   const double tscale = sqrt(2.0 * kG / a);                   /* T = t sqrt(2 g / a) */
   const int nx = o.nx, nz = 2 * o.nx, n = nx * nz;
   double *y = calloc(5 * (size_t)n, sizeof *y), *m = malloc((size_t)n * sizeof *m);
-  for (int j = 0; j < nz; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const int q = j * nx + i;
-      const double z = (j + 0.5) * d;
-      y[2 * q] = (i + 0.5) * d;
-      y[2 * q + 1] = z;
-      y[4 * n + q] = kRho0 * pow(1.0 + kRho0 * kG * (H - z) / kappa, 1.0 / kGamma); /* 003 eq 65 */
-      m[q] = y[4 * n + q] * d * d;
-    }
+  if (!y || !m) return 1;
+  fc_water_block(y, m, n, 0, 0.0, nx, nz, d, H, kRho0, kappa, kGamma, kG);
   /* walls: floor and both ends, spacing d/3, set back by offset * d, up to 1.5 H */
   const double off = o.offset * d, ws = d / 3.0, top = 1.5 * H;
   const int nb = (int)ceil((L + 2 * off) / ws) + 1, ns = (int)ceil((top + off) / ws);
@@ -181,14 +160,9 @@ int main(int argc, char **argv) {
   mfree_context_t *ctx = NULL;
   if (mfree_context_create(&ctx) != MFREE_SUCCESS) return 1;
   mfree_system_t *sys = NULL;
-  CHECK(mfree_system_create_fluid(ctx, 2, n, &sys));
-  CHECK(mfree_system_set_fluid(sys, &kRho0, 0, kappa, kGamma, o.mu));
-  CHECK(mfree_system_set_masses(sys, m, 1));
-  CHECK(mfree_system_set_smoothing(sys, h));
-  const double g[2] = {0.0, -kG};
-  CHECK(mfree_system_set_gravity(sys, g));
+  const fc_walls_t walls = {nw, nw, wx, wn};
+  CHECK(fc_fluid_create(ctx, n, m, &kRho0, 0, kappa, kGamma, o.mu, h, kG, &walls, o.strength, &sys));
   CHECK(mfree_system_set_lumping(sys, (mfree_lumping_t)o.lumping));
-  CHECK(mfree_system_set_walls(sys, nw, wx, wn, 0.7 * h, o.strength)); /* 003 Sect. 6.2 */
   const double lo[2] = {-off, -off}, hi[2] = {L + off, 10.0 * H}; /* crossing a wall fails */
   CHECK(mfree_system_set_box(sys, lo, hi));
   double mass0 = 0.0;
@@ -221,16 +195,11 @@ int main(int argc, char **argv) {
   mfree_status_t run = MFREE_SUCCESS;
   ex_progress_t prog;
   ex_progress_init(&prog, o.run.quiet, 0.0, o.t_end / tscale);
-  struct timespec c0, c1;
-  clock_gettime(CLOCK_MONOTONIC, &c0);
+  const double clock0 = fc_seconds();
   for (int io = 0; io <= nout; ++io) {
     const double T_target = io * o.out_dt;
     if (io > 0) {
-      int64_t ns_ = 0;
-      run = mfree_system_integrate(sys, (mfree_integrator_t)o.scheme, y, &t, T_target / tscale, o.cfl, 0.0,
-                                   ex_progress, &prog, &ns_);
-      steps += ns_;
-      ex_progress_steps(&prog, ns_);
+      run = fc_integrate(sys, (mfree_integrator_t)o.scheme, y, &t, T_target / tscale, o.cfl, &prog, &steps);
       if (run != MFREE_SUCCESS) break;
     }
     double xmax = -1e300, xfloor = -1e300;
@@ -246,8 +215,7 @@ int main(int argc, char **argv) {
     if (fc_vtu_maybe(&vtu, sys, T, t, n, y, NULL)) return 1;
     if (L - xmax < 2.0 * d) break; /* the front reached the far wall */
   }
-  clock_gettime(CLOCK_MONOTONIC, &c1);
-  const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
+  const double wall = fc_seconds() - clock0;
   ex_progress_done(&prog, "mfree_dam_break", t);
   fclose(csv);
   if (fc_vtu_close(&vtu)) return 1;
@@ -276,25 +244,20 @@ int main(int argc, char **argv) {
   if (ndata && !compared) maxdev = -1.0;
 
   /* ---- plot: the front against the experiment ---- */
-  char gp_path[4096] = "", png_path[4096] = "", csv_path[4096] = "";
-  ex_join(gp_path, sizeof gp_path, out_dir, "front.gp");
-  ex_join(png_path, sizeof png_path, out_dir, "front.png");
-  ex_join(csv_path, sizeof csv_path, out_dir, "front.csv");
-  if (o.run.plot && ex_plot_path_ok(png_path) && ex_plot_path_ok(o.data)) {
-    FILE *gp = fopen(gp_path, "w");
-    if (gp) {
-      fprintf(gp, "set terminal pngcairo size 800,560\nset output '%s'\nset datafile separator ','\n"
-                  "set key top left\nset grid\nset xlabel 'T = t (2g/a)^{1/2}'\nset ylabel 'Z = z/a'\n"
-                  "set title 'Dam break, n^2 = 2: Galerkin SPH (Cueto-Felgueroso et al. 2004) vs Martin and Moyce (1952)'\n"
-                  "set xrange [0:%g]\n"
-                  "plot '%s' using 1:2 with lines lw 2 title 'front, all particles (%d)', "
-                  "'%s' using 1:3 with lines dt 2 title 'front, particles on the floor'",
-              png_path, o.t_end + 0.5, csv_path, n, csv_path);
-      if (ndata) fprintf(gp, ", '%s' using 1:2 with points pt 7 title 'Martin and Moyce (1952), n^2 = 2'", o.data);
-      fprintf(gp, "\n");
-      fclose(gp);
-      ex_plot(gp_path, png_path, csv_path, o.run.json_stdout ? stderr : stdout);
-    }
+  char csv_path[4096];
+  FILE *gp = ex_plot_path_ok(o.data) ? fc_plot_begin(&o.run, "front", 800, 560, "T = t (2g/a)^{1/2}", "Z = z/a",
+                                                     csv_path, sizeof csv_path)
+                                     : NULL;
+  if (gp) {
+    fprintf(gp, "set key top left\n"
+                "set title 'Dam break, n^2 = 2: Galerkin SPH (Cueto-Felgueroso et al. 2004) vs Martin and Moyce (1952)'\n"
+                "set xrange [0:%g]\n"
+                "plot '%s' using 1:2 with lines lw 2 title 'front, all particles (%d)', "
+                "'%s' using 1:3 with lines dt 2 title 'front, particles on the floor'",
+            o.t_end + 0.5, csv_path, n, csv_path);
+    if (ndata) fprintf(gp, ", '%s' using 1:2 with points pt 7 title 'Martin and Moyce (1952), n^2 = 2'", o.data);
+    fprintf(gp, "\n");
+    fc_plot_end(gp, &o.run, "front");
   }
 
   fc_json_t js;

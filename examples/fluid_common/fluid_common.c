@@ -7,9 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
-
-#include "util.h"
 
 int fc_walls_segment(fc_walls_t *w, double x0, double z0, double x1, double z1, double ds, double nx,
                      double nz, int skip_first) {
@@ -34,6 +33,27 @@ int fc_walls_segment(fc_walls_t *w, double x0, double z0, double x1, double z1, 
     ++w->n;
   }
   return 0;
+}
+
+int fc_walls_tank(fc_walls_t *w, double x0, double x1, double top, double off, double ds) {
+  int bad = fc_walls_segment(w, x0 - off, top, x0 - off, -off, ds, 1, 0, 0);
+  bad |= fc_walls_segment(w, x0 - off, -off, x1 + off, -off, ds, 0, 1, 1);
+  bad |= fc_walls_segment(w, x1 + off, -off, x1 + off, top, ds, -1, 0, 1);
+  return bad;
+}
+
+int fc_water_block(double *y, double *m, int n, int q0, double x0, int ni, int nj, double d, double H,
+                   double rho0, double kappa, double gamma, double g) {
+  int q = q0;
+  for (int j = 0; j < nj; ++j)
+    for (int i = 0; i < ni; ++i, ++q) {
+      const double z = (j + 0.5) * d;
+      y[2 * q] = x0 + (i + 0.5) * d;
+      y[2 * q + 1] = z;
+      y[4 * (size_t)n + q] = rho0 * pow(1.0 + rho0 * g * (H - z) / kappa, 1.0 / gamma); /* 003 eq 65 */
+      m[q] = y[4 * (size_t)n + q] * d * d;
+    }
+  return q;
 }
 
 void fc_walls_free(fc_walls_t *w) {
@@ -78,6 +98,45 @@ int fc_run_option(int argc, char **argv, int *i, fc_run_t *r) {
     }
   } else return 0;
   return 1;
+}
+
+static int parse_value(const fc_option_t *o, const char *v) {
+  char *end = NULL;
+  if (o->kind == 's') {
+    *(const char **)o->value = v;
+    return 1;
+  }
+  if (o->kind == 'i') {
+    const long x = strtol(v, &end, 10);
+    if (end == v || *end || x < -2147483647L || x > 2147483647L) return 0;
+    *(int *)o->value = (int)x;
+    return 1;
+  }
+  const double x = strtod(v, &end);
+  if (end == v || *end) return 0;
+  *(double *)o->value = x;
+  return 1;
+}
+
+int fc_parse(int argc, char **argv, fc_run_t *r, const fc_option_t *opts, void (*usage)(FILE *)) {
+  for (int i = 1; i < argc; ++i) {
+    const int k = fc_run_option(argc, argv, &i, r);
+    if (k > 0) continue;
+    if (k == 0 && !strcmp(argv[i], "--help")) {
+      usage(stdout);
+      return -1;
+    }
+    const fc_option_t *o = opts;
+    if (k == 0)
+      while (o->name && strcmp(o->name, argv[i])) ++o;
+    if (k < 0 || !o->name || i + 1 >= argc || !parse_value(o, argv[i + 1])) {
+      fprintf(stderr, "mfree_%s: bad or unknown option %s\n", r->name, argv[i]);
+      usage(stderr);
+      return 2;
+    }
+    ++i;
+  }
+  return 0;
 }
 
 void fc_run_usage(FILE *f) {
@@ -317,6 +376,75 @@ int fc_run_error(mfree_context_t *ctx, const fc_run_t *r, mfree_status_t st, con
   return 3;
 }
 
+mfree_status_t fc_fluid_create(mfree_context_t *ctx, int n, const double *m, const double *rho0, int64_t stride,
+                               double kappa, double gamma, double mu, double h, double g, const fc_walls_t *walls,
+                               double strength, mfree_system_t **sys) {
+  const double gv[2] = {0.0, -g};
+  mfree_status_t st = mfree_system_create_fluid(ctx, 2, n, sys);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_fluid(*sys, rho0, stride, kappa, gamma, mu);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_masses(*sys, m, 1);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_smoothing(*sys, h);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_gravity(*sys, gv);
+  if (st == MFREE_SUCCESS && walls)
+    st = mfree_system_set_walls(*sys, walls->n, walls->x, walls->nrm, 0.7 * h, strength); /* 003 Sect. 6.2 */
+  if (st != MFREE_SUCCESS) mfree_system_destroy(sys);
+  return st;
+}
+
+void fc_json_run(fc_json_t *j, mfree_status_t run, const char *msg, double t, long long steps, int n) {
+  fc_json_int(j, "status", (int)run);
+  fc_json_str(j, "error", run == MFREE_SUCCESS ? NULL : msg);
+  fc_json_num(j, "t", t);
+  fc_json_int(j, "steps", steps);
+  fc_json_int(j, "particles", n);
+}
+
+mfree_status_t fc_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t, double t_end,
+                            double cfl, ex_progress_t *p, int64_t *steps) {
+  int64_t k = 0;
+  const mfree_status_t st = mfree_system_integrate(sys, scheme, y, t, t_end, cfl, 0.0, ex_progress, p, &k);
+  *steps += k;
+  ex_progress_steps(p, k);
+  return st;
+}
+
+double fc_seconds(void) {
+  struct timespec c;
+  clock_gettime(CLOCK_MONOTONIC, &c);
+  return (double)c.tv_sec + 1e-9 * (double)c.tv_nsec;
+}
+
+static void stem_path(char *dst, size_t size, const fc_run_t *r, const char *stem, const char *ext) {
+  char file[256];
+  snprintf(file, sizeof file, "%s.%s", stem, ext);
+  ex_join(dst, size, r->out, file);
+}
+
+FILE *fc_plot_begin(const fc_run_t *r, const char *stem, int width, int height, const char *xlabel,
+                    const char *ylabel, char *csv, size_t size) {
+  char gp[4096], png[4096];
+  stem_path(gp, sizeof gp, r, stem, "gp");
+  stem_path(png, sizeof png, r, stem, "png");
+  stem_path(csv, size, r, stem, "csv");
+  if (!r->plot || !ex_plot_path_ok(png) || !ex_plot_path_ok(csv)) return NULL;
+  FILE *f = fopen(gp, "w");
+  if (f)
+    fprintf(f, "set terminal pngcairo size %d,%d\nset output '%s'\nset datafile separator ','\nset grid\n"
+               "set xlabel '%s'\nset ylabel '%s'\n",
+            width, height, png, xlabel, ylabel);
+  return f;
+}
+
+void fc_plot_end(FILE *f, const fc_run_t *r, const char *stem) {
+  if (!f) return;
+  fclose(f);
+  char gp[4096], png[4096], csv[4096];
+  stem_path(gp, sizeof gp, r, stem, "gp");
+  stem_path(png, sizeof png, r, stem, "png");
+  stem_path(csv, sizeof csv, r, stem, "csv");
+  ex_plot(gp, png, csv, r->json_stdout ? stderr : stdout);
+}
+
 mfree_status_t fc_lumped_masses(mfree_system_t *sys, const double *y, int n, double *lumped) {
   mfree_matrix_t *M = NULL;
   mfree_status_t st = mfree_system_assemble_mass(sys, y, 0, &M);
@@ -340,6 +468,24 @@ mfree_status_t fc_mass_error(mfree_system_t *sys, const double *y, int n, const 
   free(lumped);
   *err = fmax(fabs(sum_m - mass0), fabs(sum_l - mass0)) / mass0;
   return st;
+}
+
+void fc_fit_add(fc_fit_t *f, double x, double y) {
+  f->sx += x;
+  f->sy += y;
+  f->sxx += x * x;
+  f->sxy += x * y;
+  ++f->n;
+}
+
+void fc_fit_line(const fc_fit_t *f, double *slope, double *intercept) {
+  double b = NAN, a = NAN;
+  if (f->n >= 3) {
+    b = (f->n * f->sxy - f->sx * f->sy) / (f->n * f->sxx - f->sx * f->sx);
+    a = (f->sy - b * f->sx) / f->n;
+  }
+  if (slope) *slope = b;
+  if (intercept) *intercept = a;
 }
 
 int fc_series_push(fc_series_t *s, int width, const double *row) {

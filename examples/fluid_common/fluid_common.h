@@ -22,6 +22,8 @@
 
 #include <mfree.h>
 
+#include "util.h"
+
 /* A growing list of 2D wall particles with unit normals. */
 typedef struct {
   int n, cap;
@@ -33,9 +35,29 @@ typedef struct {
  * out of memory. */
 int fc_walls_segment(fc_walls_t *w, double x0, double z0, double x1, double z1, double ds, double nx,
                      double nz, int skip_first);
+/* The walls of a rectangular tank whose fluid fills x0 <= x <= x1 above z = 0: left wall,
+ * floor and right wall set back by off, up to height top, at spacing <= ds. Returns 0, or
+ * 1 when out of memory. */
+int fc_walls_tank(fc_walls_t *w, double x0, double x1, double top, double off, double ds);
 void fc_walls_free(fc_walls_t *w);
 
+/* Particles q0, q0 + 1, ... of a block of water at rest: nj rows of ni particles at the
+ * centres of lattice cells of spacing d, the lower-left cell's corner at (x0, 0), row by
+ * row; densities hydrostatic below a free surface at height H (003 eq 65, Tait with rho0,
+ * kappa, gamma, gravity g), masses rho d^2. y is the state of n particles. Returns the
+ * next index, q0 + ni nj. */
+int fc_water_block(double *y, double *m, int n, int q0, double x0, int ni, int nj, double d, double H,
+                   double rho0, double kappa, double gamma, double g);
+
 /* ---- run options ---- */
+
+/* An example's own option: name, kind 'i' (int), 'd' (double) or 's' (string), and where
+ * its value goes. A list ends with a NULL name. */
+typedef struct {
+  const char *name;
+  char kind;
+  void *value;
+} fc_option_t;
 typedef struct {
   const char *name;      /* the example's short name: file names and messages */
   const char *out;       /* --out */
@@ -51,6 +73,10 @@ void fc_run_init(fc_run_t *r, const char *name, double vtu_every);
 /* 1 when argv[*i] is one of the run options (advancing *i past a value), 0 otherwise;
  * -1 for an option missing its value or with a bad one. */
 int fc_run_option(int argc, char **argv, int *i, fc_run_t *r);
+/* Parse the command line: the run options, the example's own (opts) and --help (usage on
+ * stdout). Returns 0 to go on, -1 after --help (exit with 0), 2 after a bad or unknown
+ * option (usage on stderr; exit with 2). */
+int fc_parse(int argc, char **argv, fc_run_t *r, const fc_option_t *opts, void (*usage)(FILE *));
 /* Usage lines of the run options. */
 void fc_run_usage(FILE *f);
 /* Create the out directory (and the VTU directory). Returns 0, or 1 with a message. */
@@ -110,6 +136,38 @@ int fc_json_finish(fc_json_t *j, const fc_run_t *r);
 int fc_run_error(mfree_context_t *ctx, const fc_run_t *r, mfree_status_t st, const char *unit, double t,
                  char *msg, size_t size);
 
+/* ---- running ---- */
+
+/* A 2D fluid of the paper 003 examples: n particles with masses m, rest densities rho0
+ * (stride 0: one for all), Tait kappa and gamma, viscosity mu, smoothing length h,
+ * gravity g downwards, and, unless walls is NULL, the wall force of 003 Sect. 6.2 at
+ * r0 = 0.7 h with the given strength A. On failure *sys is NULL and the context holds
+ * the message. */
+mfree_status_t fc_fluid_create(mfree_context_t *ctx, int n, const double *m, const double *rho0, int64_t stride,
+                               double kappa, double gamma, double mu, double h, double g, const fc_walls_t *walls,
+                               double strength, mfree_system_t **sys);
+/* The head of every summary: "status", "error" (the message, null without a failure),
+ * "t", "steps", "particles". */
+void fc_json_run(fc_json_t *j, mfree_status_t run, const char *msg, double t, long long steps, int n);
+
+/* mfree_system_integrate to t_end with the progress bar p, adding the steps taken to
+ * *steps. */
+mfree_status_t fc_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t, double t_end,
+                            double cfl, ex_progress_t *p, int64_t *steps);
+/* Seconds of a monotonic clock, for the summaries' wall_seconds. */
+double fc_seconds(void);
+
+/* ---- plots (examples/util's ex_plot runs gnuplot) ---- */
+
+/* Begin the gnuplot script DIR/<stem>.gp that draws DIR/<stem>.png (width x height) from
+ * the CSV DIR/<stem>.csv, whose path goes to csv: terminal, output, separator, grid and
+ * axis labels; the caller adds key, title and plot. NULL when plots are off (--no-plot)
+ * or a path cannot be quoted in the script. */
+FILE *fc_plot_begin(const fc_run_t *r, const char *stem, int width, int height, const char *xlabel,
+                    const char *ylabel, char *csv, size_t size);
+/* Close the script and run gnuplot: "plot: <png>", or why there is no plot. */
+void fc_plot_end(FILE *f, const fc_run_t *r, const char *stem);
+
 /* ---- mass ---- */
 
 /* The Galerkin lumped masses (003 eq 56; the diagonal of the velocity block of
@@ -119,6 +177,15 @@ mfree_status_t fc_lumped_masses(mfree_system_t *sys, const double *y, int n, dou
  * none lost) and |sum of the lumped masses - mass0| (003 eq 57), over mass0. */
 mfree_status_t fc_mass_error(mfree_system_t *sys, const double *y, int n, const double *m, double mass0,
                              double *err);
+
+/* ---- least-squares line y = a + b x through samples added one at a time ---- */
+typedef struct {
+  double sx, sy, sxx, sxy;
+  int n;
+} fc_fit_t;
+void fc_fit_add(fc_fit_t *f, double x, double y);
+/* Slope and intercept (NaN with fewer than 3 samples); either output may be NULL. */
+void fc_fit_line(const fc_fit_t *f, double *slope, double *intercept);
 
 /* A growable array of doubles for measured series. Returns 0, 1 when out of memory. */
 typedef struct {

@@ -60,28 +60,10 @@ int main(int argc, char **argv) {
   double light = 2.0 * kD, t_end = 1.5, mu = 0.01, cfl = 0.25;
   fc_run_t ro;
   fc_run_init(&ro, "gravity_current", 0.05);
-  for (int i = 1; i < argc; ++i) {
-    const char *s = argv[i];
-    const int has = i + 1 < argc;
-    const int r = fc_run_option(argc, argv, &i, &ro);
-    if (r < 0) {
-      usage(stderr);
-      return 2;
-    }
-    if (r > 0) continue;
-    if (!strcmp(s, "--help")) {
-      usage(stdout);
-      return 0;
-    } else if (!strcmp(s, "--nz") && has) nz = atoi(argv[++i]);
-    else if (!strcmp(s, "--light") && has) light = atof(argv[++i]);
-    else if (!strcmp(s, "--tend") && has) t_end = atof(argv[++i]);
-    else if (!strcmp(s, "--mu") && has) mu = atof(argv[++i]);
-    else if (!strcmp(s, "--cfl") && has) cfl = atof(argv[++i]);
-    else {
-      usage(stderr);
-      return 2;
-    }
-  }
+  const fc_option_t opts[] = {{"--nz", 'i', &nz}, {"--light", 'd', &light}, {"--tend", 'd', &t_end},
+                              {"--mu", 'd', &mu}, {"--cfl", 'd', &cfl},     {NULL, 0, NULL}};
+  const int parsed = fc_parse(argc, argv, &ro, opts, usage);
+  if (parsed) return parsed < 0 ? 0 : parsed;
   if (nz < 4 || !(light >= kD) || !(t_end > 0) || !(mu >= 0) || !(cfl > 0 && cfl <= 1)) {
     usage(stderr);
     return 2;
@@ -109,10 +91,7 @@ int main(int argc, char **argv) {
     }
   const double top = 2.0 * kD;
   fc_walls_t w = {0, 0, NULL, NULL};
-  int bad = fc_walls_segment(&w, -off, top, -off, -off, ds, 1, 0, 0);
-  bad |= fc_walls_segment(&w, -off, -off, L + off, -off, ds, 0, 1, 1);
-  bad |= fc_walls_segment(&w, L + off, -off, L + off, top, ds, -1, 0, 1);
-  if (bad) return 1;
+  if (fc_walls_tank(&w, 0.0, L, top, off, ds)) return 1;
 
   mfree_context_t *ctx = NULL;
   if (mfree_context_create(&ctx) != MFREE_SUCCESS) return 1;
@@ -120,13 +99,7 @@ int main(int argc, char **argv) {
   mfree_status_t st;
 #define CHECK(call) \
   if ((st = (call)) != MFREE_SUCCESS) return ex_fail(ctx, "mfree_gravity_current", st, #call)
-  CHECK(mfree_system_create_fluid(ctx, 2, n, &sys));
-  CHECK(mfree_system_set_fluid(sys, rho0, 1, kappa, kGamma, mu));
-  CHECK(mfree_system_set_masses(sys, m, 1));
-  CHECK(mfree_system_set_smoothing(sys, h));
-  const double g[2] = {0.0, -kG};
-  CHECK(mfree_system_set_gravity(sys, g));
-  CHECK(mfree_system_set_walls(sys, w.n, w.x, w.nrm, 0.7 * h, 10.0));
+  CHECK(fc_fluid_create(ctx, n, m, rho0, 1, kappa, kGamma, mu, h, kG, &w, 10.0, &sys));
   const double lo[2] = {-off, -off}, hi[2] = {L + off, 10.0 * kD};
   CHECK(mfree_system_set_box(sys, lo, hi));
   double mass0 = 0.0;
@@ -143,19 +116,14 @@ int main(int argc, char **argv) {
   const double out_dt = 0.005;
   ex_progress_t prog;
   ex_progress_init(&prog, ro.quiet, 0.0, t_end);
-  double t = 0.0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  double t = 0.0;
   int64_t steps = 0;
-  int nfit = 0;
+  fc_fit_t fit = {0, 0, 0, 0, 0};
   mfree_status_t run = MFREE_SUCCESS;
-  struct timespec c0, c1;
-  clock_gettime(CLOCK_MONOTONIC, &c0);
+  const double clock0 = fc_seconds();
   for (int io = 0; t < t_end - 1e-12; ++io) {
     if (io > 0) {
-      int64_t ns = 0;
-      run = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, fmin(t_end, io * out_dt), cfl, 0.0,
-                                   ex_progress, &prog, &ns);
-      steps += ns;
-      ex_progress_steps(&prog, ns);
+      run = fc_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, fmin(t_end, io * out_dt), cfl, &prog, &steps);
       if (run != MFREE_SUCCESS) break;
     }
     double xh = 1e300;
@@ -165,55 +133,42 @@ int main(int argc, char **argv) {
     fprintf(csv, "%.4f,%.6f,%.6f\n", t, xh, travel);
     const double row[2] = {t, xh};
     if (fc_series_push(&head, 2, row)) return 1;
-    if (travel >= 0.5 * kD && travel <= light - kD) {
-      sx += t;
-      sy += xh;
-      sxx += t * t;
-      sxy += t * xh;
-      ++nfit;
-    }
+    if (travel >= 0.5 * kD && travel <= light - kD) fc_fit_add(&fit, t, xh);
     if (fc_vtu_maybe(&vtu, sys, t, t, n, y, tag)) return 1;
     if (travel > light - kD) break; /* past the measuring window */
   }
-  clock_gettime(CLOCK_MONOTONIC, &c1);
-  const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
+  const double wall = fc_seconds() - clock0;
   ex_progress_done(&prog, "mfree_gravity_current", t);
   fclose(csv);
   if (fc_vtu_close(&vtu)) return 1;
   char msg[1024] = "";
   const int exit_status = run == MFREE_SUCCESS ? 0 : fc_run_error(ctx, &ro, run, "t", t, msg, sizeof msg);
-  const double speed = nfit >= 3 ? -(nfit * sxy - sx * sy) / (nfit * sxx - sx * sx) : NAN;
+  const int nfit = fit.n;
+  double speed;
+  fc_fit_line(&fit, &speed, NULL);
+  speed = -speed;
   const double ref = 0.4 * sqrt(kG * kD * (kRho2 - kRho1) / kRho1); /* 003 eq 126 */
-  double mass1 = 0.0;
-  for (int q = 0; q < n; ++q) mass1 += m[q];
-  const double merr = fabs(mass1 - mass0) / mass0;
+  double merr = 0.0;
+  CHECK(fc_mass_error(sys, y, n, m, mass0, &merr));
   /* plot: the distance the head travelled against time, with the Rottman & Simpson speed
    * drawn through the middle of the fitted window */
-  char gp_path[4096], png_path[4096], csv_path[4096];
-  ex_join(gp_path, sizeof gp_path, out, "head.gp");
-  ex_join(png_path, sizeof png_path, out, "head.png");
-  ex_join(csv_path, sizeof csv_path, out, "head.csv");
-  FILE *gp = ro.plot && ex_plot_path_ok(png_path) ? fopen(gp_path, "w") : NULL;
+  char csv_path[4096];
+  FILE *gp = fc_plot_begin(&ro, "head", 800, 560, "t (s)", "distance travelled by the head (m)", csv_path,
+                           sizeof csv_path);
   if (gp) {
-    fprintf(gp, "set terminal pngcairo size 800,560\nset output '%s'\nset datafile separator ','\n"
-                "set key top left\nset grid\nset xlabel 't (s)'\nset ylabel 'distance travelled by the head (m)'\n"
+    fprintf(gp, "set key top left\n"
                 "set title 'Gravity current, %d particles: head against Rottman and Simpson (1983)'\n"
                 "plot '%s' every ::1 using 1:3 with linespoints pt 7 ps 0.5 title 'mfree (Galerkin SPH)'",
-            png_path, n, csv_path);
+            n, csv_path);
     if (nfit >= 3)
       fprintf(gp, ", %.6f + %.6f * (x - %.6f) with lines lw 2 dt 2 title 'v_h = 0.4 (g D drho/rho_0)^{1/2} = %.3f m/s'",
-              xlock - sy / nfit, ref, sx / nfit, ref);
+              xlock - fit.sy / nfit, ref, fit.sx / nfit, ref);
     fprintf(gp, "\n");
-    fclose(gp);
-    ex_plot(gp_path, png_path, csv_path, ro.json_stdout ? stderr : stdout);
+    fc_plot_end(gp, &ro, "head");
   }
   fc_json_t js;
   fc_json_init(&js);
-  fc_json_int(&js, "status", (int)run);
-  fc_json_str(&js, "error", run == MFREE_SUCCESS ? NULL : msg);
-  fc_json_num(&js, "t", t);
-  fc_json_int(&js, "steps", steps);
-  fc_json_int(&js, "particles", n);
+  fc_json_run(&js, run, msg, t, steps, n);
   fc_json_num(&js, "head_speed", nfit >= 3 ? speed : NAN);
   fc_json_num(&js, "reference", ref);
   fc_json_num(&js, "rel_dev", nfit >= 3 ? (speed - ref) / ref : NAN);

@@ -55,27 +55,10 @@ int main(int argc, char **argv) {
   double t_end = 0.2, cfl = 0.5, mu = 0.5;
   fc_run_t ro;
   fc_run_init(&ro, "ramp", 0.019);
-  for (int i = 1; i < argc; ++i) {
-    const char *s = argv[i];
-    const int has = i + 1 < argc;
-    const int r = fc_run_option(argc, argv, &i, &ro);
-    if (r < 0) {
-      usage(stderr);
-      return 2;
-    }
-    if (r > 0) continue;
-    if (!strcmp(s, "--help")) {
-      usage(stdout);
-      return 0;
-    } else if (!strcmp(s, "--nx") && has) nx = atoi(argv[++i]);
-    else if (!strcmp(s, "--tend") && has) t_end = atof(argv[++i]);
-    else if (!strcmp(s, "--cfl") && has) cfl = atof(argv[++i]);
-    else if (!strcmp(s, "--mu") && has) mu = atof(argv[++i]);
-    else {
-      usage(stderr);
-      return 2;
-    }
-  }
+  const fc_option_t opts[] = {
+      {"--nx", 'i', &nx}, {"--tend", 'd', &t_end}, {"--cfl", 'd', &cfl}, {"--mu", 'd', &mu}, {NULL, 0, NULL}};
+  const int parsed = fc_parse(argc, argv, &ro, opts, usage);
+  if (parsed) return parsed < 0 ? 0 : parsed;
   if (nx < 2 || !(t_end > 0) || !(cfl > 0 && cfl <= 1) || !(mu >= 0)) {
     usage(stderr);
     return 2;
@@ -86,15 +69,7 @@ int main(int argc, char **argv) {
   const int n = nx * nx;
   double *y = calloc(5 * (size_t)n, sizeof *y), *m = malloc((size_t)n * sizeof *m);
   if (!y || !m) return 1;
-  for (int j = 0; j < nx; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const int q = j * nx + i;
-      const double z = (j + 0.5) * d;
-      y[2 * q] = (i + 0.5) * d;
-      y[2 * q + 1] = z;
-      y[4 * n + q] = kRho0 * pow(1.0 + kRho0 * kG * (kH - z) / kappa, 1.0 / kGamma); /* 003 eq 65 */
-      m[q] = y[4 * n + q] * d * d;
-    }
+  fc_water_block(y, m, n, 0, 0.0, nx, nx, d, kH, kRho0, kappa, kGamma, kG);
   /* walls, set back by off along their normals: left wall, floor, ramp, lower floor, end wall */
   const double top = 3.0 * kH, nr = sqrt(1.0 + kSlope * kSlope), xr = kH + kDrop / kSlope;
   const double sx = off * kSlope / nr, sz = off / nr; /* ramp offset along -(slope, 1)/nr */
@@ -112,13 +87,7 @@ int main(int argc, char **argv) {
   mfree_status_t st;
 #define CHECK(call) \
   if ((st = (call)) != MFREE_SUCCESS) return ex_fail(ctx, "mfree_ramp", st, #call)
-  CHECK(mfree_system_create_fluid(ctx, 2, n, &sys));
-  CHECK(mfree_system_set_fluid(sys, &kRho0, 0, kappa, kGamma, mu));
-  CHECK(mfree_system_set_masses(sys, m, 1));
-  CHECK(mfree_system_set_smoothing(sys, h));
-  const double g[2] = {0.0, -kG};
-  CHECK(mfree_system_set_gravity(sys, g));
-  CHECK(mfree_system_set_walls(sys, w.n, w.x, w.nrm, 0.7 * h, 10.0)); /* 003 Sect. 6.2 */
+  CHECK(fc_fluid_create(ctx, n, m, &kRho0, 0, kappa, kGamma, mu, h, kG, &w, 10.0, &sys));
   const double lo[2] = {-off, -kDrop - off}, hi[2] = {kEnd + off, 10.0 * kH};
   CHECK(mfree_system_set_box(sys, lo, hi));
   double mass0 = 0.0;
@@ -131,19 +100,14 @@ int main(int argc, char **argv) {
   double t = 0.0;
   int64_t steps = 0;
   mfree_status_t run = MFREE_SUCCESS;
-  struct timespec c0, c1;
-  clock_gettime(CLOCK_MONOTONIC, &c0);
+  const double clock0 = fc_seconds();
   if (fc_vtu_maybe(&vtu, sys, t, t, n, y, NULL)) return 1;
   while (t < t_end && run == MFREE_SUCCESS) {
     const double target = vtu.pvd ? fmin(t_end, vtu.next) : t_end;
-    int64_t ns = 0;
-    run = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, target, cfl, 0.0, ex_progress, &prog, &ns);
-    steps += ns;
-    ex_progress_steps(&prog, ns);
+    run = fc_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, target, cfl, &prog, &steps);
     if (fc_vtu_maybe(&vtu, sys, t, t, n, y, NULL)) return 1;
   }
-  clock_gettime(CLOCK_MONOTONIC, &c1);
-  const double wall = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
+  const double wall = fc_seconds() - clock0;
   ex_progress_done(&prog, "mfree_ramp", t);
   if (fc_vtu_close(&vtu)) return 1;
   char msg[1024] = "";
@@ -160,11 +124,7 @@ int main(int argc, char **argv) {
   CHECK(fc_mass_error(sys, y, n, m, mass0, &merr));
   fc_json_t js;
   fc_json_init(&js);
-  fc_json_int(&js, "status", (int)run);
-  fc_json_str(&js, "error", run == MFREE_SUCCESS ? NULL : msg);
-  fc_json_num(&js, "t", t);
-  fc_json_int(&js, "steps", steps);
-  fc_json_int(&js, "particles", n);
+  fc_json_run(&js, run, msg, t, steps, n);
   fc_json_num(&js, "mass_rel_error", merr);
   fc_json_num(&js, "front_x", front);
   fc_json_num(&js, "min_clearance", clear);
