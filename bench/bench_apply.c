@@ -104,7 +104,10 @@ static void run(int dim, double n_target, int threads, double g1, double gn) {
     }
     /* table (dim doubles per entry) + 32-bit columns + row pointers + input + output */
     const double bytes = (double)nnz * (8.0 * dim + 4.0) + 8.0 * (n + 1) + 8.0 * n * nc + 8.0 * n * nc * dim;
+    char lb[32];
     for (int k = 0; k < 2; ++k) {
+      bench_figure(best[k], "s", "apply %dD %d gradient of %d-vector, %s", dim, n, nc,
+                   k ? bench_threads_label(threads, lb, sizeof lb) : "1 thread");
       const double gbs = bytes / best[k] / 1e9;
       printf("%dD n=%8d threads %-3s grad of %d-vector %9.5f s %10.3g p/s %7.2f GB/s = %5.1f %% of triad", dim, n,
              k ? "all" : "1", nc, best[k], n / best[k], gbs, 100.0 * gbs / (k ? gn : g1));
@@ -131,6 +134,9 @@ int main(int argc, char **argv) {
     printf("STREAM-style triad, 2^24 doubles: 1 thread %.4f s %.2f GB/s; all threads %.4f s %.2f GB/s "
            "(x%.2f: a bandwidth-bound apply cannot gain more from threads)\n",
            t1, g1, tn, gn, t1 / tn);
+    char lb[32];
+    bench_figure(t1, "s", "reference triad before %dD, 1 thread", dim);
+    bench_figure(tn, "s", "reference triad before %dD, %s", dim, bench_threads_label(bench_threads(), lb, sizeof lb));
     run(dim, n, bench_threads(), g1, gn);
   }
   return 0;

@@ -98,6 +98,8 @@ int main(int argc, char **argv) {
     printf("dam break, %d particles, threads %-3s: %8.3f ms per step, %9.3g particle-steps/s, "
            "%.2fx PySPH WCSPH (target >= 2 on 1 thread)\n",
            n, label, 1e3 * ts, n / ts, pysph * n / ts);
+    char lb[32];
+    bench_figure(ts, "s", "dambreak %d step, %s", n, pass == 0 || only == 1 ? "1 thread" : bench_threads_label(threads, lb, sizeof lb));
   }
   return 0;
 }

@@ -19,6 +19,8 @@
 
 #include <mfree_mpi.h>
 
+#include "bench_util.h"
+
 static void ok(mfree_context_t *ctx, mfree_status_t st, const char *what) {
   if (st == MFREE_SUCCESS) return;
   char msg[512] = "";
@@ -122,6 +124,10 @@ int main(int argc, char **argv) {
            "plan %.4f s, rebuild %.4f s\n",
            size, no, t_step / steps, t_comm / steps, 100.0 * t_comm / t_step, t_bare / steps,
            100.0 * t_bare / t_step, bmax / 1e6, ngmax, tpm[0], tpm[1]);
+  if (rank == 0) {
+    bench_figure(t_step / steps, "s", "mpi_weak %d ranks x %d step", size, no);
+    bench_figure(t_comm / steps, "s", "mpi_weak %d ranks x %d exchanges in the step", size, no);
+  }
   mfree_approximant_destroy(&ap);
   mfree_particles_destroy(&ps);
   mfree_halo_destroy(&halo);

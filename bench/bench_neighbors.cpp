@@ -180,7 +180,7 @@ void run(int dim, double n_target) {
   const int m = bench_side(dim, n_target);
   double *x = bench_lattice(dim, m, 0.3, &n);
   const double r = bench_radius(dim), h = 0.5 * r;  // cubic spline: support 2h
-  const int reps = n <= 200000 ? 5 : 3;
+  const int reps = bench_reps(n <= 200000 ? 5 : 3);
   int64_t nnz = 0, nnz_t = 0;
   mfree_particles_t *ps = nullptr;
   double held = 0;
@@ -206,6 +206,12 @@ void run(int dim, double n_target) {
               nnz_t == nnz && nnz_a == nnz && nnz_h == nnz ? "" : "  THREADED OR HOOKED COUNT DIFFERS");
   std::printf("      memory held by the set-up particle set: %.0f bytes per particle (lists %.0f)\n", held,
               4.0 * static_cast<double>(nnz) / n + 8.0);
+  char lb[32];
+  bench_figure(t1, "s", "neighbors %dD %d setup, 1 thread", dim, n);
+  bench_figure(tn, "s", "neighbors %dD %d setup, %s", dim, n, bench_threads_label(bench_threads(), lb, sizeof lb));
+  bench_figure(t1_first, "s", "neighbors %dD %d first setup of a new set, 1 thread", dim, n);
+  bench_figure(t1_again, "s", "neighbors %dD %d first setup after a set was destroyed, 1 thread", dim, n);
+  bench_figure(held, "B/particle", "neighbors %dD %d memory", dim, n);
 #ifdef MFREE_BENCH_HAVE_NANOFLANN
   long long pairs = 0;
   double tk = 1e300, tk_first = 0;
@@ -214,6 +220,7 @@ void run(int dim, double n_target) {
     if (k == 0) tk_first = t;  // its first run in this process at this size
     tk = std::min(tk, t);
   }
+  bench_figure(tk, "s", "reference neighbors %dD %d nanoflann build + search, 1 thread", dim, n);
   std::printf("      nanoflann k-d tree build + radius search %8.4f s %9.3g p/s  pairs %s  "
               "mfree speed-up %.2fx (target >= 3)\n",
               tk, n / tk, pairs == nnz ? "equal" : "DIFFER", tk / t1);

@@ -156,6 +156,10 @@ static void run(int dim, double ntarget, int reps) {
       }
       printf("  %-12s %7d %10.2f %10.2f %8.2f   %6.2f %6.2f %6.2f\n", names[q], shown, 1e3 * best_m,
              1e3 * best_h, best_m / best_h, 1e3 * part[0], 1e3 * part[1], 1e3 * part[2]);
+      char lb[32];
+      const char *tl = t ? bench_threads_label(nthreads[t], lb, sizeof lb) : "1 thread";
+      bench_figure(best_m, "s", "pairs %dD %d %s step, %s", dim, n, names[q], tl);
+      bench_figure(best_h, "s", "reference pairs %dD %d host dwdx loop (with %s), %s", dim, n, names[q], tl);
       fflush(stdout);
       mfree_approximant_destroy(&a);
       mfree_particles_destroy(&ps);

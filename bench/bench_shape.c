@@ -7,7 +7,8 @@
  * order 2 0.65 s; targets 10x faster. The like-for-like rows (2D) build the gradient
  * table only, as Compadre's figure does. Also the bytes per particle held by the set-up
  * approximant, counted through the context's allocator hook.
- * MFREE_BENCH_ALL_METHODS=1 adds every method's one-thread setup relative to SPH.
+ * MFREE_BENCH_ALL_METHODS=1 adds every method's one-thread setup relative to SPH;
+ * MFREE_BENCH_REPS sets the timed repetitions (default 5, 1 above 2e5 particles).
  * Usage: bench_shape [n ...]  (default 100000). */
 #include "bench_util.h"
 
@@ -110,7 +111,7 @@ static void time_method(int dim, int n, const double *x, double h, const method_
   if (m->order) check(ctx, mfree_approximant_set_order(a, m->order), "set_order");
   check(ctx, mfree_approximant_set_derivatives(a, flags), "set_derivatives");
   check(ctx, mfree_approximant_setup(a), "approximant_setup");
-  const int reps = n <= 200000 ? 5 : 1;
+  const int reps = bench_reps(n <= 200000 ? 5 : 1);
   t_setup[0] = t_setup[1] = t_update[0] = t_update[1] = 1e300;
   for (int r = 0; r < 2 * reps; ++r) {
     const int k = r & 1;
@@ -138,6 +139,8 @@ static void run(int dim, double n_target) {
   printf("%-18s %10s %10s %10s %10s %10s %10s %8s %9s\n", "method", "setup s", "p/s", "update s",
          "p/s", "pattern s", "all thr s", "speedup", "B/part");
   double t_mls1 = 0, t_cheap[2] = {0, 0};
+  char lb[32];
+  const char *tl = bench_threads_label(bench_threads(), lb, sizeof lb);
   for (size_t k = 0; k < sizeof kMethods / sizeof kMethods[0]; ++k) {
     const method_t *m = &kMethods[k];
     double tsv[2], tuv[2], bytes;
@@ -148,6 +151,11 @@ static void run(int dim, double n_target) {
     if (m->method == MFREE_METHOD_KB_METHOD1) t_cheap[1] = ts;
     printf("%-18s %10.4f %10.3g %10.4f %10.3g %10.4f %10.4f %8.2f %9.0f\n", m->name, ts, n / ts, tu,
            n / tu, ts - tu, tsn, ts / tsn, bytes);
+    bench_figure(ts, "s", "shape %dD %d %s setup, 1 thread", dim, n, m->name);
+    bench_figure(tu, "s", "shape %dD %d %s update, 1 thread", dim, n, m->name);
+    bench_figure(tsn, "s", "shape %dD %d %s setup, %s", dim, n, m->name, tl);
+    bench_figure(tuv[1], "s", "shape %dD %d %s update, %s", dim, n, m->name, tl);
+    bench_figure(bytes, "B/particle", "shape %dD %d %s memory", dim, n, m->name);
   }
   printf("setup MLS order 1 / Randles-Libersky %.2f, / KB Method 1 %.2f (paper 000 Table IV: >= 2.4)\n",
          t_mls1 / t_cheap[0], t_mls1 / t_cheap[1]);
@@ -161,6 +169,8 @@ static void run(int dim, double n_target) {
       time_method(dim, n, x, h, &kEvery[k], vg, 1, tsv, tuv, &bytes);
       if (k == 0) t_sph = tsv[0];
       printf("%-18s %10.4f %10.4f %9.2f\n", kEvery[k].name, tsv[0], tuv[0], tsv[0] / t_sph);
+      bench_figure(tsv[0], "s", "shape %dD %d every method: %s setup, 1 thread", dim, n, kEvery[k].name);
+      bench_figure(tuv[0], "s", "shape %dD %d every method: %s update, 1 thread", dim, n, kEvery[k].name);
     }
   }
   if (dim == 2) {
@@ -180,6 +190,9 @@ static void run(int dim, double n_target) {
       const double ref = m->compadre * (n / 100489.0);
       printf("%-18s %10.4f %10.4f %10.4f %10.2f %11.1fx %11.1fx\n", m->name, ts, tu, tsn, ts / tsn,
              ref / ts, ref / tu);
+      bench_figure(ts, "s", "shape %dD %d %s gradient only setup, 1 thread", dim, n, m->name);
+      bench_figure(tu, "s", "shape %dD %d %s gradient only update, 1 thread", dim, n, m->name);
+      bench_figure(tsn, "s", "shape %dD %d %s gradient only setup, %s", dim, n, m->name, tl);
     }
   }
   free(x);

@@ -3,7 +3,7 @@
  * for domain-size multipliers d_m = 1.5, 2.5, 3.5 (support radius d_m * dx; cubic
  * spline, so h = d_m dx / 2). The paper reports 3.06, 3.12 and 2.43. Prints particles
  * per second for both and the ratio (one thread; best of 3 setups, each pattern +
- * tables). Usage: bench_table4 [particles-per-side, 300]. */
+ * tables; MFREE_BENCH_REPS changes the 3). Usage: bench_table4 [particles-per-side, 300]. */
 #include "bench_util.h"
 
 #include <mfree.h>
@@ -56,9 +56,11 @@ int main(int argc, char **argv) {
     mfree_particles_set_support(ps, &h, 0, MFREE_COPY);
     mfree_particles_set_volumes(ps, &vol, 0, MFREE_COPY);
     mfree_particles_setup(ps);
-    const double t1 = time_setup(ctx, ps, MFREE_METHOD_KB_METHOD1, 3);
-    const double t2 = time_setup(ctx, ps, MFREE_METHOD_MLS, 3);
+    const double t1 = time_setup(ctx, ps, MFREE_METHOD_KB_METHOD1, bench_reps(3));
+    const double t2 = time_setup(ctx, ps, MFREE_METHOD_MLS, bench_reps(3));
     printf("%5.1f %14.3g %14.3g %10.2f %10.2f\n", dms[k], n / t1, n / t2, t2 / t1, paper[k]);
+    bench_figure(t1, "s", "table4 %d d_m=%.1f KB Method 1 setup, 1 thread", n, dms[k]);
+    bench_figure(t2, "s", "table4 %d d_m=%.1f MLS order 1 setup, 1 thread", n, dms[k]);
     mfree_particles_destroy(&ps);
   }
   mfree_context_destroy(&ctx);

@@ -4,9 +4,11 @@
 #define MFREE_BENCH_UTIL_H
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 /* Wall clock; with MFREE_BENCH_CLOCK=cpu the process CPU time instead, which keeps
@@ -66,6 +68,47 @@ static inline double bench_radius(int dim) {
 static inline int bench_threads(void) {
   const char *s = getenv("MFREE_BENCH_THREADS");
   return s ? atoi(s) : 0;
+}
+
+/* The name of the second thread count in figures: "all threads" (count 0), "N threads",
+ * or "1 thread (second count)", so that it never equals the one-thread figure's. */
+static inline const char *bench_threads_label(int threads, char *buf, size_t len) {
+  if (threads <= 0) return "all threads";
+  if (threads == 1) return "1 thread (second count)";
+  snprintf(buf, len, "%d threads", threads);
+  return buf;
+}
+
+/* Repetitions of a program's timing loop: MFREE_BENCH_REPS overrides the program's
+ * default `def` (fewer for a side-by-side run that repeats whole programs instead). */
+static inline int bench_reps(int def) {
+  const char *s = getenv("MFREE_BENCH_REPS");
+  const int r = s ? atoi(s) : 0;
+  return r > 0 ? r : def;
+}
+
+/* Machine-readable figures: with MFREE_BENCH_FORMAT=tsv each figure is also printed as
+ * one line "name<TAB>value<TAB>unit" among the human lines (which carry no tab), for
+ * scripts/bench-compare.sh. Times are in seconds (unit "s", lower is better), memory in
+ * "B/particle"; the name of a figure of a reference that is not mfree (nanoflann, the
+ * triad, a host loop) starts with "reference ". Names are stable: the script matches the
+ * figures of two builds by them. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static inline void bench_figure(double value, const char *unit, const char *name_fmt, ...) {
+  static int tsv = -1;
+  if (tsv < 0) {
+    const char *s = getenv("MFREE_BENCH_FORMAT");
+    tsv = s && strcmp(s, "tsv") == 0;
+  }
+  if (!tsv) return;
+  char name[256];
+  va_list ap;
+  va_start(ap, name_fmt);
+  vsnprintf(name, sizeof name, name_fmt, ap);
+  va_end(ap);
+  printf("%s\t%.6g\t%s\n", name, value, unit);
 }
 
 #endif
