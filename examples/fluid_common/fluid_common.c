@@ -87,7 +87,7 @@ int fc_run_option(int argc, char **argv, int *i, fc_run_t *r) {
   else if (!strcmp(s, "--quiet")) r->quiet = 1;
   else if (!strcmp(s, "--vtu") || !strcmp(s, "--json-file") || !strcmp(s, "--vtu-every")) {
     if (!has) return -1;
-    const char *v = argv[++*i];
+    const char *v = argv[*i + 1];
     if (!strcmp(s, "--vtu")) r->vtu_dir = v;
     else if (!strcmp(s, "--json-file")) r->json_path = v;
     else {
@@ -96,6 +96,7 @@ int fc_run_option(int argc, char **argv, int *i, fc_run_t *r) {
       r->vtu_every_set = 1;
       if (end == v || *end || !(r->vtu_every >= 0)) return -1;
     }
+    ++*i;
   } else return 0;
   return 1;
 }
@@ -130,7 +131,8 @@ int fc_parse(int argc, char **argv, fc_run_t *r, const fc_option_t *opts, void (
     if (k == 0)
       while (o->name && strcmp(o->name, argv[i])) ++o;
     if (k < 0 || !o->name || i + 1 >= argc || !parse_value(o, argv[i + 1])) {
-      fprintf(stderr, "mfree_%s: bad or unknown option %s\n", r->name, argv[i]);
+      fprintf(stderr, "mfree_%s: error: bad or unknown option %s%s%s\n", r->name, argv[i], i + 1 < argc ? " " : "",
+              i + 1 < argc ? argv[i + 1] : "");
       usage(stderr);
       return 2;
     }
