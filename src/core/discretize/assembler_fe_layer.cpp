@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "core/shape/fe_shape.hpp"
+
 namespace mfree {
 
 void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, int32_t ngu, const int32_t *gu,
@@ -45,17 +47,16 @@ void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, in
   // orientation: positive Jacobian at every corner (counter-clockwise, not degenerate)
   for (int32_t e = 0; e < nelem; ++e) {
     const int32_t *c = &fe.conn[first + static_cast<size_t>(e) * npe];
-    double xmin[2] = {1e300, 1e300}, xmax[2] = {-1e300, -1e300};
+    double xmin[2] = {1e300, 1e300}, xmax[2] = {-1e300, -1e300}, X[4 * 3] = {0};
+    for (int a = 0; a < npe; ++a)
+      for (int d = 0; d < 2; ++d) X[3 * a + d] = ps_->x(c[a], d);
     for (int a = 0; a < npe; ++a) {
-      const int32_t i = c[a], j = c[(a + 1) % npe], k = c[(a + npe - 1) % npe];
-      const double ax = ps_->x(j, 0) - ps_->x(i, 0), ay = ps_->x(j, 1) - ps_->x(i, 1);
-      const double bx = ps_->x(k, 0) - ps_->x(i, 0), by = ps_->x(k, 1) - ps_->x(i, 1);
-      if (!(ax * by - ay * bx > 0.0))
+      if (!(corner_cross(X, npe, a) > 0.0))
         throw Error(MFREE_ERR_INPUT, "layer element " + std::to_string(e) + " of this call" +
                                          " is inverted or degenerate (nodes must run counter-clockwise)");
       for (int d = 0; d < 2; ++d) {
-        xmin[d] = std::min(xmin[d], ps_->x(i, d));
-        xmax[d] = std::max(xmax[d], ps_->x(i, d));
+        xmin[d] = std::min(xmin[d], X[3 * a + d]);
+        xmax[d] = std::max(xmax[d], X[3 * a + d]);
       }
     }
     for (int d = 0; d < 2; ++d) {
@@ -81,66 +82,10 @@ bool Assembler::fe_shape(int32_t e, const double *x, double *N, double *dN) cons
   const int32_t *c = &fe_.conn[static_cast<size_t>(e) * npe];
   if (x[0] < fe_.bmin[2 * e] || x[0] > fe_.bmax[2 * e] || x[1] < fe_.bmin[2 * e + 1] || x[1] > fe_.bmax[2 * e + 1])
     return false;
-  double X[4][2];
+  double X[4 * 3] = {0};
   for (int a = 0; a < npe; ++a)
-    for (int d = 0; d < 2; ++d) X[a][d] = ps_->x(c[a], d);
-  const double tol = 1e-10;
-  if (npe == 3) {
-    const double j00 = X[1][0] - X[0][0], j01 = X[2][0] - X[0][0], j10 = X[1][1] - X[0][1], j11 = X[2][1] - X[0][1];
-    const double det = j00 * j11 - j01 * j10;
-    const double rx = x[0] - X[0][0], ry = x[1] - X[0][1];
-    const double l1 = (j11 * rx - j01 * ry) / det, l2 = (-j10 * rx + j00 * ry) / det;
-    if (l1 < -tol || l2 < -tol || l1 + l2 > 1.0 + tol) return false;
-    N[0] = 1.0 - l1 - l2;
-    N[1] = l1;
-    N[2] = l2;
-    // dl1/dx = (j11, -j01)/det, dl2/dx = (-j10, j00)/det
-    dN[2] = j11 / det;
-    dN[3] = -j01 / det;
-    dN[4] = -j10 / det;
-    dN[5] = j00 / det;
-    dN[0] = -dN[2] - dN[4];
-    dN[1] = -dN[3] - dN[5];
-    return true;
-  }
-  static const double xi[4] = {-1, 1, 1, -1}, eta[4] = {-1, -1, 1, 1};
-  double u = 0.0, v = 0.0, J[2][2] = {{0, 0}, {0, 0}};
-  for (int it = 0; it < 30; ++it) {
-    double f[2] = {-x[0], -x[1]};
-    J[0][0] = J[0][1] = J[1][0] = J[1][1] = 0.0;
-    for (int a = 0; a < 4; ++a) {
-      const double Na = 0.25 * (1 + xi[a] * u) * (1 + eta[a] * v);
-      const double du = 0.25 * xi[a] * (1 + eta[a] * v), dv = 0.25 * eta[a] * (1 + xi[a] * u);
-      for (int d = 0; d < 2; ++d) {
-        f[d] += Na * X[a][d];
-        J[d][0] += du * X[a][d];
-        J[d][1] += dv * X[a][d];
-      }
-    }
-    const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
-    const double su = (J[1][1] * f[0] - J[0][1] * f[1]) / det, sv = (-J[1][0] * f[0] + J[0][0] * f[1]) / det;
-    u -= su;
-    v -= sv;
-    if (std::fabs(su) + std::fabs(sv) < 1e-15) break;
-  }
-  if (std::fabs(u) > 1.0 + tol || std::fabs(v) > 1.0 + tol) return false;
-  J[0][0] = J[0][1] = J[1][0] = J[1][1] = 0.0;
-  double dNu[4], dNv[4];
-  for (int a = 0; a < 4; ++a) {
-    N[a] = 0.25 * (1 + xi[a] * u) * (1 + eta[a] * v);
-    dNu[a] = 0.25 * xi[a] * (1 + eta[a] * v);
-    dNv[a] = 0.25 * eta[a] * (1 + xi[a] * u);
-    for (int d = 0; d < 2; ++d) {
-      J[d][0] += dNu[a] * X[a][d];
-      J[d][1] += dNv[a] * X[a][d];
-    }
-  }
-  const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
-  for (int a = 0; a < 4; ++a) {  // grad N = J^-T (dN/du, dN/dv)
-    dN[2 * a] = (J[1][1] * dNu[a] - J[1][0] * dNv[a]) / det;
-    dN[2 * a + 1] = (-J[0][1] * dNu[a] + J[0][0] * dNv[a]) / det;
-  }
-  return true;
+    for (int d = 0; d < 2; ++d) X[3 * a + d] = ps_->x(c[a], d);
+  return element_shape_at(npe == 3 ? MFREE_ELEMENT_TRI3 : MFREE_ELEMENT_QUAD4, X, x, N, dN);
 }
 
 // Paper 000 eqs 100-105: in the layer, Phi0_I = (1 - r) N_I + r Phi_I with r = 3R^2 - 2R^3,

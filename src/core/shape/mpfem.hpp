@@ -1,21 +1,18 @@
 // Moving particle finite element method (paper 004): finite-element meshes over the
-// particles, general shape functions (eqs 1-3) and the element weights of the moving
-// kernel (eqs 4-13, 21). The approximant itself lives in approximant.cpp's tables;
-// Approximant::compute_mpfem (mpfem.cpp) fills them.
+// particles and their geometry at the current positions (mpfem_mesh.cpp), with the
+// general shape functions of eqs 1-3 from the finite-element shape-function module
+// (fe_shape.hpp). The element weights of the moving kernel (eqs 4-13, 21) are in
+// mpfem_weights.*; Approximant::compute_mpfem (mpfem.cpp) fills the approximant's tables.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "core/base/error.hpp"
-#include "core/base/kernel.hpp"
 #include "core/particles/particles.hpp"
+#include "core/shape/fe_shape.hpp"
 
 namespace mfree {
-
-// Dimension and node count of an mfree_element_t (0 for an unknown type).
-int element_dim(int type);
-int element_nodes(int type);
 
 // Element connectivity over the particles of a set, in blocks of one element type,
 // copied or borrowed.
@@ -48,7 +45,7 @@ class Mesh {
 // of its general shape functions, the element interpolant in physical coordinates
 // extended over the whole domain (004 eqs 1-2).
 struct MeshGeometry {
-  static constexpr int kMaxNodes = 8;
+  static constexpr int kMaxNodes = kMaxElementNodes;
   int dim = 1;
   std::vector<int32_t> type, ptr, nodes;
   std::vector<double> rel;            // 3 per node entry, relative to the element's first node
@@ -69,30 +66,6 @@ struct MeshGeometry {
   // Gauss points (absolute coordinates of the first node plus relative ones).
   void quadrature(const ParticleSet &ps, int ngauss, std::vector<double> &x,
                   std::vector<double> &w) const;
-};
-
-// The 1D profile g(t) = W1(|t|, h) of a kernel, its derivative and its cumulative
-// integral G(t) = int_{-Rh}^t g, so that the tensor kernel prod_c g(t_c) has unit
-// integral. Closed forms for the MPFEM kernels, panel Gauss sums for the others.
-class KernelProfile {
- public:
-  KernelProfile(int kernel, double param);
-  double radius() const { return R_; }
-  void g(double t, double h, double &v, double &dv) const;
-  double G(double t, double h) const;
-  // Knots in units of h where g or g' may jump (the support edges, 0, spline knots).
-  const std::vector<double> &knots() const { return knots_; }
-  bool continuous() const { return id_ != MFREE_KERNEL_HAAR; }
-  // The cosine kernel g = (k/2) cos(k t), k = pi / (2 R h): edge integrals of products of
-  // g, G and g' are sums of sines and cosines of linear functions, integrated exactly.
-  bool cosine() const { return id_ == MFREE_KERNEL_COSINE; }
-
- private:
-  double Gq(double q) const;  // cumulative in units of h
-  int id_;
-  Kernel k_;
-  double R_;
-  std::vector<double> knots_, cum_, xg_, wg_;
 };
 
 }  // namespace mfree
