@@ -133,6 +133,11 @@ void Approximant::set_fallback(int policy) {
   fallback_ = policy;
 }
 
+void Approximant::set_shepard_condition(double max_cond) {
+  if (!(max_cond >= 1.0)) throw Error(MFREE_ERR_ARG, "the Shepard condition threshold must be >= 1");
+  shepard_cond_ = max_cond;
+}
+
 void Approximant::set_points(int32_t npts, const double *x, int layout, int64_t ld,
                              const double *h, int64_t h_stride, int mem) {
   if (particles_only(method_))
@@ -301,7 +306,7 @@ Report Approximant::update() {
 namespace {
 // A 64-bit digest of the rows (order-sensitive; entries mixed independently so that the
 // pass runs at memory speed, in blocks for the threads, combined in block order).
-uint64_t rows_hash(const Csr &g) {
+uint64_t rows_hash(const int64_t *rp, const int32_t *cl, int64_t rows) {
   auto mix = [](uint64_t v) {
     v ^= v >> 33;
     v *= 0xff51afd7ed558ccdULL;
@@ -309,11 +314,8 @@ uint64_t rows_hash(const Csr &g) {
     v *= 0xc4ceb9fe1a85ec53ULL;
     return v ^ (v >> 33);
   };
-  const int64_t rows = static_cast<int64_t>(g.rowptr.size()) - 1;
-  const int nt = std::min(num_threads(g.nnz()), 64);
+  const int nt = std::min(num_threads(rp[rows]), 64);
   uint64_t part[64] = {0};
-  const int64_t *rp = g.rowptr.data();
-  const int32_t *cl = g.cols.data();
   parallel_blocks(rows, nt, [&](int t, int64_t b, int64_t e) {
     uint64_t h = 0;
     for (int64_t i = b; i < e; ++i) {
@@ -327,13 +329,18 @@ uint64_t rows_hash(const Csr &g) {
   for (int t = 0; t < nt; ++t) h = mix(h ^ part[t]);
   return h;
 }
+uint64_t rows_hash(const Csr &g) {
+  return rows_hash(g.rowptr.data(), g.cols.data(), static_cast<int64_t>(g.rowptr.size()) - 1);
+}
 }  // namespace
 
 void Approximant::record_set_state() {
   set_setups_ = ps_->setup_count();
   set_owned_ = ps_->num_owned();
   // points: their pattern comes from their own search, not from the set's rows
-  set_rows_hash_ = points_ ? 0 : rows_hash(ps_->neighbors());
+  // (a pattern that is a copy of the set's rows is their digest's source later: a setup
+  // every step, as a moving-particle code does, then pays for no digest)
+  set_rows_hash_ = points_ || rows_shared_ ? 0 : rows_hash(ps_->neighbors());
 }
 
 void Approximant::check_set_unchanged() {
@@ -346,7 +353,8 @@ void Approximant::check_set_unchanged() {
                                      " owned particles, " + std::to_string(set_owned_) +
                                      " at this approximant's setup (ghost count changed): call "
                                      "mfree_approximant_setup, not update");
-  if (!points_ && rows_hash(ps_->neighbors()) != set_rows_hash_)
+  const uint64_t then = rows_shared_ ? rows_hash(rowptr_.data(), cols_.data(), nsites_) : set_rows_hash_;
+  if (!points_ && rows_hash(ps_->neighbors()) != then)
     throw Error(MFREE_ERR_STATE, "the particle set was set up again with other neighbour lists "
                                  "since this approximant's setup (its pattern would be stale): "
                                  "call mfree_approximant_setup, not update");

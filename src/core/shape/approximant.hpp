@@ -2,6 +2,7 @@
 // set of sites (the owned particles or host points), applied to host fields.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -63,6 +64,12 @@ class Approximant {
   void set_order(int order);
   void set_derivatives(int flags);
   void set_fallback(int policy);
+  // Sites whose local system is worse conditioned than max_cond (condition estimate, as
+  // site_cond reports it) get Shepard functions of the volume-weighted kernel instead,
+  // with order 0 and their condition kept; the default, infinity, never does. (Moving
+  // particles: a site in a thin sheet of particles is not singular, yet its gradients are
+  // no use; paper 003 Sect. 6.)
+  void set_shepard_condition(double max_cond);
   void set_points(int32_t npts, const double *x, int layout, int64_t ld, const double *h,
                   int64_t h_stride, int mem);
   // MPFEM (mpfem.cpp): the mesh, the derivative form and the edge-integral rule.
@@ -167,6 +174,7 @@ class Approximant {
   int order_;
   int flags_ = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT;
   int fallback_ = MFREE_FALLBACK_NONE;
+  double shepard_cond_ = HUGE_VAL;
   std::shared_ptr<const Mesh> mesh_;
   int mpfem_deriv_ = MFREE_MPFEM_DERIV_FULL;
   int mpfem_ngauss_ = 8;
@@ -204,6 +212,8 @@ class Approximant {
   HVec<double> pack_, spack_;
   HVec<int32_t> pbad_;  // find_bad_particles
   uint64_t set_rows_hash_ = 0;  // (with set_setups_: record_set_state)
+  bool rows_shared_ = false;    // the pattern is a copy of the set's rows (share_rows)
+  bool any_bad_ = true;         // some particle's data is invalid (find_bad_particles)
   // Correction records (pair-list sets): the sites' (empty when not kept) and the
   // ghosts' (set_ghost_correction; ghost_valid_ false for a record of zeros, a site that
   // failed at its owner, and for all after a setup/update).

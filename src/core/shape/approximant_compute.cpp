@@ -15,6 +15,22 @@
 
 namespace mfree {
 
+namespace {
+// Sites computed before their rows are screened (screen_sites): rows of a few hundred
+// sites stay in the L2 cache
+constexpr int64_t kScreenBlock = 256;
+
+// Whether v[0 .. n) are all finite: one pass without a branch, which vectorises
+bool all_finite(const double *v, int64_t n) {
+  int ok = 1;
+#ifdef _OPENMP
+#pragma omp simd reduction(& : ok)
+#endif
+  for (int64_t k = 0; k < n; ++k) ok &= std::fabs(v[k]) <= DBL_MAX;
+  return ok != 0;
+}
+}  // namespace
+
 Report Approximant::compute(const char *what) {
   (void)what;
   const int dim = ps_->dim(), nh = hessian_size(dim);
@@ -98,13 +114,15 @@ Report Approximant::compute(const char *what) {
   fs.pst = points_ ? nullptr : pst.data();
   fs.order_used = has_order(method_) ? order_ : fixed_order(method_);
   std::atomic<int64_t> nfailed{0};
-  parallel_blocks(nsites_, nt, [&](int t, int64_t b, int64_t e) {
+  // the sites of a block, then their screening while their rows are still in cache
+  auto sites = [&](int t, int64_t b, int64_t e) {
     SiteScratch &w = scratch_[t];
     LocalConfig cfg = base;
     if (fast.ok()) fast.run(ft, b, e, w.fast, fs);
-    int64_t bad = 0;
     for (int32_t s = static_cast<int32_t>(b); s < e; ++s) {
-      if (fast.ok() && status_[s] != kFastPending) continue;
+      // a site done by the fast path goes on only when ill-conditioned (set_shepard_condition)
+      const bool fast_done = fast.ok() && status_[s] != kFastPending;
+      if (fast_done && !(status_[s] == 0 && cond_[s] > shepard_cond_)) continue;
       const int32_t me = site_particle(s);
       if (me >= 0 && pst[me] != 0) {
         status_[s] = pst[me];
@@ -131,7 +149,12 @@ Report Approximant::compute(const char *what) {
       out.coef = recs ? records_.data() + int64_t{s} * ncoef : nullptr;
       cfg.method = method_;
       cfg.order = order_;
-      compute_site(cfg, in, w.work, out);
+      if (fast_done) {  // the fast path's result stands but for the rows
+        out.status = 0;
+        out.cond = cond_[s];
+      } else {
+        compute_site(cfg, in, w.work, out);
+      }
       if (out.status && fallback_ == MFREE_FALLBACK_LOWER_ORDER) {
         const int first_status = out.status;
         const double first_cond = out.cond;
@@ -156,12 +179,25 @@ Report Approximant::compute(const char *what) {
           out.cond = first_cond;
         }
       }
+      if (!out.status && out.cond > shepard_cond_) {
+        const double cond = out.cond;
+        if (out.coef) std::fill_n(out.coef, ncoef, 0.0);  // as a fallback's (above)
+        out.coef = nullptr;
+        cfg.method = MFREE_METHOD_SHEPARD;
+        cfg.order = 0;
+        compute_site(cfg, in, w.work, out);
+        out.cond = cond;
+      }
       status_[s] = out.status;
       support_[s] = out.support;
       cond_[s] = out.cond;
       order_used_[s] = out.order_used;
     }
-    bad = screen_sites(b, e);
+    return screen_sites(b, e);
+  };
+  parallel_blocks(nsites_, nt, [&](int t, int64_t b, int64_t e) {
+    int64_t bad = 0;
+    for (int64_t c = b; c < e; c += kScreenBlock) bad += sites(t, c, std::min<int64_t>(e, c + kScreenBlock));
     if (bad) nfailed += bad;
   });
   if (recs) {
@@ -223,9 +259,13 @@ void Approximant::find_bad_particles() {
   const int32_t n = ps_->size();
   pbad_.resize(static_cast<size_t>(n));  // (same size on update: no allocation)
   int32_t *bad = pbad_.data();
-  parallel_blocks(n, num_threads(n), [&](int, int64_t b, int64_t e) {
-    for (int64_t i = b; i < e; ++i) bad[i] = ps_->data_status(static_cast<int32_t>(i));
+  bool any[64] = {};  // per thread (parallel_blocks runs at most 64)
+  parallel_blocks(n, num_threads(n), [&](int t, int64_t b, int64_t e) {
+    int32_t all = 0;
+    for (int64_t i = b; i < e; ++i) all |= bad[i] = ps_->data_status(static_cast<int32_t>(i));
+    any[t] = all != 0;
   });
+  any_bad_ = std::any_of(any, any + 64, [](bool a) { return a; });
 }
 
 int64_t Approximant::screen_sites(int64_t b, int64_t e) {
@@ -245,15 +285,13 @@ int64_t Approximant::screen_sites(int64_t b, int64_t e) {
       if (!cls && !(hs > 0.0)) cls = MFREE_FAIL_INVALID_DATA;
     }
     const int64_t k0 = rowptr_[s], k1 = rowptr_[s + 1];
-    for (int64_t k = k0; k < k1 && !cls; ++k) cls = bad[cols_[k]];
+    if (any_bad_)
+      for (int64_t k = k0; k < k1 && !cls; ++k) cls = bad[cols_[k]];
     if (!cls && status_[s] == 0) {
       bool finite = true;
-      if (!val_.empty())
-        for (int64_t k = k0; k < k1; ++k) finite &= std::fabs(val_[k]) <= DBL_MAX;
-      if (!grad_.empty())
-        for (int64_t k = k0 * dim; k < k1 * dim; ++k) finite &= std::fabs(grad_[k]) <= DBL_MAX;
-      if (!hess_.empty())
-        for (int64_t k = k0 * nh; k < k1 * nh; ++k) finite &= std::fabs(hess_[k]) <= DBL_MAX;
+      if (!val_.empty()) finite &= all_finite(val_.data() + k0, k1 - k0);
+      if (!grad_.empty()) finite &= all_finite(grad_.data() + k0 * dim, (k1 - k0) * dim);
+      if (!hess_.empty()) finite &= all_finite(hess_.data() + k0 * nh, (k1 - k0) * nh);
       if (!finite) cls = MFREE_FAIL_NONFINITE;
     }
     if (cls) {

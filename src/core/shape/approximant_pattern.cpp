@@ -104,9 +104,9 @@ void Approximant::build_pattern() {
   // gather, no periodic axis, lists found by the set's own search), so the filter below
   // would keep every entry (same closed-edge test d^2 <= (R h_s)^2 (1 + kEdgeTol2)) and
   // the pattern is the set's rows: copied, not rebuilt.
-  if (!points_ && !ps_->host_neighbors() && conv == MFREE_SEARCH_GATHER && !any_periodic &&
-      R == ps_->kappa() && share_rows(*src))
-    return;
+  rows_shared_ = !points_ && !ps_->host_neighbors() && conv == MFREE_SEARCH_GATHER && !any_periodic &&
+                 R == ps_->kappa() && share_rows(*src);
+  if (rows_shared_) return;
   // One pass over static blocks of sites (the pattern is the same for any thread count):
   // row s is written at src->rowptr[s] + s (room for every candidate and an appended
   // self), then the rows are moved down to their final offsets.

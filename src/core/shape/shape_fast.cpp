@@ -19,6 +19,7 @@
 #include <type_traits>
 
 #include "core/shape/local.hpp"
+#include "core/shape/shape_fast_mls1.hpp"
 #include "core/base/simd.hpp"
 
 #if MFREE_SIMD_X86
