@@ -23,36 +23,15 @@ namespace mfree {
 
 namespace {
 
-// The cubic spline W(r, h) = c / h^dim f(r / h) and dW/dr as Kernel::eval computes them
-// (same expressions, same results), without its dispatch over kernels: these loops run
-// over every pair at every evaluation.
-struct CubicSpline {
-  double ih, s;  // 1 / h, c / h^dim
-  CubicSpline(int dim, double h) : ih(1.0 / h) {
-    s = Kernel(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0).norm();
-    for (int d = 0; d < dim; ++d) s *= ih;
-  }
+// The nodes' kernel at distance r for the smoothing length h: W and dW/dr.
+struct NodeKernel {
+  Kernel k;
+  double h;
   void eval(double r, double &w, double &dw) const {
-    const double q = r * ih;
-    double f, df;
-    if (q < 1.0) {
-      f = 1.0 - 1.5 * q * q + 0.75 * q * q * q;
-      df = -3.0 * q + 2.25 * q * q;
-    } else if (q < 2.0) {
-      const double t = 2.0 - q;
-      f = 0.25 * t * t * t;
-      df = -0.75 * t * t;
-    } else {
-      f = df = 0.0;
-    }
-    w = s * f;
-    dw = s * ih * df;
+    double d2w;
+    k.eval(r, h, w, dw, d2w);
   }
-  double value(double r) const {
-    double w, dw;
-    eval(r, w, dw);
-    return w;
-  }
+  double value(double r) const { return k.value(r, h); }
 };
 
 }  // namespace
@@ -135,7 +114,7 @@ const double *FluidSystem::node_densities(const double *rho) const {
     dummy_.p[f] = kappa_ * (std::pow(rho[f] / rho0_[f], gamma_) - 1.0);
     dummy_.level[f] = 1;
   }
-  const CubicSpline kern(dim, h_);
+  const NodeKernel kern{Kernel(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0), h_};
   const double fallback_rho0 = rho0_.empty() ? 1000.0 : rho0_[0];
   bool progress = true;
   // pass 2: dummies with fluid neighbours; passes 3, 4 reach 4h into the wall, as deep as
@@ -217,7 +196,7 @@ void FluidSystem::density_diffusion(const double *rho, double *drho) const {
     for (int64_t e = rb(k); e < re(k); ++e)
       for (int c = 0; c < dim; ++c) dummy_.grad_rho[static_cast<size_t>(k) * dim + c] += G_[e * dim + c] * r[cols[e]];
   const double *gr = dummy_.grad_rho.data();
-  const CubicSpline kern(dim, h_);
+  const NodeKernel kern{Kernel(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0), h_};
   for (int32_t i = 0; i < n_; ++i) {
     const double c0 = std::sqrt(gamma_ * kappa_ / rho0_[i]);
     double s = 0.0;
@@ -259,7 +238,7 @@ void FluidSystem::density_diffusion(const double *rho, double *drho) const {
 void FluidSystem::vci_setup() {
   if (!vci_) return;
   const int dim = dim_;
-  const CubicSpline kern(dim, h_);
+  const NodeKernel kern{Kernel(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0), h_};
   dummy_.xi.assign(static_cast<size_t>(n_) * dim, 0.0);
   dummy_.blend.assign(n_, 0.0);
   for (int32_t i = 0; i < n_; ++i) {
@@ -346,7 +325,7 @@ void FluidSystem::set_velocity_smoothing(double beta) {
 void FluidSystem::velocity_smoothing(const double *v, const double *lumped, int stride, double *a) const {
   if (!(vsmooth_ > 0.0)) return;
   const int dim = dim_;
-  const CubicSpline kern(dim, h_);
+  const NodeKernel kern{Kernel(MFREE_KERNEL_CUBIC_SPLINE, dim, 0.0), h_};
   const double *mass = dummy_.n ? dummy_.mass.data() : mass_.data();
   const double *rho0 = dummy_.n ? dummy_.rho0.data() : rho0_.data();
   const double gk = gamma_ * kappa_;
