@@ -9,11 +9,14 @@
 #   - the smoothing kernels' normalisation: the constant c of W = c / h^dim f(q),
 #     computed from the kernel's integral, or written as a number (10/(7 pi), 1/pi,
 #     21/(16 pi), 7/(4 pi), 7/(478 pi), 0.4547..., 0.3183..., M_1_PI);
-#   - the cubic spline written out: its derivative's coefficient 9/4 (2.25; within the
-#     kernels' file other kernels may use the number too);
-#   - the small dense SPD factorisation: Eigen's dense LDLT / LLT, or a function whose
-#     name says spd, ldl(t) or chol(esky) (the sparse SimplicialLDLT of the global
-#     systems is another thing and not counted);
+#   - the cubic spline written out: its coefficients -1.5 and 0.75 on one line (named or
+#     folded into vector constants), 1 - 1.5 q^2 + 0.75 q^3, -3 q + 2.25 q^2, 0.25 t^3,
+#     0.75 t^2 or a vector constant 2.25 (its derivative's 9/4);
+#   - the small dense SPD factorisation: a function defined in src/ whose name says spd,
+#     ldl(t) or chol(esky), unless its body only returns the same function of another
+#     namespace (an out-of-line instance of the one definition). Eigen's factorisations
+#     are Eigen's, not defined here: the reference path uses them as the independent
+#     oracle (and the sparse SimplicialLDLT of the global systems is another thing);
 #   - the minimum reciprocal condition number of the local solves: a constant whose name
 #     holds "rcond" or "min...cond", given a number.
 # The entries of `exceptions` ("<item>|<file from src/>") are tolerated for now: each is
@@ -25,7 +28,7 @@ endif()
 
 set(items normalisation cubic_spline spd threshold)
 set(what_normalisation "the smoothing kernels' normalisation constant")
-set(what_cubic_spline "the cubic spline's formula (its coefficient 2.25)")
+set(what_cubic_spline "the cubic spline's formula")
 set(what_spd "the small SPD factorisation")
 set(what_threshold "the condition threshold of the local solves")
 set(S "[ \t]*")
@@ -39,11 +42,18 @@ set(re_normalisation
   "0\\.4547284"
   "0\\.3183098"
   "M_1_PI")
-set(re_cubic_spline "(^|[^0-9.])2\\.25([^0-9]|$)")
+set(re_cubic_spline
+  "(^|[^0-9.])1\\.5${S}\\*${S}q${S}\\*${S}q${S}\\+${S}0\\.75([^0-9]|$)"
+  "(^|[^0-9.])3(\\.0*)?${S}\\*${S}q${S}\\+${S}2\\.25${S}\\*${S}q"
+  "-${S}1\\.5([^0-9].*[^0-9.]|[^0-9.])0\\.75([^0-9]|$)"
+  "(^|[^0-9.])0\\.75([^0-9].*[^0-9]|[^0-9])-${S}1\\.5([^0-9]|$)"
+  "(^|[^0-9.])0\\.25${S}\\*${S}t${S}\\*${S}t${S}\\*${S}t"
+  "(^|[^0-9.])0\\.75${S}\\*${S}t${S}\\*${S}t"
+  "set1_pd${S}\\(${S}2\\.25${S}\\)")
 set(re_spd
-  "(^|[^A-Za-z0-9_])(Eigen::)?L(D)?LT${S}<"
-  "\\.l(d)?lt${S}\\(${S}\\)"
   "(^|[ \t])[A-Za-z_][A-Za-z0-9_:<>]*[ \t]+[*&]?${S}[a-z0-9_]*(spd|ldlt|ldl|cholesky|chol)[a-z0-9_]*${S}(<[^()]*>)?${S}\\(")
+# a line matching the item's pattern and one of these is not counted
+set(not_spd "Eigen::")
 set(re_threshold
   "[A-Za-z0-9_]*[Rr][Cc][Oo][Nn][Dd][A-Za-z0-9_]*${S}=${S}[0-9]"
   "[Mm][Ii][Nn][A-Za-z0-9_]*[Cc][Oo][Nn][Dd][A-Za-z0-9_]*${S}=${S}[0-9]")
@@ -71,6 +81,7 @@ foreach(f IN LISTS files)
   string(REPLACE "\n" ";" lines "${text}")
   set(n 0)
   set(in_block FALSE)
+  set(forward "")  # a definition by name waiting for its body's first line
   foreach(line IN LISTS lines)
     math(EXPR n "${n} + 1")
     set(code "")
@@ -108,13 +119,43 @@ foreach(f IN LISTS files)
     if(code MATCHES "^[ \t]*$")
       continue()
     endif()
+    string(STRIP "${code}" shown)
+    string(REPLACE "`" ";" shown "${shown}")
+    if(NOT forward STREQUAL "")
+      # the line after a definition by name: a forwarder's body is one return of the
+      # same name from another namespace
+      list(GET forward 0 it)
+      list(GET forward 1 name)
+      list(GET forward 2 at)
+      list(GET forward 3 sig)
+      set(forward "")
+      if(NOT code MATCHES "^[ \t]*return[ \t]+[A-Za-z_0-9:]*::${name}[ \t]*[<(]")
+        math(EXPR count_${it} "${count_${it}} + 1")
+        list(APPEND files_${it} "${f}")
+        string(APPEND hits_${it} "    src/${f}:${at}: ${sig}\n")
+      endif()
+    endif()
     foreach(it IN LISTS items)
       foreach(re IN LISTS re_${it})
         if(code MATCHES "${re}")
+          set(excluded FALSE)
+          foreach(x IN LISTS not_${it})
+            if(code MATCHES "${x}")
+              set(excluded TRUE)
+            endif()
+          endforeach()
+          if(excluded)
+            break()
+          endif()
+          if(it STREQUAL "spd" AND code MATCHES "\\{[ \t]*$")
+            # a definition whose body starts on the next line: decide there
+            string(REGEX MATCH "[a-z0-9_]*(spd|ldlt|ldl|cholesky|chol)[a-z0-9_]*[ \t]*(<[^()]*>)?[ \t]*\\(" name "${code}")
+            string(REGEX REPLACE "[ \t]*(<[^()]*>)?[ \t]*\\($" "" name "${name}")
+            set(forward "${it};${name};${n};${shown}")
+            break()
+          endif()
           math(EXPR count_${it} "${count_${it}} + 1")
           list(APPEND files_${it} "${f}")
-          string(STRIP "${code}" shown)
-          string(REPLACE "`" ";" shown "${shown}")
           string(APPEND hits_${it} "    src/${f}:${n}: ${shown}\n")
           break()
         endif()
