@@ -215,6 +215,11 @@ run_one() {  # side bench log
   esac >"$log" 2>&1 || die "$1: bench_$b failed, see $log"
 }
 runs="$scratch/logs/runs.tsv"  # side, round, name, value, unit
+# CPU seconds (user + system) of all finished children so far: the shell's `times`
+# (run in this shell, not in a subshell, whose count would start at zero)
+child_cpu() { tail -n 1 "$1" | awk '{ s = 0; for (i = 1; i <= 2; ++i) { split($i, a, "m"); s += 60 * a[1] + a[2] } printf("%.0f", s) }'; }
+times >"$scratch/logs/cpu-before"
+t_runs=$(date +%s)
 : >"$runs"
 for ((r = 1; r <= rounds; ++r)); do
   if ((r % 2)); then order="old new"; else order="new old"; fi
@@ -236,12 +241,15 @@ for ((r = 1; r <= rounds; ++r)); do
 done
 
 # --- table ------------------------------------------------------------------------------
+times >"$scratch/logs/cpu-after"
+cpu_runs=$(( $(child_cpu "$scratch/logs/cpu-after") - $(child_cpu "$scratch/logs/cpu-before") ))
 table="$scratch/table.md"
 old_s="$(git -C "$repo" rev-parse --short "$old_c")"
 new_s="$(git -C "$repo" rev-parse --short "$new_c")"
 {
   echo "Side by side: old $old_s, new $new_s (bench/ of $(git -C "$repo" rev-parse --short "$from_c")), $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg),"
-  echo "clock $clock, second thread count $threads, $rounds rounds ($([ "$full" = 1 ] && echo full sizes || echo default sizes)), best of the rounds; $(( $(date +%s) - t_start )) s."
+  echo "clock $clock, second thread count $threads, $rounds rounds ($([ "$full" = 1 ] && echo full sizes || echo default sizes)), best of the rounds;"
+  echo "$(( $(date +%s) - t_start )) s in all, the runs $(( $(date +%s) - t_runs )) s using $cpu_runs s of CPU (on an idle machine the runs take about that, less the threaded passes' overlap)."
   echo
   echo "| figure | old (best) | new (best) | new/old | within |"
   echo "| --- | --- | --- | --- | --- |"
