@@ -115,6 +115,9 @@ repo="$(git rev-parse --show-toplevel 2>/dev/null)" || die "run inside the mfree
 scratch="${scratch:-$repo/build/bench-compare}"
 mkdir -p "$scratch"
 scratch="$(cd "$scratch" && pwd)"
+# one run per scratch directory: a second one would rebuild a library under the first
+exec 9>"$scratch/.lock"
+flock -n 9 || die "another bench-compare is using $scratch (wait, or pass --scratch)"
 
 if [ "$remove" = 1 ]; then
   for side in old new; do
