@@ -89,8 +89,8 @@ static int parse(int argc, char **argv, options_t *o) {
   if (!strcmp(lumping, "galerkin")) o->lumping = MFREE_LUMP_GALERKIN;
   else if (!strcmp(lumping, "physical")) o->lumping = MFREE_LUMP_PHYSICAL;
   else o->lumping = -1;
-  const int ok = o->scheme >= 0 && o->lumping >= 0 && o->nx >= 2 && o->a > 0 && o->tank > 1 && o->t_end > 0 && o->cfl > 0 && o->cfl <= 1 &&
-         o->mu >= 0 && o->strength >= 0 && o->offset >= 0;
+  const int ok = o->scheme >= 0 && o->lumping >= 0 && o->nx >= 2 && o->a > 0 && o->tank > 1 && o->t_end > 0 &&
+                 o->cfl > 0 && o->cfl <= 1 && o->mu >= 0 && o->strength >= 0 && o->offset >= 0;
   if (!ok) usage(stderr);
   return ok ? 0 : 2;
 }

@@ -14,8 +14,10 @@
  * h = 1.5 d, water at rest density, and the divergence-free vortex u = (U sin(pi x/L)
  * cos(pi z/L), -U cos(pi x/L) sin(pi z/L)), U = 0.1 m/s, L = n d. Printed: the largest
  * |v_hat - u| with the solved parameters (round-off) and with v = u (smoothing error),
- * relative to U, and UMFPACK's reciprocal condition estimate. --json prints them as
- * {"particles":..,"rel_error_solved":..,"rel_error_naive":..,"rcond":..}. */
+ * relative to U, and UMFPACK's reciprocal condition estimate, and in the JSON summary
+ * --out DIR/initial_velocity.json (default initial_velocity_out; --json: on stdout too)
+ * {"status":0,"particles":..,"rel_error_solved":..,"rel_error_naive":..,"rcond":..}.
+ * --vtu DIR: the patch with the solved parameters' velocity (one snapshot). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,6 +26,7 @@
 #include <mfree.h>
 #include <mfree_suitesparse.h>
 
+#include "fluid_common.h"
 #include "util.h"
 
 #define CHECK(call) \
@@ -36,20 +39,23 @@ static double mismatch(const double *vhat, const double *u, int n) {
   return e;
 }
 
+static void usage(FILE *f) {
+  fprintf(f, "usage: mfree_initial_velocity [--n N (40, >= 3)] [run options]\n");
+  fc_run_usage(f);
+}
+
 int main(int argc, char **argv) {
-  int m = 40, json = 0;
-  for (int i = 1; i < argc; ++i) {
-    if (!strcmp(argv[i], "--json")) json = 1;
-    else if (!strcmp(argv[i], "--n") && i + 1 < argc) m = atoi(argv[++i]);
-    else {
-      fprintf(stderr, "usage: mfree_initial_velocity [--n N (40)] [--json]\n");
-      return 2;
-    }
-  }
+  int m = 40;
+  fc_run_t ro;
+  fc_run_init(&ro, "initial_velocity", 1.0);
+  const fc_option_t opts[] = {{"--n", 'i', &m}, {NULL, 0, NULL}};
+  const int parsed = fc_parse(argc, argv, &ro, opts, usage);
+  if (parsed) return parsed < 0 ? 0 : parsed;
   if (m < 3) {
-    fprintf(stderr, "usage: mfree_initial_velocity [--n N >= 3] [--json]\n");
+    usage(stderr);
     return 2;
   }
+  if (fc_run_prepare(&ro)) return 1;
   const double d = 1e-3, L = m * d, U = 0.1, pi = 3.14159265358979323846, rho0 = 1000.0;
   const int n = m * m;
   double *y = calloc(5 * (size_t)n, sizeof *y), *u = malloc(2 * (size_t)n * sizeof *u);
@@ -100,10 +106,19 @@ int main(int argc, char **argv) {
   CHECK(mfree_system_get_velocity(sys, y, vhat));
   const double solved = mismatch(vhat, u, n) / U;
 
-  if (json)
-    printf("{\"particles\":%d,\"rel_error_solved\":%.3e,\"rel_error_naive\":%.3e,\"rcond\":%.3e}\n", n, solved,
-           naive, rcond);
-  else {
+  fc_vtu_t vtu;
+  if (fc_vtu_open(&vtu, fc_run_vtu_dir(&ro), "initial_velocity", 1.0) ||
+      fc_vtu_maybe(&vtu, sys, 0.0, 0.0, n, y, NULL) || fc_vtu_close(&vtu))
+    return 1;
+  fc_json_t js;
+  fc_json_init(&js);
+  fc_json_int(&js, "status", 0);
+  fc_json_int(&js, "particles", n);
+  fc_json_num(&js, "rel_error_solved", solved);
+  fc_json_num(&js, "rel_error_naive", naive);
+  fc_json_num(&js, "rcond", rcond);
+  if (fc_json_finish(&js, &ro)) return 1;
+  if (!ro.json_stdout) {
     printf("initial velocity of a %d x %d fluid patch (paper 003 eq 99), UMFPACK rcond %.2e\n", m, m, rcond);
     printf("  max |v_hat - u| / U with v = u:               %.3e (MLS smoothing)\n", naive);
     printf("  max |v_hat - u| / U with S v = u solved:      %.3e\n", solved);
