@@ -30,7 +30,7 @@
  *    wall_impulse_z / pool_weight_impulse), its horizontal part with zero (the side walls
  *    push equally: wall_impulse_x_rel = |x| / |z| part);
  *  - free fall: the drop's centre of mass against z_c(0) - 2 t - g t^2 / 2, relative to
- *    the distance fallen (free_fall_dev; gravity alone is 8.5 % of it at the impact).
+ *    the distance fallen (free_fall_dev; by the impact gravity makes about 9 % of it).
  * The run goes on past the impact to --tend (default 0.08 s; the paper's Fig. 14 is at
  * 0.0396 s).
  *
