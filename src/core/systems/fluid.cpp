@@ -10,6 +10,7 @@
 #include "core/base/parallel.hpp"
 #include "core/base/simd.hpp"
 #include "core/particles/neighbors.hpp"
+#include "core/shape/shape_fast_mls1.hpp"
 
 #ifdef __SSE2__
 #include <emmintrin.h>
@@ -766,212 +767,85 @@ MFREE_TARGET_AVX2 bool FluidSystem::table_rows_avx2(int32_t k0, int32_t k1, cons
 #endif
 
 #if MFREE_SIMD_X86
-#if defined(__GNUC__) || defined(__clang__)
-#define FLUID_INLINE_LAMBDA __attribute__((always_inline))
-#else
-#define FLUID_INLINE_LAMBDA
-#endif
-// (the region's lambdas are compiled for AVX2 + FMA too, which a target attribute on the
-// enclosing function alone would not give them)
-MFREE_AVX2_BEGIN
-namespace {
-
-// sum of the four lanes of each of a, b, c, d: (sum a, sum b, sum c, sum d)
-MFREE_TARGET_AVX2 MFREE_ALWAYS_INLINE __m256d hsum4(__m256d a, __m256d b, __m256d c, __m256d d) {
-  const __m256d ab = _mm256_hadd_pd(a, b), cd = _mm256_hadd_pd(c, d);  // (a01, b01, a23, b23), ...
-  return _mm256_add_pd(_mm256_permute2f128_pd(ab, cd, 0x20), _mm256_permute2f128_pd(ab, cd, 0x31));
+// The columns of kept_candidates<2> alone, four candidates at a time with two 128-bit loads
+// per pair of lanes (cheaper than gathers here), the test r2 < R2 rounded as there (no
+// FMA), the kept columns left-packed into js; returns their count.
+MFREE_TARGET_AVX2 FLUID_NOINLINE int kept_columns2_avx2(const double *xn, int64_t k, const int32_t *cc, int64_t nc,
+                                                       double R2, int32_t *js) {
+  const __m256d xk = _mm256_set1_pd(xn[2 * k]), yk = _mm256_set1_pd(xn[2 * k + 1]), r2v = _mm256_set1_pd(R2);
+  int q = 0;
+  int64_t e = 0;
+  for (; e + 4 <= nc; e += 4) {
+    const int32_t *j = cc + e;
+    const __m128d p0 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[0])), p1 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[1]));
+    const __m128d p2 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[2])), p3 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[3]));
+    const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(p0), p2, 1);  // x0 y0 x2 y2
+    const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(p1), p3, 1);  // x1 y1 x3 y3
+    const __m256d dx = _mm256_sub_pd(_mm256_unpacklo_pd(lo, hi), xk), dy = _mm256_sub_pd(_mm256_unpackhi_pd(lo, hi), yk);
+    __m256d px = _mm256_mul_pd(dx, dx), py = _mm256_mul_pd(dy, dy);
+    __asm__("" : "+x"(px), "+x"(py));  // r2 = d0 d0 + d1 d1, rounded as kept_candidates
+    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(_mm256_add_pd(px, py), r2v, _CMP_LT_OQ));
+    const __m256i pi = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.i[mask]));
+    const __m128i j4 = _mm_loadu_si128(reinterpret_cast<const __m128i *>(j));
+    const __m256i jp = _mm256_permutevar8x32_epi32(_mm256_zextsi128_si256(j4), pi);
+    _mm_storeu_si128(reinterpret_cast<__m128i *>(js + q), _mm256_castsi256_si128(jp));
+    q += __builtin_popcount(static_cast<unsigned>(mask));
+  }
+  for (; e < nc; ++e) {
+    const int32_t j = cc[e];
+    const double *xj = xn + static_cast<size_t>(j) * 2;
+    const double d0 = xj[0] - xn[2 * k], d1 = xj[1] - xn[2 * k + 1];
+    double p0 = d0 * d0, p1 = d1 * d1;
+    __asm__("" : "+x"(p0), "+x"(p1));
+    js[q] = j;
+    q += p0 + p1 < R2;
+  }
+  _mm256_zeroupper();
+  return q;
 }
 
-}  // namespace
-
-// One 2D row k: (A) the candidates four at a time: positions by two 128-bit loads per
-// pair of lanes (cheaper than gathers here), the pair test r2 < 4h^2 rounded as in
-// kept_candidates (no FMA), the kept scaled offsets and columns left-packed (columns
-// straight into cols_); (B) the kept neighbours four at a time: r = |s| (sqrt), the cubic
-// spline f = 1 - 3/2 r^2 + 3/4 r^3 (r < 1), (2 - r)^3 / 4 (1 <= r < 2) and
-// gf = -f'(r) / r = 3 - 9/4 r, 3/4 (2 - r)^2 / r in Horner form with a blend (the same
-// functions as table_rows_body's B-spline pieces, rounded differently), and the 15 moment
-// sums in registers (6 with the weights, 9 in a second loop); (C) the 3x3 moment matrix inverted by its adjugate, positive
-// definiteness by its leading minors (Sylvester; LDL^T's pivots up to rounding), the exact
-// 1-norm condition number as before; (D) the values and gradients four at a time, the
-// gradients interleaved (x, y) by two unpacks and two lane permutes. The last group of a
-// row stores through masks: the next row, or the next chunk (another thread), starts
-// right after it.
-MFREE_TARGET_AVX2 void FluidSystem::table_rows2_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch) {
-  const double ih = 1.0 / h_, tol = shepard_cond_, R2 = 4.0 * h_ * h_;
+// Rows [k0, k1) in chunks: the candidates closer than 2h filtered into the chunk's rows
+// (kept_candidates_avx2), then the approximants' fused linear-MLS rows on them
+// (shape_fast_mls1.hpp); the rows they leave (a moment matrix not positive definite or
+// singular) and those worse conditioned than shepard_cond_ are computed again by
+// table_rows_avx2, which writes their Shepard functions.
+void FluidSystem::table_rows2_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
+                                   FastScratch &fast, int64_t *rp) {
+  const double R2 = 4.0 * h_ * h_;
   const int64_t *crp = cand_.rowptr.data();
   const int32_t *ccols = cand_.cols.data();
   int64_t *rbeg = rb_.data(), *rend = re_.data();
-  const int64_t ms = maxrow_ + 8;  // scratch arrays: sx, sy, w, gf
-  double *sx = scratch, *sy = scratch + ms, *wv = scratch + 2 * ms, *gv = scratch + 3 * ms;
-  const __m256d r2v = _mm256_set1_pd(R2), ihv = _mm256_set1_pd(ih);
-  const __m256i lane = _mm256_setr_epi64x(0, 1, 2, 3), lane2 = _mm256_setr_epi64x(4, 5, 6, 7);
-  const __m128i lane32 = _mm_setr_epi32(0, 1, 2, 3);
-  const __m256d one = _mm256_set1_pd(1.0), two = _mm256_set1_pd(2.0), zero = _mm256_setzero_pd();
-  for (int32_t k = k0; k < k1; ++k) {  // k0 starts a chunk
-    const int64_t c0 = crp[k], nc = crp[k + 1] - c0;
-    const int32_t *cc = ccols + c0;
-    const int64_t o = k % kChunk == 0 ? c0 : rend[k - 1];
-    int32_t *js = cols_.data() + o;
-    double *Nk = N_.data() + o, *Gk = G_.data() + 2 * o;
-    const __m256d xk = _mm256_set1_pd(xn[2 * static_cast<size_t>(k)]), yk = _mm256_set1_pd(xn[2 * static_cast<size_t>(k) + 1]);
-    // (A) filter
-    int q = 0;
-    auto filter4 = [&](const int32_t *j, int lanes) FLUID_INLINE_LAMBDA {
-      const __m128d p0 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[0])), p1 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[1]));
-      const __m128d p2 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[2])), p3 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[3]));
-      const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(p0), p2, 1);  // x0 y0 x2 y2
-      const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(p1), p3, 1);  // x1 y1 x3 y3
-      const __m256d dx = _mm256_sub_pd(_mm256_unpacklo_pd(lo, hi), xk), dy = _mm256_sub_pd(_mm256_unpackhi_pd(lo, hi), yk);
-      __m256d px = _mm256_mul_pd(dx, dx), py = _mm256_mul_pd(dy, dy);
-      __asm__("" : "+x"(px), "+x"(py));  // r2 = d0 d0 + d1 d1, rounded as kept_candidates
-      const __m256d r2 = _mm256_add_pd(px, py);
-      const int mask = _mm256_movemask_pd(_mm256_cmp_pd(r2, r2v, _CMP_LT_OQ)) & lanes;
-      const __m256i pd = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.d[mask]));
-      _mm256_storeu_pd(sx + q, _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(_mm256_mul_pd(dx, ihv)), pd)));
-      _mm256_storeu_pd(sy + q, _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(_mm256_mul_pd(dy, ihv)), pd)));
-      const __m256i pi = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.i[mask]));
-      const __m128i j4 = _mm_loadu_si128(reinterpret_cast<const __m128i *>(j));
-      const __m128i jp = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_castsi128_si256(j4), pi));
-      const int kept = __builtin_popcount(static_cast<unsigned>(mask));
-      if (lanes == 15) _mm_storeu_si128(reinterpret_cast<__m128i *>(js + q), jp);
-      else _mm_maskstore_epi32(js + q, _mm_cmpgt_epi32(_mm_set1_epi32(kept), lane32), jp);
-      q += kept;
-    };
-    int64_t e = 0;
-    for (; e + 4 <= nc; e += 4) filter4(cc + e, 15);
-    if (e < nc) {
-      const int64_t rest = nc - e;  // 1, 2 or 3 (a loop here became a call of memcpy)
-      const int32_t jt[4] = {cc[e], rest > 1 ? cc[e + 1] : k, rest > 2 ? cc[e + 2] : k, k};
-      filter4(jt, (1 << rest) - 1);
+  FastTables ft;
+  ft.rowptr = rp;
+  ft.cols = cols_.data();
+  ft.x[0] = ft.sx[0] = xn;
+  ft.x[1] = ft.sx[1] = xn + 1;
+  ft.stride = ft.sstride = 2;
+  ft.h = ft.sh = &h_;
+  ft.hstride = ft.shstride = 0;
+  ft.val = N_.data();
+  ft.grad = G_.data();
+  FastSites fs;
+  fs.status = site_status_.data();
+  fs.support = site_support_.data();
+  fs.order = site_order_.data();
+  fs.cond = cond_.data();
+  fs.order_used = 1;
+  for (int32_t c0 = k0; c0 < k1; c0 += kChunk) {
+    const int32_t c1 = std::min(k1, c0 + kChunk);
+    for (int32_t k = c0; k < c1; ++k) {
+      const int64_t o = k == c0 ? crp[k] : rend[k - 1];
+      const int n = kept_columns2_avx2(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, cols_.data() + o);
+      rbeg[k] = o;
+      rend[k] = o + n;
+      rp[k] = o;  // the chunk's rows lie one after another
     }
-    const int n = q;
-    rbeg[k] = o;
-    rend[k] = o + n;
-    // (B) weights and moments
-    __m256d a0 = zero, a1 = zero, a2 = zero, a11 = zero, a12 = zero, a22 = zero;
-    __m256d b1 = zero, b2 = zero, b11 = zero, b12 = zero, b22 = zero, b111 = zero, b112 = zero, b122 = zero, b222 = zero;
-    const __m256i nv = _mm256_set1_epi64x(n);
-    _mm256_storeu_pd(sx + n, zero);  // the last group's lanes past n: offsets 0, weights 0 below
-    _mm256_storeu_pd(sy + n, zero);
-    // weights and the 6 sums of M first, then the 9 of M_,c from the stored gf: two short
-    // loops keep their sums in registers (one loop spilled 9 of 15) and let the out-of-order
-    // core overlap the square roots and divisions of successive groups
-    for (int m = 0; m < n; m += 4) {
-      const __m256d valid = _mm256_castsi256_pd(_mm256_cmpgt_epi64(nv, _mm256_add_epi64(lane, _mm256_set1_epi64x(m))));
-      const __m256d x1 = _mm256_loadu_pd(sx + m), x2 = _mm256_loadu_pd(sy + m);
-      const __m256d r2 = _mm256_fmadd_pd(x1, x1, _mm256_mul_pd(x2, x2));
-      const __m256d r = _mm256_sqrt_pd(r2);
-      const __m256d inner = _mm256_cmp_pd(r, one, _CMP_LT_OQ);
-      const __m256d win = _mm256_fmadd_pd(r2, _mm256_fmadd_pd(_mm256_set1_pd(0.75), r, _mm256_set1_pd(-1.5)), one);
-      const __m256d gin = _mm256_fnmadd_pd(_mm256_set1_pd(2.25), r, _mm256_set1_pd(3.0));
-      const __m256d b = _mm256_max_pd(_mm256_sub_pd(two, r), zero), bb = _mm256_mul_pd(b, b);
-      const __m256d wout = _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(0.25), bb), b);
-      const __m256d gout = _mm256_div_pd(_mm256_mul_pd(_mm256_set1_pd(0.75), bb), r);  // r >= 1 where taken
-      const __m256d w = _mm256_and_pd(_mm256_blendv_pd(wout, win, inner), valid);
-      const __m256d g = _mm256_and_pd(_mm256_blendv_pd(gout, gin, inner), valid);
-      _mm256_storeu_pd(wv + m, w);
-      _mm256_storeu_pd(gv + m, g);
-      const __m256d wx = _mm256_mul_pd(w, x1), wy = _mm256_mul_pd(w, x2);
-      a0 = _mm256_add_pd(a0, w);
-      a1 = _mm256_add_pd(a1, wx);
-      a2 = _mm256_add_pd(a2, wy);
-      a11 = _mm256_fmadd_pd(wx, x1, a11);
-      a12 = _mm256_fmadd_pd(wx, x2, a12);
-      a22 = _mm256_fmadd_pd(wy, x2, a22);
-    }
-    for (int m = 0; m < n; m += 4) {
-      const __m256d x1 = _mm256_loadu_pd(sx + m), x2 = _mm256_loadu_pd(sy + m), g = _mm256_loadu_pd(gv + m);
-      const __m256d g1 = _mm256_mul_pd(g, x1);
-      b1 = _mm256_add_pd(b1, g1);
-      const __m256d g11 = _mm256_mul_pd(g1, x1);
-      b11 = _mm256_add_pd(b11, g11);
-      b111 = _mm256_fmadd_pd(g11, x1, b111);
-      b112 = _mm256_fmadd_pd(g11, x2, b112);
-      const __m256d g12 = _mm256_mul_pd(g1, x2);
-      b12 = _mm256_add_pd(b12, g12);
-      b122 = _mm256_fmadd_pd(g12, x2, b122);
-      const __m256d g2 = _mm256_mul_pd(g, x2);
-      b2 = _mm256_add_pd(b2, g2);
-      const __m256d g22 = _mm256_mul_pd(g2, x2);
-      b22 = _mm256_add_pd(b22, g22);
-      b222 = _mm256_fmadd_pd(g22, x2, b222);
-    }
-    double sm[16];
-    _mm256_storeu_pd(sm, hsum4(a0, a1, a2, a11));
-    _mm256_storeu_pd(sm + 4, hsum4(a12, a22, b1, b2));
-    _mm256_storeu_pd(sm + 8, hsum4(b11, b12, b22, b111));
-    _mm256_storeu_pd(sm + 12, hsum4(b112, b122, b222, zero));
-    // (C) M = [[A00 A01 A02] [A01 A11 A12] [A02 A12 A22]], M_,c = w_,c p p^T (times h above)
-    const double A00 = sm[0], A01 = sm[1], A02 = sm[2], A11 = sm[3], A12 = sm[4], A22 = sm[5];
-    const double B1 = sm[6], B2 = sm[7], B11 = sm[8], B12 = sm[9], B22 = sm[10], B111 = sm[11], B112 = sm[12],
-                 B122 = sm[13], B222 = sm[14];
-    const double C00 = A11 * A22 - A12 * A12, C01 = A02 * A12 - A01 * A22, C02 = A01 * A12 - A02 * A11;
-    const double C11 = A00 * A22 - A02 * A02, C12 = A01 * A02 - A00 * A12, C22 = A00 * A11 - A01 * A01;
-    const double det = A00 * C00 + A01 * C01 + A02 * C02;
-    double cond = 1.0;
-    bool mls = n >= 3 && A00 > 0.0 && C22 > 0.0 && det > 0.0;
-    if (mls) {
-      const double na = std::max(std::max(std::fabs(A00) + std::fabs(A01) + std::fabs(A02),
-                                          std::fabs(A01) + std::fabs(A11) + std::fabs(A12)),
-                                 std::fabs(A02) + std::fabs(A12) + std::fabs(A22));
-      const double nc_ = std::max(std::max(std::fabs(C00) + std::fabs(C01) + std::fabs(C02),
-                                           std::fabs(C01) + std::fabs(C11) + std::fabs(C12)),
-                                  std::fabs(C02) + std::fabs(C12) + std::fabs(C22));
-      cond = na * nc_ * (1.0 / det);
-      mls = std::isfinite(cond) && cond > 0.0 && cond <= 1.0 / kMinRcond;  // one division on the row's path
-      if (!mls) cond = 1.0;
-    }
-    cond_[k] = cond;
-    if (mls && !(cond > tol)) {
-      // 003 eqs 27-31 as in table_rows_body: g = M^-1 p(0), g_,c = M^-1 (e_c / h - M_,c g)
-      const double id = 1.0 / det;  // the same division as above (the compiler keeps one)
-      const double X00 = C00 * id, X01 = C01 * id, X02 = C02 * id, X11 = C11 * id, X12 = C12 * id, X22 = C22 * id;
-      const double g0 = X00, g1 = X01, g2 = X02;
-      // M_,1 = [[B1 B11 B12] [B11 B111 B112] [B12 B112 B122]] / h, M_,2 = [[B2 B12 B22] [B12 B112 B122] [B22 B122 B222]] / h
-      const double r10 = -(B1 * g0 + B11 * g1 + B12 * g2) * ih, r11 = -(B11 * g0 + B111 * g1 + B112 * g2) * ih + ih,
-                   r12 = -(B12 * g0 + B112 * g1 + B122 * g2) * ih;
-      const double r20 = -(B2 * g0 + B12 * g1 + B22 * g2) * ih, r21 = -(B12 * g0 + B112 * g1 + B122 * g2) * ih,
-                   r22 = -(B22 * g0 + B122 * g1 + B222 * g2) * ih + ih;
-      const double c00 = X00 * r10 + X01 * r11 + X02 * r12, c01 = X01 * r10 + X11 * r11 + X12 * r12,
-                   c02 = X02 * r10 + X12 * r11 + X22 * r12;
-      const double c10 = X00 * r20 + X01 * r21 + X02 * r22, c11 = X01 * r20 + X11 * r21 + X12 * r22,
-                   c12 = X02 * r20 + X12 * r21 + X22 * r22;
-      // (D) N_j = w_j g.p_j, N_j,c = w_j g_,c.p_j + gf_j s_c / h g.p_j
-      const __m256d G0 = _mm256_set1_pd(g0), G1 = _mm256_set1_pd(g1), G2 = _mm256_set1_pd(g2);
-      const __m256d Q00 = _mm256_set1_pd(c00), Q01 = _mm256_set1_pd(c01), Q02 = _mm256_set1_pd(c02);
-      const __m256d Q10 = _mm256_set1_pd(c10), Q11 = _mm256_set1_pd(c11), Q12 = _mm256_set1_pd(c12);
-      auto out4 = [&](int m, bool tail) FLUID_INLINE_LAMBDA {
-        const __m256d x1 = _mm256_loadu_pd(sx + m), x2 = _mm256_loadu_pd(sy + m), w = _mm256_loadu_pd(wv + m);
-        const __m256d gp = _mm256_fmadd_pd(G2, x2, _mm256_fmadd_pd(G1, x1, G0));
-        const __m256d gq = _mm256_mul_pd(_mm256_mul_pd(_mm256_loadu_pd(gv + m), ihv), gp);
-        const __m256d Nv = _mm256_mul_pd(w, gp);
-        const __m256d gx = _mm256_fmadd_pd(w, _mm256_fmadd_pd(Q02, x2, _mm256_fmadd_pd(Q01, x1, Q00)), _mm256_mul_pd(gq, x1));
-        const __m256d gy = _mm256_fmadd_pd(w, _mm256_fmadd_pd(Q12, x2, _mm256_fmadd_pd(Q11, x1, Q10)), _mm256_mul_pd(gq, x2));
-        const __m256d t0 = _mm256_unpacklo_pd(gx, gy), t1 = _mm256_unpackhi_pd(gx, gy);  // (x0 y0 x2 y2), (x1 y1 x3 y3)
-        const __m256d o0 = _mm256_permute2f128_pd(t0, t1, 0x20), o1 = _mm256_permute2f128_pd(t0, t1, 0x31);
-        if (!tail) {
-          _mm256_storeu_pd(Nk + m, Nv);
-          _mm256_storeu_pd(Gk + 2 * m, o0);
-          _mm256_storeu_pd(Gk + 2 * m + 4, o1);
-        } else {
-          const __m256i rem = _mm256_set1_epi64x(n - m), rem2 = _mm256_set1_epi64x(2 * (n - m));
-          _mm256_maskstore_pd(Nk + m, _mm256_cmpgt_epi64(rem, lane), Nv);
-          _mm256_maskstore_pd(Gk + 2 * m, _mm256_cmpgt_epi64(rem2, lane), o0);
-          _mm256_maskstore_pd(Gk + 2 * m + 4, _mm256_cmpgt_epi64(rem2, lane2), o1);
-        }
-      };
-      int m = 0;
-      for (; m + 4 <= n; m += 4) out4(m, false);
-      if (m < n) out4(m, true);
-    } else {
-      double *s[2] = {sx, sy};
-      shepard_row<2>(n, wv, gv, s, ih, mls, js, Nk, Gk);
-    }
+    rp[c1] = rend[c1 - 1];
+    mls1_rows2_avx2(ft, c0, c1, kMinRcond, fast, fs);
+    for (int32_t k = c0; k < c1; ++k)
+      if (site_status_[k] != 0 || cond_[k] > shepard_cond_) table_rows_avx2<2>(k, k + 1, xn, scratch, iscratch, false);
   }
-  _mm256_zeroupper();
 }
-MFREE_AVX2_END
 #endif
 
 Report FluidSystem::prepare(const double *y, bool checked) {
@@ -1028,6 +902,16 @@ Report FluidSystem::prepare(const double *y, bool checked) {
   const size_t per_thread = static_cast<size_t>(dim + 2) * (maxrow_ + 8), iper_thread = static_cast<size_t>(maxrow_);
   if (rows_scratch_.size() < per_thread * nt) rows_scratch_.resize(per_thread * nt);
   if (rows_iscratch_.size() < iper_thread * nt) rows_iscratch_.resize(iper_thread * nt);
+#if MFREE_SIMD_X86
+  if (dim == 2 && !transpose && simd::use_avx2()) {  // table_rows2_avx2's per-thread scratch
+    if (fast_scratch_.size() < static_cast<size_t>(nt)) fast_scratch_.resize(nt);
+    for (int t = 0; t < nt; ++t) fast_scratch_[t].reserve(static_cast<int>(maxrow_));
+    rows_ptr_.resize(static_cast<size_t>(nt) * (nall + 1));
+    site_status_.resize(nall);
+    site_support_.resize(nall);
+    site_order_.resize(nall);
+  }
+#endif
   bool one_way[64] = {};  // parallel_blocks runs at most 64 threads
   const bool avx2 = simd::use_avx2();  // once per step: every thread runs the same copy
   (void)avx2;
@@ -1036,7 +920,7 @@ Report FluidSystem::prepare(const double *y, bool checked) {
     int64_t *iscratch = rows_iscratch_.data() + iper_thread * t;
 #if MFREE_SIMD_X86
     if (avx2 && dim == 2 && !transpose) {
-      table_rows2_avx2(k0, k1, xn, scratch);
+      table_rows2_avx2(k0, k1, xn, scratch, iscratch, fast_scratch_[t], rows_ptr_.data() + static_cast<size_t>(t) * (nall + 1));
       return false;
     }
     if (avx2)
@@ -1336,6 +1220,12 @@ Report FluidSystem::accel_end(const AccelArgs &aa, double *a) {
 #if MFREE_SIMD_X86
 MFREE_AVX2_BEGIN
 namespace {
+
+// sum of the four lanes of each of a, b, c, d: (sum a, sum b, sum c, sum d)
+MFREE_TARGET_AVX2 MFREE_ALWAYS_INLINE __m256d hsum4(__m256d a, __m256d b, __m256d c, __m256d d) {
+  const __m256d ab = _mm256_hadd_pd(a, b), cd = _mm256_hadd_pd(c, d);  // (a01, b01, a23, b23), ...
+  return _mm256_add_pd(_mm256_permute2f128_pd(ab, cd, 0x20), _mm256_permute2f128_pd(ab, cd, 0x31));
+}
 
 // Table entries q .. q + 3 of a 2D row in registers, lanes in the order (q, q + 2, q + 1,
 // q + 3) that the in-lane unpacks of interleaved pairs give: velocities (vx, vy) of the

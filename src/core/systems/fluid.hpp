@@ -66,11 +66,11 @@ class FluidSystem : public System {
   bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
   template <int D>
   bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
-  // The 2D rows for AVX2 + FMA without the transpose (the dam break's configuration), in
-  // one register-resident kernel: the candidates filtered four at a time, then weights,
-  // the 15 moment sums and the outputs four neighbours at a time, the 3x3 system solved in
-  // closed form (adjugate). The same rows as table_rows<2> to round-off.
-  void table_rows2_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch);
+  // The 2D rows for AVX2 + FMA without the transpose (the dam break's configuration):
+  // the approximants' fused linear-MLS rows (shape_fast_mls1.hpp) on the filtered
+  // candidates; fast and rp are the thread's scratch (rp: nq() + 1 row offsets).
+  void table_rows2_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
+                        FastScratch &fast, int64_t *rp);
   template <int D>
   bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
                        bool wide);  // wide: the AVX2 copy (gathers, 256-bit sqrt)
@@ -184,6 +184,11 @@ class FluidSystem : public System {
   int64_t maxrow_ = 0;               // longest candidate row
   std::vector<double> rows_scratch_;  // (dim + 2) (maxrow_ + 8) per thread
   std::vector<int64_t> rows_iscratch_;  // maxrow_ per thread (transposed candidates)
+  // table_rows2_avx2: per thread, the fast path's scratch and row offsets; per node, the
+  // fast path's status, support and order
+  std::vector<FastScratch> fast_scratch_;
+  std::vector<int64_t> rows_ptr_;
+  std::vector<int32_t> site_status_, site_support_, site_order_;
   Csr wall_nbr_;
   // per node (reused): packed quadrature-point data of accel; integrate's states and rates
   std::vector<double> pack_, work_state_, stage_, rate_, vh_, dr_;
