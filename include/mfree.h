@@ -634,6 +634,35 @@ MFREE_API mfree_status_t mfree_particles_set_search(mfree_particles_t *ps,
                                                     double kappa);
 
 /**
+ * Verlet skin of the neighbour search, for sets set up again after small moves (time
+ * steps). With skin s > 0 a setup that searches keeps candidate lists of search radius
+ * kappa h + s; later setups filter their rows from the candidates while no valid
+ * particle has moved, plus grown its radius kappa h_i, by more than s / 2 since the
+ * candidates were built, and search again otherwise. The lists of
+ * mfree_particles_get_neighbors are always those of a search without a skin, in the same
+ * order; only the cost changes (mfree_particles_get_search_count counts the searches).
+ * A periodic axis shorter than 2 (kappa h + s) gets a search at every setup. Costs
+ * memory for the candidates (about (1 + s / (kappa h))^dim times the lists) and the
+ * positions at the last search.
+ * @param[in] ps    the set
+ * @param[in] skin  finite and >= 0, in length units (else MFREE_ERR_ARG, nothing
+ *                  changed); 0, the default, searches at every setup
+ * @return MFREE_SUCCESS, or a failure naming the value
+ */
+MFREE_API mfree_status_t mfree_particles_set_search_skin(mfree_particles_t *ps, double skin);
+
+/**
+ * Number of neighbour searches the setups of the set have run: every setup without a
+ * skin (unless the lists are the host's), with a skin only those that (re)built the
+ * candidate lists.
+ * @param[in]  ps     the set
+ * @param[out] count  the count (0 before the first setup)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output
+ */
+MFREE_API mfree_status_t mfree_particles_get_search_count(const mfree_particles_t *ps,
+                                                          int64_t *count);
+
+/**
  * A box [lo, hi) with periodic axes. Distances use the nearest image along periodic
  * axes; kappa h must stay below half the box length there.
  * @param[in] ps        the set

@@ -453,6 +453,20 @@ module mfree
       real(c_double), value :: w
     end function mfree_particles_set_halo_width_c
 
+    integer(c_int) function mfree_particles_set_search_skin_c(ps, skin) &
+        bind(C, name="mfree_particles_set_search_skin")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: ps
+      real(c_double), value :: skin
+    end function mfree_particles_set_search_skin_c
+
+    integer(c_int) function mfree_particles_get_search_count_c(ps, count) &
+        bind(C, name="mfree_particles_get_search_count")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: ps
+      integer(c_int64_t), intent(out) :: count
+    end function mfree_particles_get_search_count_c
+
     integer(c_int) function mfree_particles_setup_c(ps) &
         bind(C, name="mfree_particles_setup")
       import :: c_int, c_ptr
@@ -1411,6 +1425,7 @@ module mfree
   public :: mfree_particles_set_neighbors_c, mfree_particles_setup_c
   public :: mfree_particles_set_global_ids_c, mfree_particles_get_global_ids_c
   public :: mfree_particles_set_halo_width_c
+  public :: mfree_particles_set_search_skin_c, mfree_particles_get_search_count_c
   public :: mfree_particles_update_c, mfree_particles_get_dimension_c
   public :: mfree_particles_get_size_c, mfree_particles_get_neighbor_nnz_c
   public :: mfree_particles_get_neighbors_c, mfree_particles_get_volumes_c
@@ -1526,6 +1541,7 @@ module mfree
   public :: mfree_particles_set_periodic, mfree_particles_set_neighbors
   public :: mfree_particles_set_global_ids, mfree_particles_get_global_ids
   public :: mfree_particles_set_halo_width
+  public :: mfree_particles_set_search_skin, mfree_particles_get_search_count
   public :: mfree_particles_setup, mfree_particles_update, mfree_particles_get_dimension
   public :: mfree_particles_get_size, mfree_particles_get_neighbor_nnz
   public :: mfree_particles_get_neighbors, mfree_particles_get_volumes
@@ -2350,6 +2366,20 @@ contains
     real(c_double), intent(in) :: w
     st = mfree_particles_set_halo_width_c(ps%ptr, w)
   end function mfree_particles_set_halo_width
+
+  !> Typed wrapper of mfree_particles_set_search_skin (mfree.h).
+  integer(c_int) function mfree_particles_set_search_skin(ps, skin) result(st)
+    type(mfree_particles), intent(in) :: ps
+    real(c_double), intent(in) :: skin
+    st = mfree_particles_set_search_skin_c(ps%ptr, skin)
+  end function mfree_particles_set_search_skin
+
+  !> Typed wrapper of mfree_particles_get_search_count (mfree.h).
+  integer(c_int) function mfree_particles_get_search_count(ps, count) result(st)
+    type(mfree_particles), intent(in) :: ps
+    integer(c_int64_t), intent(out) :: count
+    st = mfree_particles_get_search_count_c(ps%ptr, count)
+  end function mfree_particles_get_search_count
 
   !> Typed wrapper of mfree_particles_setup (mfree.h).
   integer(c_int) function mfree_particles_setup(ps) result(st)

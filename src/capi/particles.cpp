@@ -97,6 +97,21 @@ mfree_status_t mfree_particles_set_search(mfree_particles_t *ps, mfree_search_t 
   });
 }
 
+mfree_status_t mfree_particles_set_search_skin(mfree_particles_t *ps, double skin) {
+  return mfree::with_handle(ps, "mfree_particles_set_search_skin", [&](mfree::ParticleSet &s) {
+    s.set_search_skin(skin);
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_particles_get_search_count(const mfree_particles_t *ps, int64_t *count) {
+  return mfree::with_handle(ps, "mfree_particles_get_search_count", [&](const mfree::ParticleSet &s) {
+    MFREE_REQUIRE(count, MFREE_ERR_NULL, "output pointer is NULL");
+    *count = s.search_count();
+    return MFREE_SUCCESS;
+  });
+}
+
 mfree_status_t mfree_particles_set_periodic(mfree_particles_t *ps, const double *lo,
                                             const double *hi, const int32_t *periodic) {
   return mfree::with_handle(ps, "mfree_particles_set_periodic", [&](mfree::ParticleSet &s) {

@@ -359,6 +359,12 @@ static void rows_pairs(void) {
   ROW0(MFREE_ERR_NULL, mfree_particles_set_halo_width(NULL, 1.0));
   ROW(MFREE_ERR_ARG, mfree_particles_set_halo_width(F.ps, -1.0));
   ROW(MFREE_ERR_ARG, mfree_particles_set_halo_width(F.ps, NAN));
+  ROW0(MFREE_ERR_NULL, mfree_particles_set_search_skin(NULL, 0.1));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_search_skin(F.ps, -0.1));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_search_skin(F.ps, NAN));
+  ROW(MFREE_ERR_ARG, mfree_particles_set_search_skin(F.ps, INFINITY));
+  ROW0(MFREE_ERR_NULL, mfree_particles_get_search_count(NULL, &n64));
+  ROW(MFREE_ERR_NULL, mfree_particles_get_search_count(F.ps, NULL));
   ROW0(MFREE_ERR_NULL, mfree_particles_get_num_pairs(NULL, &n64));
   ROW(MFREE_ERR_NULL, mfree_particles_get_num_pairs(F.ps, NULL));
   ROW(MFREE_ERR_STATE, mfree_particles_get_num_pairs(F.ps, &n64));

@@ -26,11 +26,11 @@
 // (AVX2, query_avx2).
 // Either way the lists are the same sets, sorted: the same bits.
 //
-// The search is one translation unit in four parts, by algorithm: the cell grid
+// The search is one translation unit in five parts, by algorithm: the cell grid
 // (neighbors_cell_grid.inc) and its queries (neighbors_cell_grid_scan.inc), the general
-// queries (neighbors_general.inc) and the host-order queries (neighbors_host_order.inc);
-// this file holds the search's buffers and its two entry points, which choose between
-// them. One unit, because the parts share the grid's types and the compiler inlines the
+// queries (neighbors_general.inc), the host-order queries (neighbors_host_order.inc) and
+// the Verlet skin's reuse of candidate lists (neighbors_verlet.inc); this file holds the
+// search's buffers and its two entry points, which choose between them. One unit, because the parts share the grid's types and the compiler inlines the
 // grid's queries into the query loops of both kinds; as separate units the grid would
 // need external linkage and those decisions could change.
 #include <algorithm>
@@ -56,6 +56,23 @@
 
 namespace mfree {
 
+// The Verlet skin's candidate lists (neighbors_verlet.inc) and what they were built from.
+struct VerletLists {
+  Csr cand;            // rows of radius kappa h + skin at the build, sorted by index
+  Buf<double> x0;      // positions at the build, dim per particle
+  Buf<double> r0;      // search radii kappa h at the build
+  Buf<int32_t> stat0;  // particle statuses at the build
+  Buf<int32_t> tmp;    // filtered rows, block by block, before they are placed
+  bool built = false;  // cand holds for the settings below
+  bool used = false;   // the last search's rows came from cand
+  // the settings cand was built under (another value rebuilds)
+  int32_t n = -1, owned = -1;
+  int conv = -1;
+  double skin = 0.0;
+  bool periodic[3] = {false, false, false};
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+};
+
 // Buffers of a search, kept by a particle set between searches (sizes settle after the
 // first; a repeated search then allocates nothing), or local to one host-point search.
 struct NeighborScratch {
@@ -67,6 +84,8 @@ struct NeighborScratch {
   Buf<int32_t> lo_hi;
   Buf<const int32_t *> src;
   Csr next;  // the lists host_order_blocks writes, then swaps with the set's
+  VerletLists verlet;
+  int64_t searches = 0;  // completed searches of the set's rows or candidates
 };
 
 NeighborScratch *new_neighbor_scratch() { return new NeighborScratch; }
@@ -79,9 +98,13 @@ void NeighborScratchDeleter::operator()(NeighborScratch *s) const { delete s; }
 
 namespace mfree {
 
-void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, NeighborScratch &sc, Csr &out) {
+namespace {
+
+// The rows of the owned particles with every search radius kappa h_i + pad.
+void search_rows(const ParticleSet &ps, const std::vector<int32_t> &status, NeighborScratch &sc, Csr &out,
+                 double pad) {
   const int32_t rows = ps.num_owned();
-  sc.grid.build(ps, status);
+  sc.grid.build(ps, status, pad);
   const CellGrid &grid = sc.grid;
   const Rule rule{ps.search_convention(), grid.rmax()};
   // AVX2, particles stored in spatial order: in host order, on one thread straight into
@@ -119,10 +142,30 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, N
   run_queries(sc, rule, rows, symmetric,
               [&](int32_t i, double *x) {
                 for (int c = 0; c < dim; ++c) x[c] = grid.wrap(ps.x(i, c), c);
-                return ps.kappa() * ps.h(i);  // (what the grid's radii were built from)
+                return ps.kappa() * ps.h(i) + pad;  // (what the grid's radii were built from)
               },
               out);
 }
+
+}  // namespace
+}  // namespace mfree
+
+#include "core/particles/neighbors_verlet.inc"
+
+namespace mfree {
+
+void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, NeighborScratch &sc, Csr &out) {
+  if (ps.search_skin() > 0.0) {
+    verlet_rows(ps, status, sc, out);
+    return;
+  }
+  sc.verlet.built = sc.verlet.used = false;
+  search_rows(ps, status, sc, out, 0.0);
+  ++sc.searches;
+}
+
+const Csr *neighbor_candidates(const NeighborScratch &sc) { return sc.verlet.used ? &sc.verlet.cand : nullptr; }
+int64_t neighbor_searches(const NeighborScratch &sc) { return sc.searches; }
 
 void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, int32_t npts,
                           const VectorArray &x, const ScalarArray &h, Csr &out) {

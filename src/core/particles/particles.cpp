@@ -157,6 +157,20 @@ void ParticleSet::set_search(int convention, double kappa) {
   setup_done_ = false;
 }
 
+void ParticleSet::set_search_skin(double skin) {
+  if (!std::isfinite(skin) || skin < 0.0)
+    throw Error(MFREE_ERR_ARG, "search skin must be finite and >= 0, got " + std::to_string(skin));
+  skin_ = skin;
+  setup_done_ = false;
+}
+
+int64_t ParticleSet::search_count() const { return scratch_ ? neighbor_searches(*scratch_) : 0; }
+
+const Csr &ParticleSet::search_candidates() const {
+  const Csr *c = scratch_ ? neighbor_candidates(*scratch_) : nullptr;
+  return c && !host_neighbors() ? *c : nbr_;
+}
+
 void ParticleSet::set_periodic(const double *lo, const double *hi, const int32_t *periodic) {
   if (!lo || !hi || !periodic) throw Error(MFREE_ERR_NULL, "lo, hi and periodic must not be NULL");
   for (int c = 0; c < dim_; ++c) {

@@ -69,6 +69,18 @@ class ParticleSet {
   void set_densities(const double *rho, int64_t stride, int mem);
   void set_support(const double *h, int64_t stride, int mem);
   void set_search(int convention, double kappa);
+  // Verlet skin of the search (0, the default: none). With skin s > 0 a setup that
+  // searches keeps candidate lists of radius kappa h + s, and later setups filter their
+  // rows from them until some particle has moved (or grown its radius) by more than s / 2
+  // since they were built (neighbors_verlet.inc): the rows are always a fresh search's.
+  void set_search_skin(double skin);
+  double search_skin() const { return skin_; }
+  // Searches run by setups so far (with a skin: builds of the candidate lists).
+  int64_t search_count() const;
+  // The candidate lists the last setup filtered its rows from (rows of the owned
+  // particles, sorted by index, each holding its row of neighbors(); the same lists
+  // until search_count() changes); neighbors() itself after a setup without them.
+  const Csr &search_candidates() const;
   void set_periodic(const double *lo, const double *hi, const int32_t *periodic);
   void set_neighbors(const int64_t *rowptr, const int32_t *cols, int32_t base, int mem);
   // Global ids (NULL: none) and the host's halo width (0: none declared).
@@ -171,6 +183,7 @@ class ParticleSet {
   ScalarArray vol_, mass_, rho_, h_;
   int convention_ = MFREE_SEARCH_GATHER;
   double kappa_ = 2.0;
+  double skin_ = 0.0;
   bool periodic_[3] = {false, false, false};
   double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
 
