@@ -22,16 +22,18 @@
 # into the library's figures, and OLD commits before the machine-readable mode
 # (MFREE_BENCH_FORMAT=tsv, bench/bench_util.h) print only human text.
 #
-# Default sizes (about 10-12 minutes on an idle 2-core machine, builds from ccache
-# included): the documented problem sizes (10^5 particles, the 25,088-particle dam break,
-# Table IV at 300 x 300, 2 MPI ranks x 2.5e5) with fewer repetitions inside each program
+# Default sizes (about 10 minutes on an idle 2-core machine with builds from ccache: the
+# runs use about 80 s of CPU per round): the documented problem sizes (10^5 particles,
+# the 25,088-particle dam break, Table IV at 300 x 300, 2 MPI ranks x 2.5e5) with fewer
+# repetitions inside each program
 # (MFREE_BENCH_REPS=2 for bench_shape, 3 for bench_neighbors, bench_pairs 2 repeats,
 # bench_mpi_weak 10 steps): the rounds repeat the whole programs instead. --full runs the
 # programs' own defaults (1e4 too, 7 pair repeats, 20 MPI steps, 1/2/4 ranks; about
-# twice as long).
+# twice as long per round: take fewer rounds).
 #
 # Options:
-#   -k, --rounds N      rounds (default 3): each program runs 2N times
+#   -k, --rounds N      rounds (default 6): each program runs 2N times; an even count
+#                       lets each library run first equally often
 #   -b, --bench LIST    comma-separated programs, without "bench_" (default
 #                       neighbors,shape,apply,dambreak,table4,pairs,mpi_weak)
 #   --clock wall|cpu    MFREE_BENCH_CLOCK for the programs (default: $MFREE_BENCH_CLOCK, else
@@ -63,7 +65,7 @@ usage() { sed -n '2,/^set -euo/p' "$0" | grep -v '^set' | sed 's/^# \{0,1\}//'; 
 die() { echo "bench-compare: $*" >&2; exit 2; }
 say() { echo "bench-compare: $*" >&2; }
 
-rounds=3
+rounds=6
 benches="neighbors,shape,apply,dambreak,table4,pairs,mpi_weak"
 clock="${MFREE_BENCH_CLOCK:-wall}"
 threads="${MFREE_BENCH_THREADS:-0}"
