@@ -60,6 +60,9 @@
 #   scripts/bench-compare.sh beb1e93 main                          # idle machine, wall clock
 #   MFREE_BENCH_CLOCK=cpu scripts/bench-compare.sh -t 1 -b shape,dambreak beb1e93 HEAD
 set -euo pipefail
+# The whole script is one compound command, read before it runs: editing or checking out
+# another version of this file during a run cannot change the running one.
+{
 
 usage() { sed -n '2,/^set -euo/p' "$0" | grep -v '^set' | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "bench-compare: $*" >&2; exit 2; }
@@ -123,7 +126,7 @@ flock -n 9 || die "another bench-compare is using $scratch (wait, or pass --scra
 
 if [ "$remove" = 1 ]; then
   for side in old new; do
-    [ -d "$scratch/$side" ] && git -C "$repo" worktree remove --force "$scratch/$side"
+    if [ -d "$scratch/$side" ]; then git -C "$repo" worktree remove --force "$scratch/$side"; fi
   done
   rm -rf "$scratch"
   git -C "$repo" worktree prune
@@ -296,3 +299,4 @@ new_s="$(git -C "$repo" rev-parse --short "$new_c")"
 cat "$table"
 [ -n "$out" ] && cp "$table" "$out"
 exit "${status:-0}"
+}
