@@ -14,7 +14,7 @@ namespace mfree {
 Assembler::Assembler(const ParticleSet *ps, const ApproxConfig &trial, const ApproxConfig &test,
                      bool bubnov, int form)
     : ps_(ps), trial_cfg_(trial), test_cfg_(bubnov ? trial : test), bubnov_(bubnov), form_(form),
-      dim_(ps->dim()) {
+      dim_(ps->dim()), fe_(ps) {
   if (form < MFREE_FORM_LAPLACE || form > MFREE_FORM_COLLOCATION_PLANE_STRAIN)
     throw Error(MFREE_ERR_ARG, "unknown form " + std::to_string(form));
   const bool plane = form == MFREE_FORM_ELASTICITY_PLANE_STRESS || form == MFREE_FORM_ELASTICITY_PLANE_STRAIN ||

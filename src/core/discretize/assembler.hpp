@@ -1,4 +1,9 @@
-// Galerkin (Bubnov and Petrov) and collocation assembly of sparse systems.
+// Galerkin (Bubnov and Petrov) and collocation assembly of sparse systems. The class is
+// defined across files by concern (assembler.cpp: construction, tables, pattern;
+// assembler_forms.cpp, assembler_quadrature.cpp, assembler_essential.cpp,
+// assembler_tractions.cpp) and delegates to components with narrow inputs: the FE layer
+// (fe_layer.hpp), consistent integration (consistent_integration.hpp), small-strain
+// kinematics (strain.hpp).
 #pragma once
 
 #include <cstdint>
@@ -8,7 +13,9 @@
 #include "core/base/alloc.hpp"
 #include "core/shape/approximant.hpp"
 #include "core/base/error.hpp"
+#include "core/discretize/fe_layer.hpp"
 #include "core/discretize/matrix.hpp"
+#include "core/discretize/qtable.hpp"
 #include "mfree.h"
 #include "core/particles/particles.hpp"
 
@@ -94,38 +101,10 @@ class Assembler {
     void *user = nullptr;
   };
 
-  // Test or trial functions at the quadrature points (after the FE-layer blending):
-  // weight per point, CSR rows of particles with values and gradients.
-  struct QTable {
-    std::vector<double> w;
-    std::vector<int64_t> rowptr{0};
-    std::vector<int32_t> cols;
-    std::vector<double> val, grad;
-    std::vector<double> x;  // position of each point (dim per point)
-    // Derivatives for the shear strains when they differ from grad (Johnson-Beissel,
-    // paper 000 eqs 48-52: the shear keeps the symmetrised SPH derivatives); empty: grad.
-    std::vector<double> sgrad;
-    int32_t size() const { return static_cast<int32_t>(w.size()); }
-  };
-  // Read-only view with the accessor names of Approximant, so loops read alike.
-  struct QView {
-    const QTable &t;
-    const std::vector<int64_t> &rowptr() const { return t.rowptr; }
-    const std::vector<int32_t> &cols() const { return t.cols; }
-    const std::vector<double> &values() const { return t.val; }
-    const std::vector<double> &gradients() const { return t.grad; }
-    int32_t num_sites() const { return t.size(); }
-  };
-  struct FeLayer {
-    int npe = 0;                  // 3 (triangles) or 4 (quadrilaterals); 0: none
-    HVec<int32_t> conn;      // nelem * npe particle indices
-    HVec<char> on_gu;        // per particle: node on the essential boundary
-    HVec<char> in_layer;     // per particle: node of some layer element
-    HVec<double> bmin, bmax;  // element bounding boxes
-  };
+  // Essential values at nodes: the function g and a mask of valid components.
+  void check_values(mfree_field_fn g, int32_t mask) const;
+  static NodeSet node_set(int kind, int32_t n, const int32_t *nodes, int32_t mask, mfree_field_fn fn, void *user);
   void build_qtables();
-  // Second-order VCI of the test gradients in t from the boundary values b with normals.
-  void correct_test_gradients(QTable &t, const QTable &b, const HVec<double> &normals) const;
   // The test table of the assembly: its own when the test functions differ from the
   // trial functions or their gradients were corrected, else the trial table.
   const QTable &test_table() const { return own_test_table_ ? qtest_ : qtrial_; }
@@ -133,10 +112,6 @@ class Assembler {
   // Positions pts (NULL: the particles).
   void fill_qtable(const Approximant &a, QTable &t, const HVec<double> *w,
                    const HVec<double> *pts = nullptr) const;
-  // Blend rows at points pts (NULL: the particles, nodal quadrature) with the FE layer.
-  void blend_qtable(QTable &t, const HVec<double> *pts) const;
-  // FE shape functions of layer element e at x (N[npe], dN[npe*2]); false if x is outside.
-  bool fe_shape(int32_t e, const double *x, double *N, double *dN) const;
 
   bool collocation() const { return form_ >= MFREE_FORM_COLLOCATION_LAPLACE; }
   bool elasticity() const;
@@ -147,6 +122,8 @@ class Assembler {
   std::vector<double> point_supports(const HVec<double> &pts) const;
   ApproxConfig values_config(const ApproxConfig &c) const;
   void check_points(int32_t npts, const double *x, const double *w, const char *what) const;
+  // Every normal (dim per point) a finite unit vector; what prefixes the message.
+  void check_unit_normals(int32_t npts, const double *normals, const char *what) const;
   void read_points(int32_t npts, const double *x, int layout, int64_t ld, HVec<double> &out) const;
   Report build_tables();
   void build_pattern();
@@ -156,6 +133,27 @@ class Assembler {
   // the one-rank rows bit for bit.
   void quadrature_order();
   void material_matrix(double *D, int &nv) const;
+  // Entry (r, c) of a matrix being assembled, which must lie in its pattern.
+  struct Entries {
+    SparseMatrix &K;
+    std::vector<double> &v;
+    double &operator()(int32_t r, int32_t c) const {
+      const int64_t k = K.find(r, c);
+      if (k < 0) throw Error(MFREE_ERR_INTERNAL, "assembly entry outside the pattern");
+      return v[k];
+    }
+  };
+  // The parts of assemble_matrix and assemble_rhs, by concern: the form's rows
+  // (assembler_forms.cpp), the boundary terms and the replaced rows
+  // (assembler_essential.cpp).
+  void assemble_collocation(const Entries &at) const;
+  void assemble_mass(const Entries &at) const;
+  void assemble_stiffness(std::vector<double> &v) const;
+  void assemble_boundary_terms(const Entries &at) const;
+  void assemble_replaced_rows(const Entries &at) const;
+  void body_loads(double *f) const;
+  void boundary_loads(double *f) const;
+  void replaced_row_loads(double *f) const;
   // Traction operator: (sigma(u) n)_c = sum_e T[c][e] u_e for the field u = phi e_e with
   // gradient g (elasticity), or c n.g (Laplace, T[0][0]).
   void traction_row(const double *g, const double *n, double T[3][3]) const;

@@ -1,5 +1,5 @@
-// Quadrature of the assembler: nodal, background cells or host points, and the tables
-// of functions at the quadrature points.
+// Quadrature of the assembler: nodal, background cells or host points, the tables of
+// functions at the quadrature points, and their consistent-integration correction.
 #include "core/discretize/assembler.hpp"
 
 #include <algorithm>
@@ -7,8 +7,43 @@
 #include <string>
 
 #include "core/base/quadrature.hpp"
+#include "core/discretize/consistent_integration.hpp"
 
 namespace mfree {
+
+namespace {
+
+// Gauss-Legendre product rule (ngauss per axis) on the cells of the box [lo, hi] cut into
+// ncells per axis: the points (dim per point) for which inside(user, x) holds (every
+// point without inside) and their weights.
+void cell_rule(int dim, const double *lo, const double *hi, const int32_t *ncells, int ngauss,
+               mfree_inside_fn inside, void *user, HVec<double> &x, HVec<double> &w) {
+  std::vector<double> g, gw;
+  gauss_legendre(ngauss, g, gw);
+  int64_t total = 1;
+  for (int c = 0; c < dim; ++c) total *= static_cast<int64_t>(ncells[c]) * ngauss;
+  if (total > (int64_t(1) << 31) - 1) throw Error(MFREE_ERR_ARG, "too many quadrature points");
+  double h[3] = {0, 0, 0};
+  for (int c = 0; c < dim; ++c) h[c] = (hi[c] - lo[c]) / ncells[c];
+  int64_t idx[3] = {0, 0, 0}, per[3] = {1, 1, 1};
+  for (int c = 0; c < dim; ++c) per[c] = static_cast<int64_t>(ncells[c]) * ngauss;
+  for (int64_t t = 0; t < total; ++t) {
+    int64_t r = t;
+    double p[3] = {0, 0, 0}, wt = 1.0;
+    for (int c = 0; c < dim; ++c) {
+      idx[c] = r % per[c];
+      r /= per[c];
+      const int64_t cell = idx[c] / ngauss, q = idx[c] % ngauss;
+      p[c] = lo[c] + h[c] * (cell + 0.5 * (1.0 + g[q]));
+      wt *= 0.5 * h[c] * gw[q];
+    }
+    if (inside && !inside(user, p)) continue;
+    for (int c = 0; c < dim; ++c) x.push_back(p[c]);
+    w.push_back(wt);
+  }
+}
+
+}  // namespace
 
 void Assembler::set_quadrature_nodal() {
   quad_kind_ = 0;
@@ -25,6 +60,15 @@ void Assembler::check_points(int32_t npts, const double *x, const double *w, con
       if (!(std::isfinite(w[p]) && w[p] >= 0.0))
         throw Error(MFREE_ERR_INPUT, std::string(what) + ": weight " + std::to_string(p) + " = " +
                                          std::to_string(w[p]) + " is negative or not finite");
+}
+
+void Assembler::check_unit_normals(int32_t npts, const double *normals, const char *what) const {
+  for (int32_t p = 0; p < npts; ++p) {
+    double len = 0.0;
+    for (int c = 0; c < dim_; ++c) len += normals[p * dim_ + c] * normals[p * dim_ + c];
+    if (!(std::isfinite(len) && std::fabs(len - 1.0) < 1e-6))
+      throw Error(MFREE_ERR_INPUT, std::string(what) + "normal " + std::to_string(p) + " is not a finite unit vector");
+  }
 }
 
 void Assembler::read_points(int32_t npts, const double *x, int layout, int64_t ld,
@@ -54,30 +98,8 @@ void Assembler::set_quadrature_cells(const double *lo, const double *hi, const i
       throw Error(MFREE_ERR_INPUT, "cell box axis " + std::to_string(c) + " needs finite lo < hi");
     if (ncells[c] < 1) throw Error(MFREE_ERR_ARG, "ncells must be >= 1");
   }
-  std::vector<double> g, gw;
-  gauss_legendre(ngauss, g, gw);
   HVec<double> x, w;
-  int64_t total = 1;
-  for (int c = 0; c < dim_; ++c) total *= static_cast<int64_t>(ncells[c]) * ngauss;
-  if (total > (int64_t(1) << 31) - 1) throw Error(MFREE_ERR_ARG, "too many quadrature points");
-  double h[3] = {0, 0, 0};
-  for (int c = 0; c < dim_; ++c) h[c] = (hi[c] - lo[c]) / ncells[c];
-  int64_t idx[3] = {0, 0, 0}, per[3] = {1, 1, 1};
-  for (int c = 0; c < dim_; ++c) per[c] = static_cast<int64_t>(ncells[c]) * ngauss;
-  for (int64_t t = 0; t < total; ++t) {
-    int64_t r = t;
-    double p[3] = {0, 0, 0}, wt = 1.0;
-    for (int c = 0; c < dim_; ++c) {
-      idx[c] = r % per[c];
-      r /= per[c];
-      const int64_t cell = idx[c] / ngauss, q = idx[c] % ngauss;
-      p[c] = lo[c] + h[c] * (cell + 0.5 * (1.0 + g[q]));
-      wt *= 0.5 * h[c] * gw[q];
-    }
-    if (inside && !inside(user, p)) continue;
-    for (int c = 0; c < dim_; ++c) x.push_back(p[c]);
-    w.push_back(wt);
-  }
+  cell_rule(dim_, lo, hi, ncells, ngauss, inside, user, x, w);
   qx_ = std::move(x);
   qw_ = std::move(w);
   quad_kind_ = 1;
@@ -136,9 +158,9 @@ void Assembler::build_qtables() {
   };
   shear(trial_shear_.get(), qtrial_);
   if (test_q_) shear(test_shear_.get(), qtest_);
-  if (fe_.npe) {
-    blend_qtable(qtrial_, nodal ? nullptr : &qx_);
-    if (test_q_) blend_qtable(qtest_, nodal ? nullptr : &qx_);
+  if (fe_.npe()) {
+    fe_.blend(qtrial_, nodal ? nullptr : &qx_);
+    if (test_q_) fe_.blend(qtest_, nodal ? nullptr : &qx_);
   }
   // boundary point sets: the same blending, so that boundary terms inside the layer use
   // the layer's functions
@@ -148,11 +170,11 @@ void Assembler::build_qtables() {
     PointSet &s = *psets_[i];
     if (s.test) {
       fill_qtable(*s.test, ps_test_[i], &s.w, &s.x);
-      if (fe_.npe) blend_qtable(ps_test_[i], &s.x);
+      if (fe_.npe()) fe_.blend(ps_test_[i], &s.x);
     }
     if (s.trial) {
       fill_qtable(*s.trial, ps_trial_[i], &s.w, &s.x);
-      if (fe_.npe) blend_qtable(ps_trial_[i], &s.x);
+      if (fe_.npe()) fe_.blend(ps_trial_[i], &s.x);
     }
   }
   // variationally consistent integration: the test gradients of the assembly corrected
@@ -163,7 +185,7 @@ void Assembler::build_qtables() {
       qtest_ = qtrial_;
       own_test_table_ = true;
     }
-    correct_test_gradients(qtest_, ps_test_[i], psets_[i]->normals);
+    correct_test_gradients(*ps_, qtest_, ps_test_[i], psets_[i]->normals);
   }
 }
 
@@ -177,6 +199,32 @@ void Assembler::quadrature_order() {
     const int64_t *gid = ps_->global_ids();
     std::sort(qorder_.begin(), qorder_.end(), [gid](int32_t a, int32_t b) { return gid[a] < gid[b]; });
   }
+}
+
+void Assembler::set_consistent_integration(int32_t npts, const double *x, int layout, int64_t ld,
+                                           const double *w, const double *normals) {
+  if (collocation() || mass())
+    throw Error(MFREE_ERR_UNSUPPORTED, "consistent integration corrects test gradients of Galerkin stiffness forms");
+  if (is_particles_only(test_cfg_.method))
+    throw Error(MFREE_ERR_UNSUPPORTED, "consistent integration needs test-function values at boundary points, which "
+                                       "symmetrised SPH, Johnson-Beissel and Randles-Libersky do not define");
+  check_points(npts, x, w, "consistent integration");
+  if (npts > 0 && !w) throw Error(MFREE_ERR_NULL, "consistent integration: weights are NULL");
+  if (npts > 0 && !normals) throw Error(MFREE_ERR_NULL, "consistent integration: normals are NULL");
+  check_unit_normals(npts, normals, "consistent integration: ");
+  std::unique_ptr<PointSet> s;
+  if (npts > 0) {
+    s = std::make_unique<PointSet>();
+    s->kind = 5;
+    read_points(npts, x, layout, ld, s->x);
+    s->w.assign(w, w + npts);
+    s->normals.assign(normals, normals + static_cast<size_t>(npts) * dim_);
+  }
+  psets_.reserve(psets_.size() + 1);  // the last allocation: nothing below may fail
+  psets_.erase(std::remove_if(psets_.begin(), psets_.end(), [](const std::unique_ptr<PointSet> &q) { return q->kind == 5; }),
+               psets_.end());
+  if (s) psets_.push_back(std::move(s));
+  setup_done_ = false;
 }
 
 }  // namespace mfree

@@ -67,9 +67,12 @@ static void check_boundary_pieces(int dim, int want_dim, int32_t count, const do
       throw Error(MFREE_ERR_INPUT, std::string(what) + " " + std::to_string(k / ncoord) + " is not finite");
 }
 
-void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss, mfree_field_fn t, void *user) {
-  check_boundary_pieces(dim_, 2, nseg, x, 4, ngauss, "segment", "facets");
-  std::vector<double> g, gw, pts, w;
+namespace {
+
+// Gauss-Legendre rule (ngauss points) on each segment (a, b) of x (4 numbers each): points
+// (2 per point) and weights.
+void segment_rule(int32_t nseg, const double *x, int ngauss, std::vector<double> &pts, std::vector<double> &w) {
+  std::vector<double> g, gw;
   gauss_legendre(ngauss, g, gw);
   for (int32_t s = 0; s < nseg; ++s) {
     const double *a = x + 4 * s, *b = a + 2;
@@ -82,14 +85,14 @@ void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss,
       w.push_back(0.5 * len * gw[q]);
     }
   }
-  add_traction(static_cast<int32_t>(w.size()), pts.data(), MFREE_LAYOUT_AOS, 2, w.data(), t, user);
 }
 
-void Assembler::add_traction_facets(int32_t nfacet, const double *x, int ngauss, mfree_field_fn t, void *user) {
-  check_boundary_pieces(dim_, 3, nfacet, x, 9, ngauss, "facet", "segments");
+// Rule with ngauss^2 points on each triangle (a, b, c) of x (9 numbers each): points (3 per
+// point) and weights.
+void facet_rule(int32_t nfacet, const double *x, int ngauss, std::vector<double> &pts, std::vector<double> &w) {
   // Collapsed (Duffy) product rule: (xi, eta) = (u, v (1 - u)) with Gauss-Legendre in u
   // and v on [0, 1]; dA = |(b - a) x (c - a)| (1 - u) du dv.
-  std::vector<double> g, gw, pts, w;
+  std::vector<double> g, gw;
   gauss_legendre(ngauss, g, gw);
   for (int32_t f = 0; f < nfacet; ++f) {
     const double *a = x + 9 * f, *b = a + 3, *c = a + 6;
@@ -110,6 +113,21 @@ void Assembler::add_traction_facets(int32_t nfacet, const double *x, int ngauss,
       }
     }
   }
+}
+
+}  // namespace
+
+void Assembler::add_traction_segments(int32_t nseg, const double *x, int ngauss, mfree_field_fn t, void *user) {
+  check_boundary_pieces(dim_, 2, nseg, x, 4, ngauss, "segment", "facets");
+  std::vector<double> pts, w;
+  segment_rule(nseg, x, ngauss, pts, w);
+  add_traction(static_cast<int32_t>(w.size()), pts.data(), MFREE_LAYOUT_AOS, 2, w.data(), t, user);
+}
+
+void Assembler::add_traction_facets(int32_t nfacet, const double *x, int ngauss, mfree_field_fn t, void *user) {
+  check_boundary_pieces(dim_, 3, nfacet, x, 9, ngauss, "facet", "segments");
+  std::vector<double> pts, w;
+  facet_rule(nfacet, x, ngauss, pts, w);
   add_traction(static_cast<int32_t>(w.size()), pts.data(), MFREE_LAYOUT_AOS, 3, w.data(), t, user);
 }
 

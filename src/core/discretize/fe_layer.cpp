@@ -1,25 +1,25 @@
-// The finite-element layer along the essential boundary (paper 000 eqs 100-105).
-#include "core/discretize/assembler.hpp"
+#include "core/discretize/fe_layer.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <string>
+#include <vector>
 
+#include "core/base/error.hpp"
 #include "core/shape/fe_shape.hpp"
+#include "mfree.h"
 
 namespace mfree {
 
-void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, int32_t ngu, const int32_t *gu,
-                             int32_t mask, mfree_field_fn g, void *user) {
-  if (dim_ != 2) throw Error(MFREE_ERR_UNSUPPORTED, "the finite-element layer is implemented in 2D");
-  if (collocation() || mass()) throw Error(MFREE_ERR_UNSUPPORTED, "the finite-element layer is for Galerkin forms");
+void FeLayer::check_arguments(int32_t nelem, int32_t npe, const int32_t *conn, int32_t ngu, const int32_t *gu) {
   if (npe != 3 && npe != 4) throw Error(MFREE_ERR_ARG, "elements must have 3 (triangle) or 4 (quadrilateral) nodes");
   if (nelem < 1 || ngu < 1) throw Error(MFREE_ERR_ARG, "the layer needs elements and essential-boundary nodes");
   if (!conn || !gu) throw Error(MFREE_ERR_NULL, "connectivity or boundary nodes are NULL");
-  if (!g) throw Error(MFREE_ERR_NULL, "boundary value function is NULL");
-  if (mask <= 0 || mask >= (1 << ncomp_)) throw Error(MFREE_ERR_ARG, "component mask selects no valid component");
-  if (fe_.npe && fe_.npe != npe)
-    throw Error(MFREE_ERR_ARG, "the layer already has elements with " + std::to_string(fe_.npe) +
+}
+
+void FeLayer::add(int32_t nelem, int32_t npe, const int32_t *conn, int32_t ngu, const int32_t *gu) {
+  check_arguments(nelem, npe, conn, ngu, gu);
+  if (npe_ && npe_ != npe)
+    throw Error(MFREE_ERR_ARG, "the layer already has elements with " + std::to_string(npe_) +
                                    " nodes; every call must use the same element type");
   // (the orientation check below reads the positions)
   if (!ps_->pos_data()) throw Error(MFREE_ERR_STATE, "the particle set has no positions");
@@ -27,26 +27,26 @@ void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, in
   // Calls accumulate: elements of every call form one layer (the blending sees all of
   // them) and each call's boundary nodes get its own component mask, so symmetry lines
   // with different constrained components are one layer.
-  FeLayer fe = fe_;
-  fe.npe = npe;
-  const size_t first = fe.conn.size();
-  fe.conn.insert(fe.conn.end(), conn, conn + static_cast<size_t>(nelem) * npe);
-  fe.on_gu.resize(ps_->size(), 0);
-  fe.in_layer.resize(ps_->size(), 0);
+  FeLayer fe = *this;
+  fe.npe_ = npe;
+  const size_t first = fe.conn_.size();
+  fe.conn_.insert(fe.conn_.end(), conn, conn + static_cast<size_t>(nelem) * npe);
+  fe.on_gu_.resize(ps_->size(), 0);
+  fe.in_layer_.resize(ps_->size(), 0);
   for (int32_t k = 0; k < nelem * npe; ++k) {
     if (conn[k] < 0 || conn[k] >= n)
       throw Error(MFREE_ERR_INPUT, "element " + std::to_string(k / npe) + " refers to particle " +
                                        std::to_string(conn[k]) + ", not an owned particle");
-    fe.in_layer[conn[k]] = 1;
+    fe.in_layer_[conn[k]] = 1;
   }
   for (int32_t k = 0; k < ngu; ++k) {
-    if (gu[k] < 0 || gu[k] >= n || !fe.in_layer[gu[k]])
+    if (gu[k] < 0 || gu[k] >= n || !fe.in_layer_[gu[k]])
       throw Error(MFREE_ERR_INPUT, "essential-boundary node " + std::to_string(gu[k]) + " is not a layer node");
-    fe.on_gu[gu[k]] = 1;
+    fe.on_gu_[gu[k]] = 1;
   }
   // orientation: positive Jacobian at every corner (counter-clockwise, not degenerate)
   for (int32_t e = 0; e < nelem; ++e) {
-    const int32_t *c = &fe.conn[first + static_cast<size_t>(e) * npe];
+    const int32_t *c = &fe.conn_[first + static_cast<size_t>(e) * npe];
     double xmin[2] = {1e300, 1e300}, xmax[2] = {-1e300, -1e300}, X[4 * 3] = {0};
     for (int a = 0; a < npe; ++a)
       for (int d = 0; d < 2; ++d) X[3 * a + d] = ps_->x(c[a], d);
@@ -61,26 +61,17 @@ void Assembler::set_fe_layer(int32_t nelem, int32_t npe, const int32_t *conn, in
     }
     for (int d = 0; d < 2; ++d) {
       const double pad = 1e-10 * (xmax[d] - xmin[d] + 1.0);
-      fe.bmin.push_back(xmin[d] - pad);
-      fe.bmax.push_back(xmax[d] + pad);
+      fe.bmin_.push_back(xmin[d] - pad);
+      fe.bmax_.push_back(xmax[d] + pad);
     }
   }
-  NodeSet ns;
-  ns.kind = 3;
-  ns.nodes.assign(gu, gu + ngu);
-  ns.mask = mask;
-  ns.fn = g;
-  ns.user = user;
-  nsets_.reserve(nsets_.size() + 1);  // the last allocation: nothing below may fail
-  fe_ = std::move(fe);
-  nsets_.push_back(std::move(ns));
-  setup_done_ = false;
+  *this = std::move(fe);
 }
 
-bool Assembler::fe_shape(int32_t e, const double *x, double *N, double *dN) const {
-  const int npe = fe_.npe;
-  const int32_t *c = &fe_.conn[static_cast<size_t>(e) * npe];
-  if (x[0] < fe_.bmin[2 * e] || x[0] > fe_.bmax[2 * e] || x[1] < fe_.bmin[2 * e + 1] || x[1] > fe_.bmax[2 * e + 1])
+bool FeLayer::shape(int32_t e, const double *x, double *N, double *dN) const {
+  const int npe = npe_;
+  const int32_t *c = &conn_[static_cast<size_t>(e) * npe];
+  if (x[0] < bmin_[2 * e] || x[0] > bmax_[2 * e] || x[1] < bmin_[2 * e + 1] || x[1] > bmax_[2 * e + 1])
     return false;
   double X[4 * 3] = {0};
   for (int a = 0; a < npe; ++a)
@@ -92,9 +83,9 @@ bool Assembler::fe_shape(int32_t e, const double *x, double *N, double *dN) cons
 // R = sum of the FE functions of the interface nodes; at nodal quadrature points on the
 // essential boundary the functions are the FE ones, the node's volume split among its
 // elements (the Figure 2 procedure).
-void Assembler::blend_qtable(QTable &t, const HVec<double> *pts) const {
-  const int npe = fe_.npe;
-  const int32_t nelem = static_cast<int32_t>(fe_.conn.size() / npe);
+void FeLayer::blend(QTable &t, const HVec<double> *pts) const {
+  const int npe = npe_;
+  const int32_t nelem = static_cast<int32_t>(conn_.size() / npe);
   QTable out;
   out.rowptr.assign(1, 0);
   double N[4], dN[8];
@@ -119,22 +110,22 @@ void Assembler::blend_qtable(QTable &t, const HVec<double> *pts) const {
     grad.assign(t.grad.begin() + 2 * k0, t.grad.begin() + 2 * k1);
     if (has_s) sgrad.assign(t.sgrad.begin() + 2 * k0, t.sgrad.begin() + 2 * k1);
     if (!pts) {
-      if (!fe_.on_gu[q]) {
+      if (!on_gu_[q]) {
         push(t.w[q]);
         continue;
       }
       std::vector<int32_t> elems;
       for (int32_t e = 0; e < nelem; ++e)
         for (int a = 0; a < npe; ++a)
-          if (fe_.conn[static_cast<size_t>(e) * npe + a] == q) elems.push_back(e);
+          if (conn_[static_cast<size_t>(e) * npe + a] == q) elems.push_back(e);
       const double x[2] = {ps_->x(q, 0), ps_->x(q, 1)};
       for (int32_t e : elems) {
-        fe_shape(e, x, N, dN);
+        shape(e, x, N, dN);
         cols.clear();
         val.clear();
         grad.clear();
         for (int a = 0; a < npe; ++a) {
-          cols.push_back(fe_.conn[static_cast<size_t>(e) * npe + a]);
+          cols.push_back(conn_[static_cast<size_t>(e) * npe + a]);
           val.push_back(N[a]);
           grad.push_back(dN[2 * a]);
           grad.push_back(dN[2 * a + 1]);
@@ -147,15 +138,15 @@ void Assembler::blend_qtable(QTable &t, const HVec<double> *pts) const {
     const double x[2] = {(*pts)[2 * static_cast<size_t>(q)], (*pts)[2 * static_cast<size_t>(q) + 1]};
     int32_t e = 0;
     for (; e < nelem; ++e)
-      if (fe_shape(e, x, N, dN)) break;
+      if (shape(e, x, N, dN)) break;
     if (e == nelem) {
       push(t.w[q]);
       continue;
     }
-    const int32_t *c = &fe_.conn[static_cast<size_t>(e) * npe];
+    const int32_t *c = &conn_[static_cast<size_t>(e) * npe];
     double R = 0.0, gR[2] = {0, 0};
     for (int a = 0; a < npe; ++a)
-      if (!fe_.on_gu[c[a]]) {
+      if (!on_gu_[c[a]]) {
         R += N[a];
         gR[0] += dN[2 * a];
         gR[1] += dN[2 * a + 1];

@@ -1,43 +1,10 @@
-// Variationally consistent integration (Chen, Hillman, Rueter 2013) of the test gradients.
-#include "core/discretize/assembler.hpp"
+#include "core/discretize/consistent_integration.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <string>
+#include <vector>
 
 namespace mfree {
-
-void Assembler::set_consistent_integration(int32_t npts, const double *x, int layout, int64_t ld,
-                                           const double *w, const double *normals) {
-  if (collocation() || mass())
-    throw Error(MFREE_ERR_UNSUPPORTED, "consistent integration corrects test gradients of Galerkin stiffness forms");
-  if (is_particles_only(test_cfg_.method))
-    throw Error(MFREE_ERR_UNSUPPORTED, "consistent integration needs test-function values at boundary points, which "
-                                       "symmetrised SPH, Johnson-Beissel and Randles-Libersky do not define");
-  check_points(npts, x, w, "consistent integration");
-  if (npts > 0 && !w) throw Error(MFREE_ERR_NULL, "consistent integration: weights are NULL");
-  if (npts > 0 && !normals) throw Error(MFREE_ERR_NULL, "consistent integration: normals are NULL");
-  for (int32_t p = 0; p < npts; ++p) {
-    double len = 0.0;
-    for (int c = 0; c < dim_; ++c) len += normals[p * dim_ + c] * normals[p * dim_ + c];
-    if (!(std::isfinite(len) && std::fabs(len - 1.0) < 1e-6))
-      throw Error(MFREE_ERR_INPUT, "consistent integration: normal " + std::to_string(p) +
-                                       " is not a finite unit vector");
-  }
-  std::unique_ptr<PointSet> s;
-  if (npts > 0) {
-    s = std::make_unique<PointSet>();
-    s->kind = 5;
-    read_points(npts, x, layout, ld, s->x);
-    s->w.assign(w, w + npts);
-    s->normals.assign(normals, normals + static_cast<size_t>(npts) * dim_);
-  }
-  psets_.reserve(psets_.size() + 1);  // the last allocation: nothing below may fail
-  psets_.erase(std::remove_if(psets_.begin(), psets_.end(), [](const std::unique_ptr<PointSet> &q) { return q->kind == 5; }),
-               psets_.end());
-  if (s) psets_.push_back(std::move(s));
-  setup_done_ = false;
-}
 
 // Chen, Hillman and Rueter (IJNME 93, 2013): with the corrected gradients
 // grad Psi_J + C_J p(x) at the quadrature points of J's support, p = (1, (x - x_J) / h_J),
@@ -47,14 +14,14 @@ void Assembler::set_consistent_integration(int32_t npts, const double *x, int la
 // whatever the quadrature (nodal, or the layer's strip sampled at its two edges), and
 // the integration error of linear stress fields is removed too. A support whose moment
 // matrix is singular (too few points) gets the constant correction only.
-void Assembler::correct_test_gradients(QTable &t, const QTable &b, const HVec<double> &normals) const {
-  const int dim = dim_, np = 1 + dim;
-  const int32_t n = ps_->size();
+void correct_test_gradients(const ParticleSet &ps, QTable &t, const QTable &b, const HVec<double> &normals) {
+  const int dim = ps.dim(), np = 1 + dim;
+  const int32_t n = ps.size();
   std::vector<double> M(static_cast<size_t>(n) * np * np, 0.0), R(static_cast<size_t>(n) * np * dim, 0.0);
   auto basis = [&](int32_t J, const double *x, double *P) {
-    const double h = ps_->h(J);
+    const double h = ps.h(J);
     P[0] = 1.0;
-    for (int d = 0; d < dim; ++d) P[1 + d] = (x[d] - ps_->x(J, d)) / h;
+    for (int d = 0; d < dim; ++d) P[1 + d] = (x[d] - ps.x(J, d)) / h;
   };
   double P[4];
   for (int32_t p = 0; p < b.size(); ++p)
@@ -69,7 +36,7 @@ void Assembler::correct_test_gradients(QTable &t, const QTable &b, const HVec<do
   for (int32_t q = 0; q < t.size(); ++q)
     for (int64_t a = t.rowptr[q]; a < t.rowptr[q + 1]; ++a) {
       const int32_t J = t.cols[a];
-      const double w = t.w[q], hinv = 1.0 / ps_->h(J);
+      const double w = t.w[q], hinv = 1.0 / ps.h(J);
       basis(J, &t.x[static_cast<size_t>(q) * dim], P);
       double *m = &M[static_cast<size_t>(J) * np * np];
       for (int k = 0; k < np; ++k)
