@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/base/kernel.hpp"
 #include "core/discretize/unknowns.h"
 #include "core/particles/neighbors.hpp"
 
@@ -96,6 +97,7 @@ std::vector<double> Assembler::point_supports(const HVec<double> &pts) const {
   H.stride = 0;
   Csr nb;
   find_point_neighbors(*ps_, ps_->site_status(), m, X, H, nb);
+  const Kernel spline(MFREE_KERNEL_CUBIC_SPLINE, dim_, 0.0);
   std::vector<double> h(m, hmax);
   for (int32_t q = 0; q < m; ++q) {
     double best = HUGE_VAL, sw = 0.0, swh = 0.0;
@@ -109,8 +111,7 @@ std::vector<double> Assembler::point_supports(const HVec<double> &pts) const {
       const double hj = ps_->h(j), u = 2.0 * std::sqrt(d2) / (kappa * hj);
       if (d2 < best) best = d2, h[q] = hj;
       if (u >= 2.0) continue;
-      const double f = u < 1.0 ? 1.0 - 1.5 * u * u + 0.75 * u * u * u : 0.25 * (2.0 - u) * (2.0 - u) * (2.0 - u);
-      const double w = f / std::pow(hj, dim_);
+      const double w = spline.shape(u) / std::pow(hj, dim_);
       sw += w;
       swh += w * hj;
     }
