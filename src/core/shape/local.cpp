@@ -11,15 +11,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/base/small_dense.hpp"
+
 namespace mfree {
 
 using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxBasis, kMaxBasis>;
 using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxBasis, 1>;
 
 namespace {
-
-// A local system whose reciprocal condition estimate falls below this is singular.
-constexpr double kMinRcond = 1e-12;
 
 struct Site {
   const LocalConfig &cfg;
@@ -120,41 +119,34 @@ int shepard(Site &s, bool write) {
   return 0;
 }
 
-// Ratio of the smallest to the largest pivot magnitude of a factorisation.
-template <class V>
-double pivot_ratio(const V &piv) {
-  const double big = piv.cwiseAbs().maxCoeff(), small = piv.cwiseAbs().minCoeff();
-  return big > 0.0 ? small / big : 0.0;
-}
+// The pivots of a factorisation, for the condition rule (base/small_dense.hpp).
 template <class M>
-double pivots(const Eigen::LDLT<M> &f) { return pivot_ratio(f.vectorD()); }
+Vec pivots(const Eigen::LDLT<M> &f) { return f.vectorD(); }
 template <class M>
-double pivots(const Eigen::PartialPivLU<M> &f) { return pivot_ratio(f.matrixLU().diagonal()); }
+Vec pivots(const Eigen::PartialPivLU<M> &f) { return f.matrixLU().diagonal(); }
 
-// The reciprocal 1-norm condition number 1 / (||A||_1 ||A^-1||_1), exact: the systems
-// are small (L <= 20), so the inverse costs a few solves, and the fast path
-// (shape_fast.cpp), which has the inverse anyway, gets the same number from one column
-// sum (Eigen's rcond() estimate, a lower bound of ||A^-1||_1, cost the fast path a tenth
-// of an MLS setup). It is blind to an exactly zero pivot (1 for [[1,0],[0,0]] when the
-// solve does not overflow), so the smaller of it and the pivot ratio decides.
-template <class MatA, class Solver>
-double rcond_exact(const MatA &A, const Solver &solver) {
-  const Eigen::Index L = A.rows();
-  const double anorm = A.cwiseAbs().colwise().sum().maxCoeff();
-  if (anorm == 0.0) return 0.0;
-  if (L == 1) return 1.0;
-  const MatA X = solver.solve(MatA::Identity(L, L));
-  const double xnorm = X.cwiseAbs().colwise().sum().maxCoeff();
-  return xnorm == 0.0 ? 0.0 : (1.0 / xnorm) / anorm;
-}
-
+// The condition rule of base/small_dense.hpp with ||A^-1||_1 exact: the systems are small
+// (L <= 20), so the inverse costs a few solves, and the fast path, which has the inverse
+// anyway, gets the same number from one column sum (Eigen's rcond() estimate, a lower
+// bound of ||A^-1||_1, would make the two paths disagree).
+//
+// The reference path factorises with Eigen (LDLT, PartialPivLU), not with the fixed-size
+// factorisations of small_dense.hpp that the fast path uses: it is the oracle the fast
+// path is checked against (statuses, condition numbers and tables to round-off), and an
+// independent factorisation keeps a fault in the hand-written one visible there. What the
+// two paths must share, the threshold and the rule, is defined once, in small_dense.hpp.
 template <class MatA, class Solver>
 bool check_rcond(Site &s, const MatA &A, const Solver &solver) {
-  double rc = rcond_exact(A, solver);
-  if (!std::isfinite(rc)) rc = 0.0;
-  rc = std::min(rc, pivots(solver));
-  s.out.cond = rc > 0.0 ? 1.0 / rc : INFINITY;
-  return rc >= kMinRcond;
+  const Eigen::Index L = A.rows();
+  const double anorm = A.cwiseAbs().colwise().sum().maxCoeff();
+  double xnorm = 0.0;
+  if (anorm != 0.0 && L > 1) {
+    const MatA X = solver.solve(MatA::Identity(L, L));
+    xnorm = X.cwiseAbs().colwise().sum().maxCoeff();
+  }
+  const Vec piv = pivots(solver);
+  return dense::condition_ok(dense::rcond_from_norms(anorm, xnorm, static_cast<int>(L)),
+                             dense::pivot_ratio(piv.data(), static_cast<int>(L)), s.out.cond);
 }
 
 // Moving least squares (MLS, weights w) and RKPM (weights w V), order k, with true

@@ -18,9 +18,10 @@
 #include <cstring>
 #include <type_traits>
 
+#include "core/base/simd.hpp"
+#include "core/base/small_dense.hpp"
 #include "core/shape/local.hpp"
 #include "core/shape/shape_fast_mls1.hpp"
-#include "core/base/simd.hpp"
 
 #if MFREE_SIMD_X86
 #include <immintrin.h>

@@ -1,21 +1,65 @@
-// Small dense inverses of the fast path, with the general path's condition test.
-// Part of the fast path's row kernels: included by shape_fast_rows.inc, which
-// shape_fast.cpp includes twice (baseline and AVX2 + FMA, each copy in its own
-// namespace), so no #include and no external linkage here.
-// NOLINT(build/header_guard): included twice on purpose.
+// Small dense solves of the local systems (moment matrices, correction matrices): the one
+// condition threshold and condition rule of the library, the one pivoted LDL^T of
+// symmetric positive definite matrices, Gauss-Jordan with partial pivoting of general
+// ones, and the 2x2 and 3x3 closed forms.
+//
+// The condition rule: rc = min(1 / (||A||_1 ||A^-1||_1), ratio of the smallest to the
+// largest |pivot| of the pivoted factorisation that solved A); the system is singular
+// when rc < kMinRcond, and its condition number is reported as 1 / rc. The 1-norm
+// product alone is blind to an exactly zero pivot (it is 1 for [[1,0],[0,0]] when the
+// solve does not overflow), hence the pivot ratio. The fixed-size inverses below apply
+// it with the 1-norm of their explicit inverse; the reference path (shape/local.cpp)
+// applies it to Eigen's factorisations (see there why it keeps them).
+//
+// The fixed-size functions are always inlined so that every caller compiles them for its
+// own target (the fast path's AVX2 + FMA copy included, simd.hpp): a caller that wants
+// one out-of-line instance per copy wraps them in a function of its own region.
+#pragma once
 
-// As in local.cpp: a local system whose reciprocal condition number is below this is
-// singular (the site then goes to the general path, which decides and reports).
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "core/base/simd.hpp"
+
+// (the same definition as the fast path's: fully unrolled loops of compile-time length)
+#ifndef MFREE_UNROLL
+#define MFREE_UNROLL _Pragma("GCC unroll 64")
+#endif
+
+namespace mfree {
+namespace dense {
+
+// A local system whose reciprocal condition number is below this is singular.
 constexpr double kMinRcond = 1e-12;
 
-// ---------------------------------------------------------------------------------------
-// Small dense inverses, with the general path's singularity test and condition number
-// (local.cpp check_rcond): rc = min(1 / (||A||_1 ||A^-1||_1), ratio of the smallest to
-// the largest pivot of the same pivoted factorisation), singular below kMinRcond,
-// reported as 1 / rc. The 1-norm of the explicit inverse is one column sum here; the
-// general path solves for the inverse to get the same number.
+// 1 / (||A||_1 ||A^-1||_1) of an L x L matrix from the two norms; 0 for a zero matrix,
+// 1 for L = 1 (a positive 1 x 1 system is perfectly conditioned).
+MFREE_ALWAYS_INLINE double rcond_from_norms(double anorm, double xnorm, int L) {
+  if (anorm == 0.0) return 0.0;
+  if (L == 1) return 1.0;
+  return xnorm == 0.0 ? 0.0 : (1.0 / xnorm) / anorm;
+}
 
-// (inlined: KB 1's 3x3 inverse calls it twice per site)
+// The smallest over the largest |pivot| of L pivots (0 when all are zero).
+MFREE_ALWAYS_INLINE double pivot_ratio(const double *piv, int L) {
+  double big = 0.0, small = INFINITY;
+  for (int k = 0; k < L; ++k) {
+    big = std::max(big, std::fabs(piv[k]));
+    small = std::min(small, std::fabs(piv[k]));
+  }
+  return big > 0.0 ? small / big : 0.0;
+}
+
+// The condition rule (top of this file): cond = 1 / rc, true when the system is regular.
+MFREE_ALWAYS_INLINE bool condition_ok(double rc_norms, double pivots, double &cond) {
+  double rc = std::isfinite(rc_norms) ? rc_norms : 0.0;
+  rc = std::min(rc, pivots);
+  cond = rc > 0.0 ? 1.0 / rc : INFINITY;
+  return rc >= kMinRcond;
+}
+
+// ||A||_1, the largest column sum of |A|.
 template <int L>
 MFREE_ALWAYS_INLINE double norm1(const double (&A)[L][L]) {
   double big = 0.0;
@@ -29,34 +73,22 @@ MFREE_ALWAYS_INLINE double norm1(const double (&A)[L][L]) {
   return big;
 }
 
-// matrix_norm = ||A||_1, piv = the factorisation's pivots.
+// The condition rule for an explicit inverse X of A (matrix_norm = ||A||_1) and the
+// pivots of the factorisation that gave it.
 template <int L>
-bool accept(double matrix_norm, const double (&X)[L][L], const double *piv, double &cond) {
-  double rc;
-  if (matrix_norm == 0.0) {
-    rc = 0.0;
-  } else if (L == 1) {
-    rc = 1.0;
-  } else {
-    const double inv = norm1<L>(X);  // exact, from the explicit inverse
-    rc = inv == 0.0 ? 0.0 : (1.0 / inv) / matrix_norm;
-  }
-  if (!std::isfinite(rc)) rc = 0.0;
-  double big = 0.0, small = INFINITY;
-  for (int k = 0; k < L; ++k) {
-    big = std::max(big, std::fabs(piv[k]));
-    small = std::min(small, std::fabs(piv[k]));
-  }
-  rc = std::min(rc, big > 0.0 ? small / big : 0.0);
-  cond = rc > 0.0 ? 1.0 / rc : INFINITY;
-  return rc >= kMinRcond;
+MFREE_ALWAYS_INLINE bool accept(double matrix_norm, const double (&X)[L][L], const double *piv,
+                                double &cond) {
+  // (||A^-1||_1 is exact here: one column sum of the explicit inverse)
+  const double xnorm = (matrix_norm == 0.0 || L == 1) ? 0.0 : norm1<L>(X);
+  return condition_ok(rcond_from_norms(matrix_norm, xnorm, L), pivot_ratio(piv, L), cond);
 }
 
 // Symmetric positive definite A (moment matrices of non-negative weights): LDL^T with
-// Eigen's diagonal pivoting (largest remaining original diagonal first), X = A^-1.
-// False when a pivot is not positive (the general path then decides) or the test fails.
+// Eigen's diagonal pivoting (largest remaining original diagonal first, so that the pivots
+// and the condition number are those of Eigen::LDLT to round-off), X = A^-1. False when a
+// pivot is not positive or the condition rule fails.
 template <int L>
-bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
+MFREE_ALWAYS_INLINE bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
   int p[L];
   double dg[L];
   MFREE_UNROLL
@@ -137,9 +169,9 @@ bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
 }
 
 // General A (the corrected-derivative systems): Gauss-Jordan with partial pivoting (the
-// pivots of Eigen's PartialPivLU).
+// pivots of Eigen's PartialPivLU), X = A^-1.
 template <int L>
-bool gen_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
+MFREE_ALWAYS_INLINE bool gen_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
   double W[L][L], piv[L];
   for (int a = 0; a < L; ++a)
     for (int b = 0; b < L; ++b) {
@@ -231,9 +263,13 @@ MFREE_ALWAYS_INLINE bool inverse3(const double (&A)[3][3], double (&X)[3][3], do
   return cond <= 1.0 / kMinRcond;  // false for inf and NaN
 }
 
+// The inverse of a D x D general matrix: the closed forms for D = 2, 3.
 template <int D>
 MFREE_ALWAYS_INLINE bool small_inverse(const double (&A)[D][D], double (&X)[D][D], double &cond) {
   if constexpr (D == 2) return inverse2(A, X, cond);
   else if constexpr (D == 3) return inverse3(A, X, cond);
   else return gen_inverse<D>(A, X, cond);
 }
+
+}  // namespace dense
+}  // namespace mfree
