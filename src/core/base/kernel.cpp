@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/base/error.hpp"
+#include "core/base/kernel_eval.hpp"
 #include "core/base/quadrature.hpp"
 
 namespace mfree {
@@ -87,18 +88,20 @@ void Kernel::shape(double q, double &f, double &df, double &d2f) const {
   if (q > radius_ * (1.0 + kEdgeTol)) return;
   if (q > radius_) q = radius_;  // on the edge: the value from inside (closed support)
   switch (id_) {
-    case MFREE_KERNEL_CUBIC_SPLINE:
+    case MFREE_KERNEL_CUBIC_SPLINE: {  // inlined by the fast paths too (kernel_eval.hpp)
+      using S = CubicSplineShape;
       if (q < 1.0) {
-        f = 1.0 - 1.5 * q * q + 0.75 * q * q * q;
-        df = -3.0 * q + 2.25 * q * q;
-        d2f = -3.0 + 4.5 * q;
+        f = S::inner(q);
+        df = S::inner_d(q);
+        d2f = S::inner_d2(q);
       } else {
-        const double t = 2.0 - q;
-        f = 0.25 * t * t * t;
-        df = -0.75 * t * t;
-        d2f = 1.5 * t;
+        const double t = S::kRadius - q;
+        f = S::outer(t);
+        df = S::outer_d(t);
+        d2f = S::outer_d2(t);
       }
       return;
+    }
     case MFREE_KERNEL_QUARTIC:
       f = 1.0 - 1.5 * q * q + q * q * q - 0.1875 * q * q * q * q;
       df = -3.0 * q + 3.0 * q * q - 0.75 * q * q * q;

@@ -18,6 +18,7 @@
 #include <cstring>
 #include <type_traits>
 
+#include "core/base/kernel_eval.hpp"
 #include "core/base/simd.hpp"
 #include "core/base/small_dense.hpp"
 #include "core/shape/local.hpp"
