@@ -126,6 +126,17 @@ class Approximant {
   // more than the machine's memory (alloc.hpp, request_too_large).
   void check_table_size(int64_t nnz) const;
   Report compute(const char *what);
+  // compute's parts: the per-thread scratch of nt threads sized for the longest row; the
+  // fast path's view of the tables and packed records; the general path (local.cpp) of
+  // site s with its fallbacks and the Shepard rule (fast_done: the fast path's result
+  // stands but for the rows), writing the site's rows, record (coef, ncoef doubles;
+  // nullptr when not kept) and results; the message of the first failed site of nfailed.
+  void reserve_scratch(int nt);
+  FastTables fast_tables();
+  struct SiteScratch;
+  void general_site(int32_t s, const LocalConfig &base, bool fast_done, SiteScratch &w, double *coef,
+                    int ncoef);
+  void report_failures(int64_t nfailed, Report &rep) const;
   // Particle (and point) data as SoA arrays for the pattern and the fast path, re-read
   // from the (possibly borrowed) host arrays at every setup and update.
   void pack();
@@ -154,6 +165,13 @@ class Approximant {
   void site_input(int32_t s, double *d, double *v, double *h) const;
   // Pair-list checks shared by pair_gradients and correction (pairs.cpp).
   void check_pairs_ready(const char *what) const;
+  // pair_gradients' three ways (pair_gradients.cpp): SPH's kernel gradient where h_ij is
+  // symmetric, the tables at the pair offsets, and the general case (records, lookups).
+  void pair_gradients_sph(double *gi, double *gj, int64_t ld, bool antisym) const;
+  void pair_gradients_direct(double *gi, double *gj, int64_t ld, bool antisym) const;
+  void pair_gradients_general(double *gi, double *gj, int64_t ld, bool antisym) const;
+  // grad_s W(x_s - x_j, h_sj) into g (3 doubles)
+  void kernel_gradient(int32_t s, int32_t j, double *g) const;
   // The volumes of the last setup/update: particle j's is vol[j * stride].
   const double *packed_volumes(int64_t &stride) const;
   // Whether the method has correction data (correction_size() does not throw).

@@ -38,7 +38,7 @@ Report Approximant::compute(const char *what) {
   const bool fv = flags_ & MFREE_DERIV_VALUE, fg = flags_ & MFREE_DERIV_GRADIENT,
              fh = flags_ & MFREE_DERIV_HESSIAN;
   // same sizes on update: nothing is allocated; every row is written below (by the fast
-  // path or by compute_site, which zeroes failed rows), so no fill is needed
+  // path or by general_site, which zeroes failed rows), so no fill is needed
   val_.resize(fv ? nnz : 0);
   grad_.resize(fg ? nnz * dim : 0);
   hess_.resize(fh ? nnz * nh : 0);
@@ -49,52 +49,15 @@ Report Approximant::compute(const char *what) {
   find_bad_particles();
 
   const LocalConfig base = local_config(fv, fg, fh);
-
-  // Per-thread scratch sized for the longest row before the threads start, so that no
-  // site allocates; sites are split statically and are independent, so the tables do
-  // not depend on the thread count.
   const int nt = num_threads(nsites_);
-  if (scratch_.size() < static_cast<size_t>(nt)) scratch_.resize(nt);
-  const int maxrow = maxrow_;
-  const int maxL = basis_size(dim, std::max(has_order(method_) ? order_ : 1, 1));
-  for (int t = 0; t < nt; ++t) {
-    SiteScratch &w = scratch_[t];
-    const size_t need = static_cast<size_t>(maxrow);
-    if (w.d.size() < 3 * need) w.d.resize(3 * need);
-    if (w.v.size() < need) w.v.resize(need);
-    if (w.h.size() < need) w.h.resize(need);
-    w.work.reserve(maxrow, dim, maxL);
-    w.fast.reserve(maxrow);
-  }
+  reserve_scratch(nt);
   // The specialised path for the common configurations (shape_fast.hpp); a site it
   // cannot finish is recomputed below by the general path with its fallbacks.
   const FastPath fast(dim, method_, order_, *kernel_, flags_);
   FastTables ft;
-  if (fast.ok()) {
-    ft.rowptr = rowptr_.data();
-    ft.cols = cols_.data();
-    ft.self = self_.data();
-    for (int c = 0; c < dim; ++c) {
-      ft.x[c] = pack_.data() + c;
-      ft.sx[c] = points_ ? spack_.data() + c : ft.x[c];
-      ft.periodic[c] = ps_->periodic(c);
-      ft.period[c] = ps_->box_hi(c) - ps_->box_lo(c);
-    }
-    const int64_t PS = record_length(dim);
-    const PackedSupports ph = packed_supports(pack_.data(), dim, ps_->size());
-    ft.vol = pack_.data() + dim;
-    ft.h = ph.h;
-    ft.hstride = ph.stride;
-    ft.sh = points_ ? spack_.data() + dim : ft.h;
-    ft.shstride = points_ ? dim + 1 : ft.hstride;
-    ft.stride = PS;
-    ft.sstride = points_ ? dim + 1 : PS;
-    ft.convention = ps_->search_convention();
-    ft.val = fv ? val_.data() : nullptr;
-    ft.grad = fg ? grad_.data() : nullptr;
-  }
+  if (fast.ok()) ft = fast_tables();
   // The sites' correction records for the pair gradients (pair-list sets): written by
-  // the fast path or compute_site alongside the rows where they can, the rest after
+  // the fast path or general_site alongside the rows where they can, the rest after
   // the rows (a NaN marks a record not written).
   const bool recs = keeps_records();
   const int ncoef = recs ? correction_size() : 0;
@@ -117,7 +80,6 @@ Report Approximant::compute(const char *what) {
   // the sites of a block, then their screening while their rows are still in cache
   auto sites = [&](int t, int64_t b, int64_t e) {
     SiteScratch &w = scratch_[t];
-    LocalConfig cfg = base;
     if (fast.ok()) fast.run(ft, b, e, w.fast, fs);
     for (int32_t s = static_cast<int32_t>(b); s < e; ++s) {
       // a site done by the fast path goes on only when ill-conditioned (set_shepard_condition)
@@ -131,67 +93,7 @@ Report Approximant::compute(const char *what) {
         order_used_[s] = -1;
         continue;
       }
-      const int64_t k0 = rowptr_[s];
-      const int n = static_cast<int>(rowptr_[s + 1] - k0);
-      site_input(s, w.d.data(), w.v.data(), w.h.data());
-      LocalInput in;
-      in.n = n;
-      in.self = self_[s];
-      in.hs = site_h(s);
-      in.d = w.d.data();
-      in.vol = w.v.data();
-      in.h = w.h.data();
-      LocalOutput out;
-      // data() + offset, not &v[k]: the tables are empty when no site has a neighbour
-      out.phi = fv ? val_.data() + k0 : nullptr;
-      out.grad = fg ? grad_.data() + k0 * dim : nullptr;
-      out.hess = fh ? hess_.data() + k0 * nh : nullptr;
-      out.coef = recs ? records_.data() + int64_t{s} * ncoef : nullptr;
-      cfg.method = method_;
-      cfg.order = order_;
-      if (fast_done) {  // the fast path's result stands but for the rows
-        out.status = 0;
-        out.cond = cond_[s];
-      } else {
-        compute_site(cfg, in, w.work, out);
-      }
-      if (out.status && fallback_ == MFREE_FALLBACK_LOWER_ORDER) {
-        const int first_status = out.status;
-        const double first_cond = out.cond;
-        // A site that falls back gets a record of zeros (mfree.h): a lower order's or
-        // Shepard's record has another layout, and Shepard's (1 + dim values) is longer
-        // than Johnson-Beissel's or Randles-Libersky's, so it would run into the next one.
-        if (out.coef) std::fill_n(out.coef, ncoef, 0.0);
-        out.coef = nullptr;
-        if (has_order(method_))
-          for (int o = order_ - 1; o >= min_order(method_) && out.status; --o) {
-            cfg.order = o;
-            if (fh && !provides_hessian(method_, o)) break;
-            compute_site(cfg, in, w.work, out);
-          }
-        if (out.status) {  // last resort: Shepard functions (constant complete)
-          cfg.method = MFREE_METHOD_SHEPARD;
-          cfg.order = 0;
-          compute_site(cfg, in, w.work, out);
-        }
-        if (out.status) {
-          out.status = first_status;
-          out.cond = first_cond;
-        }
-      }
-      if (!out.status && out.cond > shepard_cond_) {
-        const double cond = out.cond;
-        if (out.coef) std::fill_n(out.coef, ncoef, 0.0);  // as a fallback's (above)
-        out.coef = nullptr;
-        cfg.method = MFREE_METHOD_SHEPARD;
-        cfg.order = 0;
-        compute_site(cfg, in, w.work, out);
-        out.cond = cond;
-      }
-      status_[s] = out.status;
-      support_[s] = out.support;
-      cond_[s] = out.cond;
-      order_used_[s] = out.order_used;
+      general_site(s, base, fast_done, w, recs ? records_.data() + int64_t{s} * ncoef : nullptr, ncoef);
     }
     return screen_sites(b, e);
   };
@@ -207,28 +109,143 @@ Report Approximant::compute(const char *what) {
     for (int32_t s = 0; s < nsites_; ++s)
       rec_ok_[s] = pst[s] == 0 && status_[s] == 0 && order_used_[s] == want;
   }
-
   Report rep;
-  if (nfailed) {
-    int32_t s = 0;
-    while (!status_[s]) ++s;  // the first failed site
-    std::ostringstream msg;
-    msg << method_name(method_) << ": site " << s;
-    if (status_[s] == MFREE_FAIL_NEIGHBORS)
-      msg << " has " << support_[s] << " neighbours with non-zero weight, too few for the basis";
-    else if (status_[s] == MFREE_FAIL_SINGULAR)
-      msg << " has a singular local system (condition estimate " << cond_[s]
-          << "; collinear, coincident or too few neighbours)";
-    else if (status_[s] == MFREE_FAIL_NONFINITE)
-      msg << " has a non-finite value in its data, a neighbour's, or its shape functions "
-             "(a support too small for the coordinates' range?)";
-    else
-      msg << " has invalid particle data (a support or volume <= 0)";
-    const int64_t nf = nfailed;
-    msg << " (" << nf << (nf == 1 ? " site" : " sites") << " failed; their rows are zero)";
-    rep.fail(static_cast<mfree_status_t>(status_[s]), msg.str());
-  }
+  if (nfailed) report_failures(nfailed, rep);
   return rep;
+}
+
+void Approximant::reserve_scratch(int nt) {
+  // Per-thread scratch sized for the longest row before the threads start, so that no
+  // site allocates; sites are split statically and are independent, so the tables do
+  // not depend on the thread count.
+  const int dim = ps_->dim();
+  if (scratch_.size() < static_cast<size_t>(nt)) scratch_.resize(nt);
+  const int maxrow = maxrow_;
+  const int maxL = basis_size(dim, std::max(has_order(method_) ? order_ : 1, 1));
+  for (int t = 0; t < nt; ++t) {
+    SiteScratch &w = scratch_[t];
+    const size_t need = static_cast<size_t>(maxrow);
+    if (w.d.size() < 3 * need) w.d.resize(3 * need);
+    if (w.v.size() < need) w.v.resize(need);
+    if (w.h.size() < need) w.h.resize(need);
+    w.work.reserve(maxrow, dim, maxL);
+    w.fast.reserve(maxrow);
+  }
+}
+
+FastTables Approximant::fast_tables() {
+  const int dim = ps_->dim();
+  FastTables ft;
+  ft.rowptr = rowptr_.data();
+  ft.cols = cols_.data();
+  ft.self = self_.data();
+  for (int c = 0; c < dim; ++c) {
+    ft.x[c] = pack_.data() + c;
+    ft.sx[c] = points_ ? spack_.data() + c : ft.x[c];
+    ft.periodic[c] = ps_->periodic(c);
+    ft.period[c] = ps_->box_hi(c) - ps_->box_lo(c);
+  }
+  const int64_t PS = record_length(dim);
+  const PackedSupports ph = packed_supports(pack_.data(), dim, ps_->size());
+  ft.vol = pack_.data() + dim;
+  ft.h = ph.h;
+  ft.hstride = ph.stride;
+  ft.sh = points_ ? spack_.data() + dim : ft.h;
+  ft.shstride = points_ ? dim + 1 : ft.hstride;
+  ft.stride = PS;
+  ft.sstride = points_ ? dim + 1 : PS;
+  ft.convention = ps_->search_convention();
+  ft.val = (flags_ & MFREE_DERIV_VALUE) ? val_.data() : nullptr;
+  ft.grad = (flags_ & MFREE_DERIV_GRADIENT) ? grad_.data() : nullptr;
+  return ft;
+}
+
+void Approximant::general_site(int32_t s, const LocalConfig &base, bool fast_done, SiteScratch &w,
+                               double *coef, int ncoef) {
+  const int dim = ps_->dim(), nh = hessian_size(dim);
+  const bool fv = flags_ & MFREE_DERIV_VALUE, fg = flags_ & MFREE_DERIV_GRADIENT,
+             fh = flags_ & MFREE_DERIV_HESSIAN;
+  const int64_t k0 = rowptr_[s];
+  const int n = static_cast<int>(rowptr_[s + 1] - k0);
+  site_input(s, w.d.data(), w.v.data(), w.h.data());
+  LocalInput in;
+  in.n = n;
+  in.self = self_[s];
+  in.hs = site_h(s);
+  in.d = w.d.data();
+  in.vol = w.v.data();
+  in.h = w.h.data();
+  LocalOutput out;
+  // data() + offset, not &v[k]: the tables are empty when no site has a neighbour
+  out.phi = fv ? val_.data() + k0 : nullptr;
+  out.grad = fg ? grad_.data() + k0 * dim : nullptr;
+  out.hess = fh ? hess_.data() + k0 * nh : nullptr;
+  out.coef = coef;
+  LocalConfig cfg = base;
+  cfg.method = method_;
+  cfg.order = order_;
+  if (fast_done) {  // the fast path's result stands but for the rows
+    out.status = 0;
+    out.cond = cond_[s];
+  } else {
+    compute_site(cfg, in, w.work, out);
+  }
+  if (out.status && fallback_ == MFREE_FALLBACK_LOWER_ORDER) {
+    const int first_status = out.status;
+    const double first_cond = out.cond;
+    // A site that falls back gets a record of zeros (mfree.h): a lower order's or
+    // Shepard's record has another layout, and Shepard's (1 + dim values) is longer
+    // than Johnson-Beissel's or Randles-Libersky's, so it would run into the next one.
+    if (out.coef) std::fill_n(out.coef, ncoef, 0.0);
+    out.coef = nullptr;
+    if (has_order(method_))
+      for (int o = order_ - 1; o >= min_order(method_) && out.status; --o) {
+        cfg.order = o;
+        if (fh && !provides_hessian(method_, o)) break;
+        compute_site(cfg, in, w.work, out);
+      }
+    if (out.status) {  // last resort: Shepard functions (constant complete)
+      cfg.method = MFREE_METHOD_SHEPARD;
+      cfg.order = 0;
+      compute_site(cfg, in, w.work, out);
+    }
+    if (out.status) {
+      out.status = first_status;
+      out.cond = first_cond;
+    }
+  }
+  if (!out.status && out.cond > shepard_cond_) {
+    const double cond = out.cond;
+    if (out.coef) std::fill_n(out.coef, ncoef, 0.0);  // as a fallback's (above)
+    out.coef = nullptr;
+    cfg.method = MFREE_METHOD_SHEPARD;
+    cfg.order = 0;
+    compute_site(cfg, in, w.work, out);
+    out.cond = cond;
+  }
+  status_[s] = out.status;
+  support_[s] = out.support;
+  cond_[s] = out.cond;
+  order_used_[s] = out.order_used;
+}
+
+void Approximant::report_failures(int64_t nfailed, Report &rep) const {
+  int32_t s = 0;
+  while (!status_[s]) ++s;  // the first failed site
+  std::ostringstream msg;
+  msg << method_name(method_) << ": site " << s;
+  if (status_[s] == MFREE_FAIL_NEIGHBORS)
+    msg << " has " << support_[s] << " neighbours with non-zero weight, too few for the basis";
+  else if (status_[s] == MFREE_FAIL_SINGULAR)
+    msg << " has a singular local system (condition estimate " << cond_[s]
+        << "; collinear, coincident or too few neighbours)";
+  else if (status_[s] == MFREE_FAIL_NONFINITE)
+    msg << " has a non-finite value in its data, a neighbour's, or its shape functions "
+           "(a support too small for the coordinates' range?)";
+  else
+    msg << " has invalid particle data (a support or volume <= 0)";
+  msg << " (" << nfailed << (nfailed == 1 ? " site" : " sites") << " failed; their rows are zero)";
+  rep.fail(static_cast<mfree_status_t>(status_[s]), msg.str());
 }
 
 void Approximant::site_input(int32_t s, double *dd, double *v, double *h) const {

@@ -44,13 +44,106 @@ inline void write_pair(int dim, bool antisym, const double *a, bool ha, const do
 
 }  // namespace
 
+void Approximant::kernel_gradient(int32_t s, int32_t j, double *g) const {
+  double d[3] = {0, 0, 0}, r, w, dw, d2w;
+  ps_->displacement(j, s, d);  // x_j - x_s
+  kernel_at(*kernel_, ps_->dim(), d, pair_h(s, j), r, w, dw, d2w, g);
+}
+
 void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisym) const {
   check_pairs_ready("pair gradients");
   if (!ps_->has_pairs())
     throw Error(MFREE_ERR_STATE, "the particle set has no pair list (mfree_particles_set_pairs)");
-  const bool sph = method_ == MFREE_METHOD_SPH || method_ == MFREE_METHOD_SPH_SYMMETRIC;
   if (!(flags_ & MFREE_DERIV_GRADIENT))
     throw Error(MFREE_ERR_STATE, "the gradient table was not built (mfree_approximant_set_derivatives)");
+  const bool sph = method_ == MFREE_METHOD_SPH || method_ == MFREE_METHOD_SPH_SYMMETRIC;
+  // SPH's kernel gradient is antisymmetric when h_ij is: one side gives the other,
+  // exactly, also for a pair whose particles have no rows (ghosts).
+  const bool sym_h = ps_->search_convention() != MFREE_SEARCH_GATHER;
+  // The common case: every row is the set's row (the pair offsets) plus the site itself
+  // appended, i.e. the kernel's support dropped no pair and no site failed; then the
+  // offset gives the table entry directly, and a particle without a row has offset -1.
+  // (With global ids the rows are in id order, not the order the offsets refer to.)
+  const bool direct = static_cast<int64_t>(cols_.size()) == ps_->neighbors().nnz() + nsites_ &&
+                      !ps_->has_global_ids();
+  // Methods with correction records take every side from a record, the sites' own or a
+  // ghost's (set_ghost_correction), so that a side computed where the particle is a
+  // ghost equals the one computed where it is owned, bit for bit. A site whose record
+  // is missing (it fell back to another order) is looked up in its row.
+  const bool by_record = !records_.empty();
+  if (sph && sym_h)
+    pair_gradients_sph(gi, gj, ld, antisym);
+  else if (direct && !sph && !by_record)
+    pair_gradients_direct(gi, gj, ld, antisym);
+  else
+    pair_gradients_general(gi, gj, ld, antisym);
+}
+
+// The kernel gradient, computed as the host computes its dwdx (the table's entries
+// differ from it in the last bits near the support's edge), and exactly antisymmetric.
+void Approximant::pair_gradients_sph(double *gi, double *gj, int64_t ld, bool antisym) const {
+  const int dim = ps_->dim();
+  const int64_t P = ps_->num_pairs();
+  const int32_t *pi = ps_->pair_first(), *pj = ps_->pair_second(), base = ps_->pair_base();
+  const auto &pst = ps_->site_status();
+  parallel_blocks(P, num_threads(P), [&](int, int64_t b, int64_t e) {
+    for (int64_t k = b; k < e; ++k) {
+      const int32_t i = pi[k] - base, j = pj[k] - base;
+      double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+      const bool ok = pst[i] == 0 && pst[j] == 0;
+      if (ok) kernel_gradient(i, j, a);
+      for (int d = 0; d < dim; ++d) c[d] = -a[d];
+      write_pair(dim, antisym, a, ok, c, ok, gi + k * ld, gj ? gj + k * ld : nullptr);
+    }
+  });
+}
+
+// Both sides straight from the tables at the pair offsets.
+void Approximant::pair_gradients_direct(double *gi, double *gj, int64_t ld, bool antisym) const {
+  const int dim = ps_->dim();
+  const int64_t P = ps_->num_pairs();
+  const int32_t *pi = ps_->pair_first(), *pj = ps_->pair_second(), base = ps_->pair_base();
+  const int32_t *off = ps_->pair_offsets().data();
+  int64_t vstride = 0;
+  const double *vol = packed_volumes(vstride);
+  const int64_t *rp = rowptr_.data();
+  const double *G = grad_.data();
+  parallel_blocks(P, num_threads(P), [&](int, int64_t b, int64_t e) {
+    // the j side's row is far from the i side's in the tables: its entry is fetched a
+    // few pairs ahead (the i sides run through their rows in order)
+    constexpr int64_t ahead = 16;
+    for (int64_t k = b; k < e; ++k) {
+      if (k + ahead < e) {
+        const int64_t ka = k + ahead;
+        const int32_t ja = pj[ka] - base, oca = off[2 * ka + 1];
+        if (oca >= 0) __builtin_prefetch(G + (rp[ja] + oca) * dim);
+      }
+      const int32_t i = pi[k] - base, j = pj[k] - base;
+      const int32_t oa = off[2 * k], oc = off[2 * k + 1];
+      double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+      const bool ha = oa >= 0, hc = oc >= 0;
+      // 1/V_j and 1/V_i from one division
+      const double vi = vol[i * vstride], vj = vol[j * vstride], ivv = 1.0 / (vi * vj);
+      if (ha) {
+        const double *g = G + (rp[i] + oa) * dim, iv = vi * ivv;
+        for (int d = 0; d < dim; ++d) a[d] = g[d] * iv;
+      }
+      if (hc) {
+        const double *g = G + (rp[j] + oc) * dim, iv = vj * ivv;
+        for (int d = 0; d < dim; ++d) c[d] = g[d] * iv;
+      }
+      write_pair(dim, antisym, a, ha, c, hc, gi + k * ld, gj ? gj + k * ld : nullptr);
+    }
+  });
+}
+
+// The general case: rows the kernel's support filtered, failed sites, records, or SPH
+// with a support of the row's own particle (gather): each side looked up, computed from
+// its record, or for SPH computed.
+void Approximant::pair_gradients_general(double *gi, double *gj, int64_t ld, bool antisym) const {
+  const bool sph = method_ == MFREE_METHOD_SPH || method_ == MFREE_METHOD_SPH_SYMMETRIC;
+  const bool sym_h = ps_->search_convention() != MFREE_SEARCH_GATHER;
+  const bool by_record = !records_.empty();
   const int dim = ps_->dim();
   const int64_t P = ps_->num_pairs();
   const int32_t *pi = ps_->pair_first(), *pj = ps_->pair_second(), base = ps_->pair_base();
@@ -61,27 +154,7 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
   const int32_t *cl = cols_.data();
   const double *G = grad_.data();
   const int32_t owned = nsites_;
-  // SPH's kernel gradient is antisymmetric when h_ij is: one side gives the other,
-  // exactly, also for a pair whose particles have no rows (ghosts).
-  const bool sym_h = ps_->search_convention() != MFREE_SEARCH_GATHER;
-  // The common case: every row is the set's row (the pair offsets) plus the site itself
-  // appended, i.e. the kernel's support dropped no pair and no site failed; then the
-  // offset gives the table entry directly, and a particle without a row has offset -1.
-  // (With global ids the rows are in id order, not the order the offsets refer to.)
-  const bool direct = static_cast<int64_t>(cols_.size()) == ps_->neighbors().nnz() + owned &&
-                      !ps_->has_global_ids();
   const auto &pst = ps_->site_status();
-  // grad_s W(x_s - x_j, h_sj) from the kernel (SPH needs no row)
-  auto kernel_gradient = [&](int32_t s, int32_t j, double *g) {
-    double d[3] = {0, 0, 0}, r, w, dw, d2w;
-    ps_->displacement(j, s, d);  // x_j - x_s
-    kernel_at(*kernel_, dim, d, pair_h(s, j), r, w, dw, d2w, g);
-  };
-  // Methods with correction records take every side from a record, the sites' own or a
-  // ghost's (set_ghost_correction), so that a side computed where the particle is a
-  // ghost equals the one computed where it is owned, bit for bit. A site whose record
-  // is missing (it fell back to another order) is looked up in its row.
-  const bool by_record = !records_.empty();
   const int m = by_record ? correction_size() : 0;
   const uint8_t *rok = rec_ok_.data();
   auto record_of = [&](int32_t s) -> const double * {
@@ -89,54 +162,6 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
     return s < owned ? records_.data() + int64_t{s} * m : ghost_records_.data() + int64_t{s - owned} * m;
   };
   const RecordGradient record_gradient(local_config(true, true, false));
-  const int nt = num_threads(P);
-  if (sph && sym_h) {
-    // the kernel gradient, computed as the host computes its dwdx (the table's entries
-    // differ from it in the last bits near the support's edge), and exactly antisymmetric
-    parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
-      for (int64_t k = b; k < e; ++k) {
-        const int32_t i = pi[k] - base, j = pj[k] - base;
-        double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
-        const bool ok = pst[i] == 0 && pst[j] == 0;
-        if (ok) kernel_gradient(i, j, a);
-        for (int d = 0; d < dim; ++d) c[d] = -a[d];
-        write_pair(dim, antisym, a, ok, c, ok, gi + k * ld, gj ? gj + k * ld : nullptr);
-      }
-    });
-    return;
-  }
-  if (direct && !sph && !by_record) {
-    parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
-      // the j side's row is far from the i side's in the tables: its entry is fetched a
-      // few pairs ahead (the i sides run through their rows in order)
-      constexpr int64_t ahead = 16;
-      for (int64_t k = b; k < e; ++k) {
-        if (k + ahead < e) {
-          const int64_t ka = k + ahead;
-          const int32_t ja = pj[ka] - base, oca = off[2 * ka + 1];
-          if (oca >= 0) __builtin_prefetch(G + (rp[ja] + oca) * dim);
-        }
-        const int32_t i = pi[k] - base, j = pj[k] - base;
-        const int32_t oa = off[2 * k], oc = off[2 * k + 1];
-        double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
-        const bool ha = oa >= 0, hc = oc >= 0;
-        // 1/V_j and 1/V_i from one division
-        const double vi = vol[i * vstride], vj = vol[j * vstride], ivv = 1.0 / (vi * vj);
-        if (ha) {
-          const double *g = G + (rp[i] + oa) * dim, iv = vi * ivv;
-          for (int d = 0; d < dim; ++d) a[d] = g[d] * iv;
-        }
-        if (hc) {
-          const double *g = G + (rp[j] + oc) * dim, iv = vj * ivv;
-          for (int d = 0; d < dim; ++d) c[d] = g[d] * iv;
-        }
-        write_pair(dim, antisym, a, ha, c, hc, gi + k * ld, gj ? gj + k * ld : nullptr);
-      }
-    });
-    return;
-  }
-  // The general case: rows the kernel's support filtered, failed sites, or SPH with a
-  // support of the row's own particle (gather): each side looked up, or for SPH computed.
   auto find = [&](int32_t s, int32_t j, int32_t hint) -> int64_t {
     const int64_t b = rp[s], e = rp[s + 1];
     if (hint >= 0 && b + hint < e && cl[b + hint] == j) return b + hint;
@@ -182,7 +207,7 @@ void Approximant::pair_gradients(double *gi, double *gj, int64_t ld, bool antisy
       kernel_at(*kernel_, D, d, pair_support(conv, hj, hi), r, w, dw, d2w, gw);
     record_gradient(record_of(j), hj, d, w, gw, xi[D], c);
   };
-  parallel_blocks(P, nt, [&](int, int64_t b, int64_t e) {
+  parallel_blocks(P, num_threads(P), [&](int, int64_t b, int64_t e) {
     for (int64_t k = b; k < e; ++k) {
       const int32_t i = pi[k] - base, j = pj[k] - base;
       double a[3] = {0, 0, 0}, c[3] = {0, 0, 0};
