@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/base/kernel_eval.hpp"
 #include "core/base/simd.hpp"
 
 #if MFREE_SIMD_X86
@@ -101,17 +102,24 @@ MFREE_TARGET_AVX2 void mls1_rows2_avx2(const FastTables &t, int64_t b, int64_t e
     // weights and the 6 sums of M first, then the 9 of M_,c from the stored gf: two short
     // loops keep their sums in registers (one loop spilled 9 of 15) and let the
     // out-of-order core overlap the square roots and divisions of successive groups
+    // the cubic spline's pieces (kernel_eval.hpp): f = 1 + a2 r^2 + a3 r^3 and -f'/r =
+    // -2 a2 - 3 a3 r (r < 1); b3 t^3 and 3 b3 t^2 / r (t = 2 - r)
+    using S = CubicSplineShape;
+    static_assert(S::a0 == 1.0, "win adds one for a0");
+    const __m256d ca3 = _mm256_set1_pd(S::a3), ca2 = _mm256_set1_pd(S::a2);
+    const __m256d cg1 = _mm256_set1_pd(3.0 * S::a3), cg0 = _mm256_set1_pd(-2.0 * S::a2);
+    const __m256d cb3 = _mm256_set1_pd(S::b3), cgb = _mm256_set1_pd(3.0 * S::b3);
     for (m = 0; m < n; m += 4) {
       const __m256d valid = _mm256_castsi256_pd(_mm256_cmpgt_epi64(nv, _mm256_add_epi64(lane, _mm256_set1_epi64x(m))));
       const __m256d x1 = _mm256_loadu_pd(sx + m), x2 = _mm256_loadu_pd(sy + m);
       const __m256d r2 = _mm256_fmadd_pd(x1, x1, _mm256_mul_pd(x2, x2));
       const __m256d r = _mm256_sqrt_pd(r2);
       const __m256d inner = _mm256_cmp_pd(r, one, _CMP_LT_OQ);
-      const __m256d win = _mm256_fmadd_pd(r2, _mm256_fmadd_pd(_mm256_set1_pd(0.75), r, _mm256_set1_pd(-1.5)), one);
-      const __m256d gin = _mm256_fnmadd_pd(_mm256_set1_pd(2.25), r, _mm256_set1_pd(3.0));
+      const __m256d win = _mm256_fmadd_pd(r2, _mm256_fmadd_pd(ca3, r, ca2), one);
+      const __m256d gin = _mm256_fnmadd_pd(cg1, r, cg0);
       const __m256d bq = _mm256_max_pd(_mm256_sub_pd(two, r), zero), bb = _mm256_mul_pd(bq, bq);
-      const __m256d wout = _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(0.25), bb), bq);
-      const __m256d gout = _mm256_div_pd(_mm256_mul_pd(_mm256_set1_pd(0.75), bb), r);  // r >= 1 where taken
+      const __m256d wout = _mm256_mul_pd(_mm256_mul_pd(cb3, bb), bq);
+      const __m256d gout = _mm256_div_pd(_mm256_mul_pd(cgb, bb), r);  // r >= 1 where taken
       const __m256d w = _mm256_and_pd(_mm256_blendv_pd(wout, win, inner), valid);
       const __m256d g = _mm256_and_pd(_mm256_blendv_pd(gout, gin, inner), valid);
       _mm256_storeu_pd(wv + m, w);
