@@ -35,7 +35,9 @@
 #   -k, --rounds N      rounds (default 6): each program runs 2N times; an even count
 #                       lets each library run first equally often
 #   -b, --bench LIST    comma-separated programs, without "bench_" (default
-#                       neighbors,shape,apply,dambreak,table4,pairs,mpi_weak)
+#                       neighbors,shape,apply,dambreak,table4,pairs,mpi_weak; also
+#                       verlet, for two commits that both have the Verlet skin, which
+#                       beb1e93 lacks)
 #   --clock wall|cpu    MFREE_BENCH_CLOCK for the programs (default: $MFREE_BENCH_CLOCK, else
 #                       wall). cpu = process CPU time, for a shared machine: one-thread
 #                       figures stay meaningful; OMP_WAIT_POLICY=passive is then set (unless
@@ -143,8 +145,8 @@ git -C "$repo" cat-file -e "$from_c:bench/bench_util.h" 2>/dev/null &&
 
 IFS=, read -r -a sel <<<"$benches"
 for b in "${sel[@]}"; do
-  case "$b" in neighbors|shape|apply|dambreak|table4|pairs|mpi_weak) ;;
-    *) die "unknown benchmark '$b' (neighbors, shape, apply, dambreak, table4, pairs, mpi_weak)" ;; esac
+  case "$b" in neighbors|shape|apply|dambreak|table4|pairs|mpi_weak|verlet) ;;
+    *) die "unknown benchmark '$b' (neighbors, shape, apply, dambreak, table4, pairs, mpi_weak, verlet)" ;; esac
 done
 want_mpi=0
 for b in "${sel[@]}"; do [ "$b" = mpi_weak ] && want_mpi=1; done
@@ -211,6 +213,7 @@ run_one() {  # side bench log
     apply) "$bd/bench_apply" ;;
     dambreak) "$bd/bench_dambreak" ;;
     table4) "$bd/bench_table4" ;;
+    verlet) if [ "$full" = 1 ]; then "$bd/bench_verlet"; else MFREE_BENCH_REPS=2 "$bd/bench_verlet"; fi ;;
     pairs) if [ "$full" = 1 ]; then "$bd/bench_pairs"; else "$bd/bench_pairs" 1e5 2; fi ;;
     mpi_weak)
       for p in $ranks; do
@@ -285,7 +288,7 @@ new_s="$(git -C "$repo" rev-parse --short "$new_c")"
         else {
           verdict = ratio <= bound ? "yes" : sprintf("**no** (> %d %%)", 100 * (bound - 1) + 0.5)
           if (ratio <= bound) ++within; else { ++beyond; bad = bad "\n  " k sprintf(" %.3f", ratio) }
-          if (clock == "cpu" && k ~ /thread/ && k !~ /1 thread$/) verdict = verdict ", CPU time of all threads"
+          if (clock == "cpu" && k ~ /(all threads|[0-9] threads|second count)/) verdict = verdict ", CPU time of all threads"
         }
         printf("| %s | %s | %s | %.3f | %s |\n", k, fmt(old[k], unit[k]), fmt(nw[k], unit[k]), ratio, verdict)
       }
