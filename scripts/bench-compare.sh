@@ -8,9 +8,10 @@
 # one program lies within the same minute or two, and neither library always runs
 # first), keeps each figure's best over the rounds, and prints a markdown table: figure,
 # old (best), new (best), new/old, and whether within the bound (5 %; the dam-break step
-# 10 %; a ratio below 1 is a gain). Figures whose name starts with "reference" are not
-# mfree (nanoflann, the STREAM triad, the host's dwdx loop): their ratio is the noise of
-# the run, not a verdict.
+# 10 %; a ratio below 1 is a gain); also the ratio of the medians over the rounds, which a
+# lucky run on either side does not move (on a busy machine compare the two). Figures
+# whose name starts with "reference" are not mfree (nanoflann, the STREAM triad, the
+# host's dwdx loop): their ratio is the noise of the run, not a verdict.
 #
 # What is compared, and why it is the honest comparison: the SAME benchmark sources
 # (bench/ of --bench-from, default NEW) are compiled against each library's own header
@@ -262,17 +263,24 @@ new_s="$(git -C "$repo" rev-parse --short "$new_c")"
   echo "clock $clock, second thread count $threads, $rounds rounds ($([ "$full" = 1 ] && echo full sizes || echo default sizes)), best of the rounds;"
   echo "$(( $(date +%s) - t_start )) s in all, the runs $(( $(date +%s) - t_runs )) s using $cpu_runs s of CPU (on an idle machine the runs take about that, less the threaded passes' overlap)."
   echo
-  echo "| figure | old (best) | new (best) | new/old | within |"
-  echo "| --- | --- | --- | --- | --- |"
+  echo "| figure | old (best) | new (best) | new/old | medians | within |"
+  echo "| --- | --- | --- | --- | --- | --- |"
   awk -F'\t' -v clock="$clock" '
     function fmt(v, u) {
       if (u == "s") return v >= 1 ? sprintf("%.3f s", v) : sprintf("%.3f ms", 1e3 * v)
       return sprintf("%.0f %s", v, u)
     }
+    function median(side, k,    m, i, j, a, t) {  # of the values of figure k on one side
+      m = cnt[side, k]
+      for (i = 1; i <= m; ++i) a[i] = val[side, k, i]
+      for (i = 2; i <= m; ++i) { t = a[i]; for (j = i - 1; j >= 1 && a[j] > t; --j) a[j + 1] = a[j]; a[j + 1] = t }
+      return m % 2 ? a[(m + 1) / 2] : 0.5 * (a[m / 2] + a[m / 2 + 1])
+    }
     {
       key = $3
       if (!(key in unit)) { order[++n] = key; unit[key] = $5 }
       v = $4 + 0
+      val[$1, key, ++cnt[$1, key]] = v
       if ($1 == "old") { if (!(key in old) || v < old[key]) old[key] = v }
       else { if (!(key in nw) || v < nw[key]) nw[key] = v }
     }
@@ -280,7 +288,9 @@ new_s="$(git -C "$repo" rev-parse --short "$new_c")"
       beyond = 0; within = 0; refs = ""
       for (i = 1; i <= n; ++i) {
         k = order[i]
-        if (!(k in old) || !(k in nw)) { printf("| %s | %s | %s | - | only one side |\n", k, (k in old) ? fmt(old[k], unit[k]) : "-", (k in nw) ? fmt(nw[k], unit[k]) : "-"); continue }
+        if (!(k in old) || !(k in nw)) { printf("| %s | %s | %s | - | - | only one side |\n", k, (k in old) ? fmt(old[k], unit[k]) : "-", (k in nw) ? fmt(nw[k], unit[k]) : "-"); continue }
+        mo = median("old", k)
+        mratio = mo > 0 ? median("new", k) / mo : 1
         ratio = old[k] > 0 ? nw[k] / old[k] : 1
         bound = (k ~ /^dambreak/) ? 1.10 : 1.05
         if (k ~ /^reference/) verdict = "(reference: noise)"
@@ -290,7 +300,7 @@ new_s="$(git -C "$repo" rev-parse --short "$new_c")"
           if (ratio <= bound) ++within; else { ++beyond; bad = bad "\n  " k sprintf(" %.3f", ratio) }
           if (clock == "cpu" && k ~ /(all threads|[0-9] threads|second count)/) verdict = verdict ", CPU time of all threads"
         }
-        printf("| %s | %s | %s | %.3f | %s |\n", k, fmt(old[k], unit[k]), fmt(nw[k], unit[k]), ratio, verdict)
+        printf("| %s | %s | %s | %.3f | %.3f | %s |\n", k, fmt(old[k], unit[k]), fmt(nw[k], unit[k]), ratio, mratio, verdict)
       }
       printf("\n%d figures within their bounds, %d beyond.\n", within, beyond)
       if (beyond) printf("Beyond:%s\n", bad) > "/dev/stderr"
