@@ -300,6 +300,29 @@ typedef MFREE_ENUM(mfree_lumping) {
                                 eq 58) */
 } mfree_lumping_t;
 
+/** Which implementation of the numerics a context's calls run
+ * (mfree_context_set_backend), as libCEED's ref and opt backends. */
+typedef MFREE_ENUM(mfree_backend) {
+  MFREE_BACKEND_REF = 1, /**< the reference path for every method: general shape
+                              functions over dense small solves, one plain loop per
+                              operator; the oracle of the optimised path */
+  MFREE_BACKEND_OPT = 2  /**< the optimised path where a method has one (the common
+                              methods' shape functions, fixed-size operator kernels,
+                              AVX2 + FMA copies chosen from the CPU), else the
+                              reference path; equal to it to round-off. The default */
+} mfree_backend_t;
+
+/** OS-level memory tuning a context may ask for (mfree_context_set_page_hints); flags,
+ * combined with |. Only without an allocator hook and on Linux; elsewhere ignored. */
+typedef MFREE_ENUM(mfree_pages) {
+  MFREE_PAGES_DEFAULT = 0,  /**< malloc's pages, no advice (the default) */
+  MFREE_PAGES_HUGE = 1,     /**< blocks of 2 MiB or more in mappings of their own advised
+                                 MADV_HUGEPAGE (fewer page faults and TLB misses; resident
+                                 memory rounded up to whole huge pages) */
+  MFREE_PAGES_PREFAULT = 2  /**< tables about to be written front to back are faulted in
+                                 with one system call (MADV_POPULATE_WRITE) */
+} mfree_pages_t;
+
 /* ------------------------------------------------------------------------------------ */
 /* Opaque handles                                                                         */
 /* ------------------------------------------------------------------------------------ */
@@ -419,12 +442,40 @@ MFREE_API mfree_status_t mfree_context_set_num_threads(mfree_context_t *ctx,
 MFREE_API mfree_status_t mfree_context_get_num_threads(const mfree_context_t *ctx,
                                                        int32_t *nthreads);
 
+/** Run the reference or the optimised path in calls on objects of this context
+ * (default MFREE_BACKEND_OPT). Takes effect at the next call; set-up tables are kept
+ * (an apply uses the backend in force at the apply).
+ * @param[in] ctx      the context
+ * @param[in] backend  MFREE_BACKEND_REF or MFREE_BACKEND_OPT, else MFREE_ERR_ARG
+ * @return MFREE_SUCCESS, or a failure named with the parameters */
+MFREE_API mfree_status_t mfree_context_set_backend(mfree_context_t *ctx, int32_t backend);
+/** The backend set by mfree_context_set_backend.
+ * @param[in]  ctx      the context
+ * @param[out] backend  MFREE_BACKEND_REF or MFREE_BACKEND_OPT
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
+MFREE_API mfree_status_t mfree_context_get_backend(const mfree_context_t *ctx, int32_t *backend);
+
+/** Ask for OS-level memory tuning in calls on objects of this context (default
+ * MFREE_PAGES_DEFAULT: none). For hosts that want the last per cent of speed and accept
+ * larger resident memory and extra system calls; ignored with an allocator hook
+ * installed and off Linux; MFREE_HUGEPAGES=0 in the environment turns it off for
+ * debugging (docs/performance.md).
+ * @param[in] ctx    the context
+ * @param[in] flags  MFREE_PAGES_* flags combined with |, else MFREE_ERR_ARG
+ * @return MFREE_SUCCESS, or a failure named with the parameters */
+MFREE_API mfree_status_t mfree_context_set_page_hints(mfree_context_t *ctx, int32_t flags);
+/** The flags set by mfree_context_set_page_hints.
+ * @param[in]  ctx    the context
+ * @param[out] flags  MFREE_PAGES_* flags
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
+MFREE_API mfree_status_t mfree_context_get_page_hints(const mfree_context_t *ctx, int32_t *flags);
+
 /**
  * Install an allocator for the large arrays (neighbour lists, shape-function tables,
  * their scratch) of calls on objects of this context. Every block goes back to the
  * free function of the allocator that made it, even after the allocator is changed.
- * Both NULL restores the default (malloc, with huge pages for large blocks on Linux;
- * docs/performance.md).
+ * Both NULL restores the default (malloc; huge pages for large blocks on Linux when
+ * asked for with mfree_context_set_page_hints).
  * @param[in] ctx      the context
  * @param[in] alloc    allocation function, or NULL
  * @param[in] release  matching free function, or NULL (both NULL or neither, else

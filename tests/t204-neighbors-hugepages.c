@@ -1,7 +1,8 @@
 /*
  * t204: the huge-page path of the internal allocator (src/core/base/alloc.hpp).
  *
- * Without an allocator hook, blocks of 2 MiB and more (here the neighbour lists of a
+ * With huge pages asked for on the context (mfree_context_set_page_hints,
+ * MFREE_PAGES_HUGE) and without an allocator hook, blocks of 2 MiB and more (here the neighbour lists of a
  * 10^5-particle set) get mappings of their own, advised MADV_HUGEPAGE, and are unmapped
  * when freed. The particles are stored in random order: a one-thread search of particles
  * in spatial order (AVX2) writes its lists in place on small pages (neighbors.cpp,
@@ -16,7 +17,8 @@
  *    with rows strictly ascending, with one thread and with two;
  *  - with a hook installed the memory is the host's: no advised mapping appears, the
  *    hook's allocations and frees balance to the byte, and the lists are identical to
- *    those of the huge-page run.
+ *    those of the huge-page run;
+ *  - without the request (the default) no advised mapping appears either.
  * Skipped where the path is off (not Linux, THP "never", MFREE_HUGEPAGES=0, small page
  * other than 4 KiB). No timing.
  */
@@ -176,6 +178,7 @@ static void test_huge_pages(void **state) {
   for (int threads = 1; threads <= 2; ++threads) {
     mfree_context_t *ctx = NULL;
     assert_ok(NULL, mfree_context_create(&ctx));
+    assert_ok(ctx, mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE)); /* opt-in */
     assert_ok(ctx, mfree_context_set_num_threads(ctx, threads));
     long during = 0;
     lists_t g = search(ctx, x, n, r, &during);
@@ -198,11 +201,21 @@ static void test_huge_pages(void **state) {
   counter_t c = {0, 0, 0, -1};
   mfree_context_t *ctx = NULL;
   assert_ok(NULL, mfree_context_create(&ctx));
+  assert_ok(ctx, mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE)); /* asked, but the hook wins */
   assert_ok(ctx, mfree_context_set_allocator(ctx, count_alloc, count_free, &c));
   long during = 0;
   lists_t g = search(ctx, x, n, r, &during);
   assert_int_equal(during, before);
   mfree_context_destroy(&ctx);
+  /* not asked for (the default): malloc's pages, no advised mapping, the same lists */
+  assert_ok(NULL, mfree_context_create(&ctx));
+  lists_t d = search(ctx, x, n, r, &during);
+  assert_int_equal(during, before);
+  mfree_context_destroy(&ctx);
+  assert_int_equal(d.nnz, ref.nnz);
+  assert_memory_equal(d.cols, ref.cols, sizeof(int32_t) * (size_t)d.nnz);
+  free(d.rowptr);
+  free(d.cols);
   assert_true(c.calls > 0);
   assert_int_equal(c.calls, c.frees);
   assert_int_equal(c.held, 0);

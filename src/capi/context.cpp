@@ -111,6 +111,39 @@ mfree_status_t mfree_context_get_num_threads(const mfree_context_t *ctx, int32_t
   return MFREE_SUCCESS;
 }
 
+mfree_status_t mfree_context_set_backend(mfree_context_t *ctx, int32_t backend) {
+  if (!ctx) return MFREE_ERR_NULL;
+  if (backend != MFREE_BACKEND_REF && backend != MFREE_BACKEND_OPT)
+    return mfree::record(ctx, MFREE_ERR_ARG, "mfree_context_set_backend",
+                         "unknown backend " + std::to_string(backend) +
+                             " (MFREE_BACKEND_REF = 1, MFREE_BACKEND_OPT = 2)");
+  ctx->config.backend = backend;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_context_get_backend(const mfree_context_t *ctx, int32_t *backend) {
+  if (!ctx || !backend) return MFREE_ERR_NULL;
+  *backend = ctx->config.backend;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_context_set_page_hints(mfree_context_t *ctx, int32_t flags) {
+  if (!ctx) return MFREE_ERR_NULL;
+  constexpr int32_t known = MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT;
+  if (flags & ~known)
+    return mfree::record(ctx, MFREE_ERR_ARG, "mfree_context_set_page_hints",
+                         "unknown flags in " + std::to_string(flags) +
+                             " (MFREE_PAGES_HUGE = 1, MFREE_PAGES_PREFAULT = 2, combined with |)");
+  ctx->config.pages = flags;
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_context_get_page_hints(const mfree_context_t *ctx, int32_t *flags) {
+  if (!ctx || !flags) return MFREE_ERR_NULL;
+  *flags = ctx->config.pages;
+  return MFREE_SUCCESS;
+}
+
 mfree_status_t mfree_context_set_allocator(mfree_context_t *ctx, mfree_alloc_fn alloc,
                                            mfree_free_fn release, void *user) {
   if (!ctx) return MFREE_ERR_NULL;

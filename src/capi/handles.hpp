@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/base/alloc.hpp"
+#include "core/base/config.hpp"
 #include "core/shape/approximant.hpp"
 #include "core/discretize/assembler.hpp"
 #include "core/base/error.hpp"
@@ -29,6 +30,7 @@ struct mfree_context {
   void *handler_user = nullptr;
   int32_t nthreads = 1;
   mfree::AllocHook alloc;  // empty: malloc
+  mfree::CallConfig config;  // backend and page hints
 };
 
 struct mfree_particles {
@@ -102,6 +104,7 @@ mfree_status_t guard(mfree_context_t *ctx, const char *fn, Body &&body) noexcept
   // the context's allocator and thread count hold for everything the call runs
   const AllocScope alloc_scope(ctx ? &ctx->alloc : nullptr);
   const ThreadScope thread_scope(ctx ? ctx->nthreads : 1);
+  const ConfigScope config_scope(ctx ? &ctx->config : nullptr);
   try {
     return body();
   } catch (const Error &e) {

@@ -5,10 +5,11 @@
 // block from the hook in force when it is allocated and records in a small header which
 // function pair made it, so that a block goes back to its own allocator even when it is
 // freed in a later call, on another context, or after the host changed the hook. Without
-// a hook, blocks come from malloc, and on Linux big ones (>= 2 MiB) from their own
+// a hook, blocks come from malloc; when the call's context asks for huge pages
+// (config.hpp, MFREE_PAGES_HUGE), big ones (>= 2 MiB) on Linux come from their own
 // mapping with transparent huge pages requested (madvise), see huge_map, unless a
 // SmallPages scope asks for malloc's small pages (blocks whose first touch matters most);
-// prefault faults a block in with one system call. The big per-object arrays (neighbour
+// with MFREE_PAGES_PREFAULT, prefault faults a block in with one system call. The big per-object arrays (neighbour
 // lists, shape function tables, per-site scratch) are HVec; small bookkeeping uses
 // std::allocator.
 #pragma once
@@ -30,6 +31,7 @@
 #include <cstring>
 #endif
 
+#include "core/base/config.hpp"
 #include "mfree.h"
 
 namespace mfree {
@@ -77,9 +79,10 @@ static_assert(sizeof(BlockHeader) % 16 == 0, "header keeps 16-byte alignment");
 // mapping (user == huge_tag(), bytes = mapped length) and freeing it unmaps it. The
 // length is rounded up to whole huge pages when that adds at most an eighth (a touched
 // huge page is resident whole), else to small pages (the tail then takes small pages).
-// Off when the kernel's THP mode is "never", when the small page is not 4 KiB (the PMD
-// huge page is then not 2 MiB), and with MFREE_HUGEPAGES=0 in the environment (read
-// once); a failing mmap falls back to malloc. With a hook installed, every block is the
+// Only when the call's context asks for it (MFREE_PAGES_HUGE); off when the kernel's THP
+// mode is "never", when the small page is not 4 KiB (the PMD huge page is then not
+// 2 MiB), and with MFREE_HUGEPAGES=0 in the environment (config.hpp); a failing mmap
+// falls back to malloc. With a hook installed, every block is the
 // host's (the hook sees every byte).
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kHugeMin = std::size_t{2} << 20;
@@ -91,9 +94,9 @@ inline void *huge_tag() {
 
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
 inline bool huge_pages_enabled() {
+  if (!(call_config().pages & MFREE_PAGES_HUGE)) return false;
   static const bool on = [] {
-    const char *env = std::getenv("MFREE_HUGEPAGES");
-    if (env && env[0] == '0') return false;
+    if (env::hugepages_off()) return false;
     if (sysconf(_SC_PAGESIZE) != 4096) return false;
     bool never = false;
     if (std::FILE *f = std::fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r")) {
@@ -177,7 +180,8 @@ inline void hook_deallocate(void *p) noexcept {
 }
 }  // namespace detail
 
-// Faults in the whole pages of [p, p + bytes) in one system call (MADV_POPULATE_WRITE,
+// When the call's context asks for it (MFREE_PAGES_PREFAULT; not with MFREE_HUGEPAGES=0):
+// faults in the whole pages of [p, p + bytes) in one system call (MADV_POPULATE_WRITE,
 // Linux 5.14), for a block about to be written front to back for the first time: the
 // kernel fills the page tables in one pass instead of one trap per 4 KiB page (cheaper
 // per page than the traps, on a virtual machine also when the host must
@@ -193,6 +197,7 @@ inline void prefault(void *p, std::size_t bytes) noexcept {
 #endif
   static std::atomic<bool> unsupported{false};
   if (current_alloc_hook() || bytes < (std::size_t{64} << 10) || unsupported.load(std::memory_order_relaxed)) return;
+  if (!(call_config().pages & MFREE_PAGES_PREFAULT) || env::hugepages_off()) return;
   const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p) + 4095) & ~static_cast<std::uintptr_t>(4095);
   const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~static_cast<std::uintptr_t>(4095);
   if (b <= a) return;

@@ -9,6 +9,7 @@
 #include <exception>
 
 #include "core/base/alloc.hpp"
+#include "core/base/config.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -64,7 +65,7 @@ constexpr int kMaxBlocks = 64;
 inline int block_count(int nt) { return nt < 1 ? 1 : (nt > kMaxBlocks ? kMaxBlocks : nt); }
 
 // Run body(t, begin, end) over the static blocks t = 0 .. block_count(nt) - 1 of count
-// items, with the caller's allocator hook installed on every thread. The layout never
+// items, with the caller's allocator hook and options installed on every thread. The layout never
 // depends on the team size: if the runtime grants fewer threads than asked (thread
 // limit, nested region, OMP_DYNAMIC), each thread runs several whole blocks in turn
 // (thread k: blocks k, k + team, ...), so `t` is always a block index below
@@ -80,11 +81,13 @@ void parallel_blocks(int64_t count, int nt, Body &&body) {
   }
 #ifdef _OPENMP
   const AllocHook *hook = current_alloc_hook();
+  const CallConfig *config = current_config();
   std::exception_ptr err[kMaxBlocks];
 #pragma omp parallel num_threads(nt)
   {
     const int team = omp_get_num_threads();
     AllocScope scope(hook);
+    ConfigScope config_scope(config);
     ThreadScope one(1);
     for (int t = omp_get_thread_num(); t < nt; t += team) {
       int64_t b, e;

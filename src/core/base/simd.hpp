@@ -1,12 +1,15 @@
-// Function multiversioning for the hot row kernels. The library is built for
-// the baseline of its target (x86-64: SSE2, no -march) so that it runs on every machine;
-// row kernels that profit from wider vectors and fused multiply-adds are compiled a
-// second time for AVX2 + FMA, and the copy to run is chosen at run time from the CPU.
+// SIMD in mfree: one style, one dispatch (docs/performance.md, "Vector instructions").
 //
-// Two ways to write the second copy (GCC and Clang on x86-64; elsewhere both macros
-// are empty and MFREE_SIMD_X86 is 0, so the code compiles once, for the baseline):
+// The library is built for the baseline of its target (x86-64: SSE2, no -march) so that
+// it runs on every machine; kernels that profit from wider vectors and fused
+// multiply-adds are compiled a second time for AVX2 + FMA, and the copy to run is chosen
+// at run time from the CPU. Every vector kernel is written the same way:
 //
-//   1. A whole region of code (templates included) in its own namespace:
+//   1. Once, as portable C++: templates with loops of compile-time length and, where the
+//      lanes must be explicit, GCC/Clang vector extensions (V2, V4 below, loaded and
+//      stored with simd::load / simd::store). Arithmetic is written as arithmetic
+//      (acc += g * u); the AVX2 copy contracts it to fused multiply-adds.
+//   2. Compiled twice by region, in an anonymous namespace of the .cpp:
 //        namespace base { <kernels> }
 //        #if MFREE_SIMD_X86
 //        MFREE_AVX2_BEGIN
@@ -15,28 +18,29 @@
 //        #endif
 //      Every function *defined* between the two macros is compiled for AVX2 + FMA;
 //      functions defined elsewhere (std::, Eigen) and inlined into them are too,
-//      functions called out of line stay baseline. Keep the region's code in an
-//      anonymous or ISA-named namespace: an inline function or template with external
-//      linkage defined twice with different targets breaks the one-definition rule
-//      (the linker may keep the AVX2 copy for baseline callers).
-//   2. One function: MFREE_TARGET_AVX2 on its definition, with the body an
-//      MFREE_ALWAYS_INLINE template shared with the baseline copy.
+//      functions called out of line stay baseline. Never give a region's code external
+//      linkage: an inline function or template defined twice with different targets
+//      breaks the one-definition rule (the linker may keep the AVX2 copy for baseline
+//      callers). No per-function target attributes; an intrinsic only for what the
+//      extensions cannot say (a masked load, a movemask), inside the region.
+//   3. Chosen once per call with simd::use_avx2(), before any parallel region, so that
+//      every thread of a call runs the same copy and results stay bitwise identical for
+//      any thread count. The reference backend (config.hpp) takes no vector path.
 //
-// Leave AVX2 code for baseline code with the upper halves of the vector registers zeroed
-// (_mm256_zeroupper() before returning to a baseline caller, as shape_fast.cpp does):
-// the compiler does this inside the AVX2 copy, but not at an indirect return to
-// baseline SSE code, and on this project's machines the dirty state made the baseline
-// code after it markedly slower (seen in the Randles-Libersky setup).
+// An AVX2 function called through a pointer from baseline code returns through
+// MFREE_ZERO_UPPER(): the compiler clears the upper halves of the vector registers inside
+// the AVX2 copy but not at an indirect return to baseline SSE code, and the dirty state
+// made the baseline code after it markedly slower on this project's machines (seen in
+// the Randles-Libersky setup).
 //
-// Choose with simd::use_avx2() once per call (not per site): the answer depends only on
-// the CPU and the environment, so every thread of a call runs the same copy and results
-// stay bitwise identical for any thread count. The two copies may differ at round-off
-// (FMA contracts a * b + c), so a host that needs bitwise reproducibility across
-// machines sets MFREE_SIMD=baseline in the environment.
+// The two copies may differ at round-off (FMA contracts a * b + c), so a host that needs
+// bitwise reproducibility across machines sets MFREE_SIMD=baseline in the environment
+// (read in config.cpp) or runs the reference backend.
 #pragma once
 
-#include <cstdlib>
 #include <cstring>
+
+#include "core/base/config.hpp"
 
 #if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__)) && \
     !defined(MFREE_NO_SIMD_DISPATCH)
@@ -52,7 +56,6 @@
 #endif
 
 #if MFREE_SIMD_X86
-#define MFREE_TARGET_AVX2 __attribute__((target("avx2,fma")))
 #if defined(__clang__)
 #define MFREE_AVX2_BEGIN \
   _Pragma("clang attribute push(__attribute__((target(\"avx2,fma\"))), apply_to = function)")
@@ -62,22 +65,88 @@
 #define MFREE_AVX2_END _Pragma("GCC pop_options")
 #endif
 #else
-#define MFREE_TARGET_AVX2
 #define MFREE_AVX2_BEGIN
 #define MFREE_AVX2_END
+#endif
+
+// Per-function target attribute: kept only for the neighbour search's kernels written
+// before the one style (particles/neighbors_*.inc); new code uses the region above.
+#if MFREE_SIMD_X86
+#define MFREE_TARGET_AVX2 __attribute__((target("avx2,fma")))
+#else
+#define MFREE_TARGET_AVX2
 #endif
 
 namespace mfree {
 namespace simd {
 
+#if defined(__GNUC__) || defined(__clang__)
+#define MFREE_VECTOR_EXTENSIONS 1
+// Two and four doubles: SSE2 / AVX2 registers (NEON pairs on arm64). Only in locals of a
+// region's functions, never passed by value across a call (whose ABI differs between
+// the copies).
+typedef double V2 __attribute__((vector_size(16)));
+typedef double V4 __attribute__((vector_size(32)));
+#else
+#define MFREE_VECTOR_EXTENSIONS 0
+#endif
+
+// N consecutive doubles at p into the low lanes of v (the others 0); no alignment.
+// Vectors go by reference (a 32-byte vector by value has another ABI in each copy).
+// Lanes are set one by one below the full width: a memcpy into part of a vector goes
+// through the stack and stalls the load that reads it back.
+template <int N, class V>
+MFREE_ALWAYS_INLINE void load(V &v, const double *p) {
+  if constexpr (N * sizeof(double) == sizeof(V)) {
+    std::memcpy(&v, p, sizeof(V));
+  } else if constexpr (sizeof(V) == 2 * sizeof(double)) {
+    v = V{p[0], 0.0};
+  } else if constexpr (N == 1) {
+    v = V{p[0], 0.0, 0.0, 0.0};
+  } else if constexpr (N == 2) {
+    v = V{p[0], p[1], 0.0, 0.0};
+  } else {
+    v = V{p[0], p[1], p[2], 0.0};
+  }
+}
+template <int N>
+MFREE_ALWAYS_INLINE void load(double &v, const double *p) { v = *p; }
+
+#if MFREE_VECTOR_EXTENSIONS
+// v = {v1, v2, v3, v0}: lanes 1-3 down to 0-2.
+MFREE_ALWAYS_INLINE void rotate_down(V4 &v) {
+#if defined(__clang__)
+  v = __builtin_shufflevector(v, v, 1, 2, 3, 0);
+#else
+  typedef long long I4 __attribute__((vector_size(32)));
+  v = __builtin_shuffle(v, I4{1, 2, 3, 0});
+#endif
+}
+#endif
+
+// The low N lanes of v to p.
+template <int N, class V>
+MFREE_ALWAYS_INLINE void store(double *p, const V &v) {
+  std::memcpy(p, &v, N * sizeof(double));
+}
+
+// Lane i of v (v itself for a scalar).
+template <class V>
+MFREE_ALWAYS_INLINE double lane(const V &v, int i) { return v[i]; }
+MFREE_ALWAYS_INLINE double lane(double v, int) { return v; }
+
+#if MFREE_SIMD_X86
+// Clears the upper halves of the vector registers (vzeroupper); call only in AVX2 code.
+#define MFREE_ZERO_UPPER() __builtin_ia32_vzeroupper()
+#endif
+
 // True when the AVX2 + FMA copies may run: the CPU has both (and the OS saves the YMM
 // state, which __builtin_cpu_supports checks) and MFREE_SIMD is not "baseline".
-// Cheap enough to ask once per setup/update/step (the CPU model is read once by the
-// compiler runtime; getenv is a scan of the environment).
+// Cheap enough to ask once per setup/update/apply (the CPU model is read once by the
+// compiler runtime; the override is one scan of the environment).
 inline bool use_avx2() {
 #if MFREE_SIMD_X86
-  const char *env = std::getenv("MFREE_SIMD");
-  if (env && std::strcmp(env, "baseline") == 0) return false;
+  if (env::simd_baseline()) return false;
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 #else
