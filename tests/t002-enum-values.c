@@ -108,6 +108,15 @@ static void test_assembly_values(void **s) {
   assert_int_equal(MFREE_MPFEM_DERIV_NODAL, 3);
 }
 
+static void test_context_option_values(void **s) {
+  (void)s;
+  assert_int_equal(MFREE_BACKEND_REF, 1);
+  assert_int_equal(MFREE_BACKEND_OPT, 2);
+  assert_int_equal(MFREE_PAGES_DEFAULT, 0);
+  assert_int_equal(MFREE_PAGES_HUGE, 1);
+  assert_int_equal(MFREE_PAGES_PREFAULT, 2);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_status_values),
@@ -115,6 +124,7 @@ int main(void) {
       cmocka_unit_test(test_kernel_values),
       cmocka_unit_test(test_method_values),
       cmocka_unit_test(test_assembly_values),
+      cmocka_unit_test(test_context_option_values),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

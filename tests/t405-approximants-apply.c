@@ -19,7 +19,11 @@
 #include "testutil.h"
 
 static mfree_context_t *ctx;
-static int setup(void **s) { (void)s; return mfree_context_create(&ctx) != MFREE_SUCCESS; }
+static int32_t backend = MFREE_BACKEND_OPT; /* argument "ref": the reference backend */
+static int setup(void **s) {
+  (void)s;
+  return mfree_context_create(&ctx) != MFREE_SUCCESS || mfree_context_set_backend(ctx, backend) != MFREE_SUCCESS;
+}
 static int teardown(void **s) { (void)s; return mfree_context_destroy(&ctx) != MFREE_SUCCESS; }
 
 #define NMAX 256
@@ -464,7 +468,8 @@ static void test_ghosts(void **s) {
   }
 }
 
-int main(void) {
+int main(int argc, char **argv) {
+  backend = mfree_test_backend(argc, argv);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_apply_add),
       cmocka_unit_test(test_layouts),

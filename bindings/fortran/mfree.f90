@@ -139,6 +139,12 @@ module mfree
   ! ---- mfree_lumping_t -----------------------------------------------------------
   integer(c_int), parameter, public :: MFREE_LUMP_GALERKIN = 1
   integer(c_int), parameter, public :: MFREE_LUMP_PHYSICAL = 2
+  ! mfree_backend_t, mfree_pages_t (mfree.h)
+  integer(c_int), parameter, public :: MFREE_BACKEND_REF = 1
+  integer(c_int), parameter, public :: MFREE_BACKEND_OPT = 2
+  integer(c_int), parameter, public :: MFREE_PAGES_DEFAULT = 0
+  integer(c_int), parameter, public :: MFREE_PAGES_HUGE = 1
+  integer(c_int), parameter, public :: MFREE_PAGES_PREFAULT = 2
 
   ! ---- mfree_element_t (mesh element types) -----------------------------------------
   integer(c_int), parameter, public :: MFREE_ELEMENT_LINE2 = 1
@@ -287,6 +293,34 @@ module mfree
       type(c_ptr), value :: ctx
       integer(c_int32_t), intent(out) :: nthreads
     end function mfree_context_get_num_threads_c
+
+    integer(c_int) function mfree_context_set_backend_c(ctx, backend) &
+        bind(C, name="mfree_context_set_backend")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: backend
+    end function mfree_context_set_backend_c
+
+    integer(c_int) function mfree_context_get_backend_c(ctx, backend) &
+        bind(C, name="mfree_context_get_backend")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), intent(out) :: backend
+    end function mfree_context_get_backend_c
+
+    integer(c_int) function mfree_context_set_page_hints_c(ctx, flags) &
+        bind(C, name="mfree_context_set_page_hints")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: flags
+    end function mfree_context_set_page_hints_c
+
+    integer(c_int) function mfree_context_get_page_hints_c(ctx, flags) &
+        bind(C, name="mfree_context_get_page_hints")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), intent(out) :: flags
+    end function mfree_context_get_page_hints_c
 
     ! alloc: type(c_funptr) to a bind(C) function returning type(c_ptr) with arguments
     ! (type(c_ptr), value :: user; integer(c_int64_t), value :: bytes); release: a
@@ -1415,6 +1449,8 @@ module mfree
   public :: mfree_context_get_last_error_c, mfree_context_set_error_c
   public :: mfree_context_set_error_handler_c, mfree_context_set_num_threads_c
   public :: mfree_context_get_num_threads_c, mfree_kernel_eval_c
+  public :: mfree_context_set_backend_c, mfree_context_get_backend_c
+  public :: mfree_context_set_page_hints_c, mfree_context_get_page_hints_c
   public :: mfree_context_set_allocator_c
   public :: mfree_kernel_get_support_radius_c, mfree_kernel_get_normalization_c
   public :: mfree_particles_create_c, mfree_particles_destroy_c
@@ -1531,6 +1567,8 @@ module mfree
   public :: mfree_context_create, mfree_context_destroy, mfree_context_get_last_error
   public :: mfree_context_set_error, mfree_context_set_error_handler
   public :: mfree_context_set_num_threads, mfree_context_get_num_threads
+  public :: mfree_context_set_backend, mfree_context_get_backend
+  public :: mfree_context_set_page_hints, mfree_context_get_page_hints
   public :: mfree_context_set_allocator
   public :: mfree_kernel_eval, mfree_kernel_get_support_radius
   public :: mfree_kernel_get_normalization
@@ -1970,6 +2008,34 @@ contains
     integer(c_int32_t), intent(out) :: nthreads
     st = mfree_context_get_num_threads_c(ctx%ptr, nthreads)
   end function mfree_context_get_num_threads
+
+  !> Typed wrapper of mfree_context_set_backend (mfree.h).
+  integer(c_int) function mfree_context_set_backend(ctx, backend) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: backend
+    st = mfree_context_set_backend_c(ctx%ptr, backend)
+  end function mfree_context_set_backend
+
+  !> Typed wrapper of mfree_context_get_backend (mfree.h).
+  integer(c_int) function mfree_context_get_backend(ctx, backend) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(out) :: backend
+    st = mfree_context_get_backend_c(ctx%ptr, backend)
+  end function mfree_context_get_backend
+
+  !> Typed wrapper of mfree_context_set_page_hints (mfree.h).
+  integer(c_int) function mfree_context_set_page_hints(ctx, flags) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: flags
+    st = mfree_context_set_page_hints_c(ctx%ptr, flags)
+  end function mfree_context_set_page_hints
+
+  !> Typed wrapper of mfree_context_get_page_hints (mfree.h).
+  integer(c_int) function mfree_context_get_page_hints(ctx, flags) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(out) :: flags
+    st = mfree_context_get_page_hints_c(ctx%ptr, flags)
+  end function mfree_context_get_page_hints
 
   !> Install an allocator (mfree_context_set_allocator): alloc = c_funloc of a bind(C)
   !> function (user, bytes) returning type(c_ptr), release = c_funloc of a bind(C)

@@ -110,6 +110,18 @@ program t010_context_errors_f
   st = mfree_context_set_num_threads(ctx, 2_c_int32_t)
   st = mfree_context_get_num_threads(ctx, nthreads)
   call check(st == MFREE_SUCCESS .and. nthreads == 2, 'thread count round trip')
+  st = mfree_context_set_backend(ctx, 7_c_int32_t)
+  call check(st == MFREE_ERR_ARG, 'unknown backend is MFREE_ERR_ARG')
+  st = mfree_context_set_backend(ctx, MFREE_BACKEND_REF)
+  st = mfree_context_get_backend(ctx, nthreads)
+  call check(st == MFREE_SUCCESS .and. nthreads == MFREE_BACKEND_REF, 'backend round trip')
+  st = mfree_context_set_backend(ctx, MFREE_BACKEND_OPT)
+  st = mfree_context_set_page_hints(ctx, 4_c_int32_t)
+  call check(st == MFREE_ERR_ARG, 'unknown page flags are MFREE_ERR_ARG')
+  st = mfree_context_set_page_hints(ctx, ior(MFREE_PAGES_HUGE, MFREE_PAGES_PREFAULT))
+  st = mfree_context_get_page_hints(ctx, nthreads)
+  call check(st == MFREE_SUCCESS .and. nthreads == 3, 'page hints round trip')
+  st = mfree_context_set_page_hints(ctx, MFREE_PAGES_DEFAULT)
 
   ! ---- null handles --------------------------------------------------------------------
   call check(mfree_particles_setup(null_ps) == MFREE_ERR_NULL, 'null particle set')

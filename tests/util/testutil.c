@@ -62,3 +62,7 @@ double mfree_test_lumped_mass_rel_diff(mfree_context_t *ctx, mfree_system_t *sys
   free(Mi);
   return fabs(lumped - total) / total;
 }
+
+int32_t mfree_test_backend(int argc, char **argv) {
+  return argc > 1 && strcmp(argv[1], "ref") == 0 ? MFREE_BACKEND_REF : MFREE_BACKEND_OPT;
+}

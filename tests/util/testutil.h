@@ -50,4 +50,8 @@ void mfree_test_lumped_masses(mfree_context_t *ctx, mfree_system_t *sys, const d
 double mfree_test_lumped_mass_rel_diff(mfree_context_t *ctx, mfree_system_t *sys, const double *y,
                                        const double *m, int n);
 
+/* The backend a conformance test runs on: MFREE_BACKEND_REF when its first argument is
+ * "ref" (CTest registers those tests once more as <name>-ref), else MFREE_BACKEND_OPT. */
+int32_t mfree_test_backend(int argc, char **argv);
+
 #endif

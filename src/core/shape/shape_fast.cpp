@@ -110,6 +110,7 @@ void FastScratch::reserve(int maxrow) {
 
 FastPath::FastPath(int dim, int method, int order, const Kernel &kernel, int flags)
     : method_(method), order_(order), kernel_(&kernel) {
+  if (!optimised()) return;  // the reference backend (config.hpp) runs the general path
   if (flags & MFREE_DERIV_HESSIAN) return;
   if (dim < 1 || dim > 3) return;
   // LDL^T without pivoting needs non-negative weights
