@@ -76,7 +76,7 @@ static void run(int dim, double n_target, int threads, double g1, double gn) {
   const double h = 0.5 * bench_radius(dim);
   mfree_context_t *ctx = NULL;
   mfree_context_create(&ctx);
-  mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT); /* a host that wants speed opts in */
+  bench_page_hints(ctx);
   mfree_particles_t *ps = NULL;
   mfree_particles_create(ctx, dim, n, &ps);
   mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);

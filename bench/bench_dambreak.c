@@ -50,7 +50,7 @@ static double run(int nx, int64_t steps, int threads, int *n_out) {
   mfree_context_t *ctx = NULL;
   mfree_system_t *sys = NULL;
   mfree_context_create(&ctx);
-  mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT); /* a host that wants speed opts in */
+  bench_page_hints(ctx);
   mfree_context_set_num_threads(ctx, threads);
   mfree_system_create_fluid(ctx, 2, n, &sys);
   mfree_system_set_fluid(sys, &rho0, 0, kappa, gam, 1e-3);

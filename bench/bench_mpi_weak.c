@@ -50,7 +50,7 @@ int main(int argc, char **argv) {
   mfree_context_t *ctx = NULL;
   mfree_halo_t *halo = NULL;
   ok(ctx, mfree_context_create(&ctx), "context");
-  mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT); /* a host that wants speed opts in */
+  bench_page_hints(ctx);
   ok(ctx, mfree_halo_create(ctx, MPI_COMM_WORLD, 2, &halo), "halo");
   MPI_Barrier(MPI_COMM_WORLD);
   double t0 = MPI_Wtime();

@@ -145,7 +145,7 @@ double time_mfree(int dim, int n, const double *x, double h, int threads, int re
   static Held count;  // outlives a kept set (destroyed after this context)
   count.bytes = 0;
   mfree_context_create(&ctx);
-  mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT); /* a host that wants speed opts in */
+  bench_page_hints(ctx);
   if (held) mfree_context_set_allocator(ctx, held_alloc, held_free, &count);  // (not thread-safe: 1-thread run)
   mfree_context_set_num_threads(ctx, 1);
   mfree_particles_create(ctx, dim, n, &ps);

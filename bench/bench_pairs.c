@@ -77,7 +77,7 @@ static void run(int dim, double ntarget, int reps) {
   }
   mfree_context_t *ctx = NULL;
   CHECK(mfree_context_create(&ctx));
-  mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT); /* a host that wants speed opts in */
+  bench_page_hints(ctx);
   /* the host's pair list: mfree's own search once (j > i), as a linked-list search
    * would give it */
   mfree_particles_t *search = NULL;

@@ -87,7 +87,7 @@ static void time_method(int dim, int n, const double *x, double h, const method_
   counter_t cnt = {0, 0, 0};
   mfree_context_t *ctx = NULL;
   mfree_context_create(&ctx);
-  mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT); /* a host that wants speed opts in */
+  bench_page_hints(ctx);
   mfree_particles_t *ps = NULL;
   const double vol = 1.0;
   check(ctx, mfree_particles_create(ctx, dim, n, &ps), "particles_create");

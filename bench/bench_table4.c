@@ -45,7 +45,7 @@ int main(int argc, char **argv) {
   const double vol = dx * dx, dms[3] = {1.5, 2.5, 3.5}, paper[3] = {3.06, 3.12, 2.43};
   mfree_context_t *ctx = NULL;
   mfree_context_create(&ctx);
-  mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT); /* a host that wants speed opts in */
+  bench_page_hints(ctx);
   mfree_context_set_num_threads(ctx, 1);
   printf("paper 000 Table IV: Method 1 vs MLS (order 1) shape functions + gradients, %d particles\n", n);
   printf("%5s %14s %14s %10s %10s\n", "d_m", "Method1 p/s", "MLS p/s", "speed-up", "paper");

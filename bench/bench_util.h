@@ -11,6 +11,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <mfree.h>
+
 /* Wall clock; with MFREE_BENCH_CLOCK=cpu the process CPU time instead, which keeps
  * one-thread figures meaningful on a machine shared with other jobs (threaded figures
  * then add the threads' times and mean nothing). */
@@ -23,6 +25,17 @@ static inline double bench_now(void) {
   struct timespec t;
   clock_gettime(cpu ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC, &t);
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Huge pages and prefaulting for the library's big tables: a host that wants speed opts
+ * in. A library from before the option did both by default (bench/CMakeLists.txt defines
+ * MFREE_BENCH_HAVE_PAGE_HINTS when mfree.h declares it). */
+static inline void bench_page_hints(mfree_context_t *ctx) {
+#ifdef MFREE_BENCH_HAVE_PAGE_HINTS
+  mfree_context_set_page_hints(ctx, MFREE_PAGES_HUGE | MFREE_PAGES_PREFAULT);
+#else
+  (void)ctx;
+#endif
 }
 
 /* Deterministic uniform numbers in [-1, 1) (xorshift64*), the same on every libc. */
