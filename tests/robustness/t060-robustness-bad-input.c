@@ -236,6 +236,11 @@ static const char *health(int ref) {
   if (mfree_assembler_assemble_rhs(F.as, rhs)) return "assembler rhs";
   if (mfree_system_rhs(F.sys, 0.0, F.y, ydot)) return "system rhs";
   if (mfree_context_get_num_threads(F.ctx, &nt) || nt != 1) return "context threads";
+  int32_t backend = 0, hints = -1;
+  if (mfree_context_get_backend(F.ctx, &backend) || backend != MFREE_BACKEND_OPT)
+    return "context backend";
+  if (mfree_context_get_page_hints(F.ctx, &hints) || hints != MFREE_PAGES_DEFAULT)
+    return "context page hints";
   if (ref) {
     F.ref_nnz = nnz;
     memcpy(F.ref_grad, grad, sizeof grad);
@@ -439,6 +444,16 @@ static void rows_version_context(void) {
   ROW(MFREE_ERR_ARG, mfree_context_set_num_threads(F.ctx, -1));
   ROW0(MFREE_ERR_NULL, mfree_context_get_num_threads(NULL, &i32));
   ROW0(MFREE_ERR_NULL, mfree_context_get_num_threads(F.ctx, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_context_set_backend(NULL, MFREE_BACKEND_REF));
+  ROW(MFREE_ERR_ARG, mfree_context_set_backend(F.ctx, 0));
+  ROW(MFREE_ERR_ARG, mfree_context_set_backend(F.ctx, 3));
+  ROW0(MFREE_ERR_NULL, mfree_context_get_backend(NULL, &i32));
+  ROW0(MFREE_ERR_NULL, mfree_context_get_backend(F.ctx, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_context_set_page_hints(NULL, MFREE_PAGES_HUGE));
+  ROW(MFREE_ERR_ARG, mfree_context_set_page_hints(F.ctx, -1));
+  ROW(MFREE_ERR_ARG, mfree_context_set_page_hints(F.ctx, 4));
+  ROW0(MFREE_ERR_NULL, mfree_context_get_page_hints(NULL, &i32));
+  ROW0(MFREE_ERR_NULL, mfree_context_get_page_hints(F.ctx, NULL));
 #if MFREE_T060_ALLOCATOR
   ROW0(MFREE_ERR_NULL, mfree_context_set_allocator(NULL, my_alloc, my_free, NULL));
   ROW(MFREE_ERR_ARG, mfree_context_set_allocator(F.ctx, my_alloc, NULL, NULL));
