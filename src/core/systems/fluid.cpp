@@ -21,6 +21,13 @@
 
 namespace mfree {
 
+namespace {
+// Threads for a loop of a few operations per particle (checks, volumes, updates): a team
+// and its barrier (a few microseconds on idle cores, far more on a loaded machine) pay
+// off from ~8,000 particles.
+inline int light_threads(int64_t n) { return num_threads(n / 4); }
+}  // namespace
+
 FluidSystem::FluidSystem(int dim, int32_t n)
     : dim_(dim), n_(n), ps_(dim, n), kernel_(MFREE_KERNEL_CUBIC_SPLINE, dim == 3 ? 3 : 2, 0.0) {
   if (dim != 2 && dim != 3) throw Error(MFREE_ERR_ARG, "the fluid system is 2D or 3D, not " + std::to_string(dim) + "D");
@@ -212,6 +219,900 @@ double FluidSystem::tait(double rho, double rho0) const {
     return r2 * r2 * r2 * r;
   }
   return std::pow(r, gamma_);
+}
+
+
+Report FluidSystem::candidates(const double *xn) {
+  const int dim = dim_;
+  const int32_t nall = nq();
+  const size_t nx = static_cast<size_t>(nall) * dim;
+  bool rebuild = !lists_valid_ || xref_.size() != nx || href_ != h_;
+  if (!rebuild) {
+    // 2 max |x - x_ref| < skin: pairs now closer than 2h were closer than 2h + skin at
+    // the build (a tenth of the skin kept back for rounding)
+    const double lim = 0.45 * skin_ * h_, lim2 = lim * lim;
+    bool moved[64] = {};  // per thread (parallel_blocks runs at most 64)
+    const double *xr = xref_.data();
+    parallel_blocks(nall, light_threads(nall), [&](int t, int64_t b, int64_t e) {
+      bool far = false;
+      for (int64_t i = b; i < e; ++i) {
+        double d2 = 0.0;
+        for (int c = 0; c < dim; ++c) d2 += (xn[i * dim + c] - xr[i * dim + c]) * (xn[i * dim + c] - xr[i * dim + c]);
+        far = far || !(d2 <= lim2);
+      }
+      moved[t] = far;
+    });
+    rebuild = std::any_of(moved, moved + 64, [](bool f) { return f; });
+  }
+  if (!rebuild) {
+    if (xn != xbound_) {  // same lists, positions from another buffer (ps_ is read by fluid_wall)
+      ps_.set_positions(xn, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
+      xbound_ = xn;
+    }
+    return Report();
+  }
+  lists_valid_ = false;
+  const double hs = h_ * (1.0 + 0.5 * skin_);  // gather radius 2 hs = 2h + skin
+  ps_.set_positions(xn, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
+  xbound_ = xn;
+  ps_.set_volumes(vol_.data(), 1, MFREE_BORROW);
+  ps_.set_support(&hs, 0, MFREE_COPY);
+  Report r = ps_.setup();
+  if (!r.ok()) return r;
+  const Csr &nb = ps_.neighbors();
+  cand_.rowptr.assign(nb.rowptr.begin(), nb.rowptr.end());
+  cand_.cols.assign(nb.cols.begin(), nb.cols.end());
+  const int64_t cnnz = cand_.nnz();
+  ctrans_valid_ = false;
+  // the tables' rows lie in their candidate rows: no allocation until the next rebuild
+  cols_.resize(cnnz);
+  N_.resize(cnnz);
+  G_.resize(cnnz * dim);
+  rb_.resize(nall);
+  re_.resize(nall);
+  cond_.resize(nall);
+  maxrow_ = 0;
+  for (int32_t i = 0; i < nall; ++i)
+    maxrow_ = std::max<int64_t>(maxrow_, cand_.rowptr[i + 1] - cand_.rowptr[i]);
+  xref_.assign(xn, xn + nx);
+  href_ = h_;
+  ++rebuilds_;
+  color_chunks();
+  if (walls_) {
+    VectorArray xa;
+    xa.ptr = xn;
+    xa.ld = dim;
+    xa.layout = MFREE_LAYOUT_AOS;
+    ScalarArray ha;
+    const double hw = 0.5 * (r0_ + 0.5 * skin_ * h_);  // walls stand still: skin / 2 is enough
+    ha.ptr = &hw;
+    ha.stride = 0;
+    find_point_neighbors(*walls_, walls_->site_status(), n_, xa, ha, wall_nbr_);
+  }
+  lists_valid_ = true;
+  return Report();
+}
+
+void FluidSystem::transposed_candidates() {
+  const int32_t nall = nq();
+  // transposed entries: rows are sorted, so the rows i < j that hold j are met in the
+  // order of row j (next[j] walks it); a missing partner (an asymmetric pair at the
+  // edge of the lists) is -1 and may not become a pair of the tables
+  ctrans_.assign(cand_.nnz(), -1);
+  std::vector<int64_t> next(cand_.rowptr.begin(), cand_.rowptr.end() - 1);
+  for (int32_t i = 0; i < nall; ++i)
+    for (int64_t e = cand_.rowptr[i]; e < cand_.rowptr[i + 1]; ++e) {
+      const int32_t j = cand_.cols[e];
+      int64_t &p = next[j];
+      while (p < cand_.rowptr[j + 1] && cand_.cols[p] < i) ++p;
+      if (p < cand_.rowptr[j + 1] && cand_.cols[p] == i) ctrans_[e] = p;
+    }
+  cpos_.resize(cand_.nnz());
+  NT_.resize(cand_.nnz() * (dim_ + 1));
+  ctrans_valid_ = true;
+}
+
+// Greedy colouring of the row chunks in chunk order: color_mask_[j] holds the colours
+// of the chunks so far that touch node j (write to it in the scatter: the candidates of
+// their rows, a superset of the table rows until the next rebuild). The chunks and their
+// colours depend on the lists only, not on the thread count. A node ordering so scattered
+// that 64 colours do not suffice runs all chunks in one colour, in order, on one thread.
+void FluidSystem::color_chunks() {
+  const int32_t nall = nq();
+  const int32_t nch = (nall + kChunk - 1) / kChunk;
+  const int64_t *crp = cand_.rowptr.data();
+  const int32_t *ccols = cand_.cols.data();
+  color_mask_.assign(nall, 0);
+  std::vector<int32_t> &color = chunk_color_;  // members: a rebuild allocates only when the set grows
+  color.assign(nch, 0);
+  int ncolor = 0;
+  bool serial = false;
+  for (int32_t c = 0; c < nch && !serial; ++c) {
+    const int64_t e0 = crp[static_cast<int64_t>(c) * kChunk], e1 = crp[std::min<int64_t>(nall, (c + 1) * int64_t{kChunk})];
+    uint64_t used = 0;
+    for (int64_t e = e0; e < e1; ++e) used |= color_mask_[ccols[e]];
+    if (used == ~uint64_t{0}) {
+      serial = true;
+      break;
+    }
+    int col = 0;
+    while (used >> col & 1u) ++col;
+    color[c] = col;
+    ncolor = std::max(ncolor, col + 1);
+    for (int64_t e = e0; e < e1; ++e) color_mask_[ccols[e]] |= uint64_t{1} << col;
+  }
+  if (serial) {
+    ncolor = 1;
+    std::fill(color.begin(), color.end(), 0);
+  }
+  color_ptr_.assign(static_cast<size_t>(ncolor) + 1, 0);
+  for (int32_t c = 0; c < nch; ++c) ++color_ptr_[color[c] + 1];
+  for (int col = 0; col < ncolor; ++col) color_ptr_[col + 1] += color_ptr_[col];
+  chunk_order_.resize(nch);
+  std::vector<int32_t> &fill = chunk_fill_;
+  fill.assign(color_ptr_.begin(), color_ptr_.end() - 1);
+  for (int32_t c = 0; c < nch; ++c) chunk_order_[fill[color[c]]++] = c;
+  scatter_threads_ = !serial;
+}
+
+// Shepard functions replace the MLS rows where the moment matrix is singular or the row
+// too short (of the weights w: MLS of order 0), and where it is ill-conditioned, not only
+// singular (of w V_j: the approximants' Shepard method; 003 Sect. 6: a lattice node has a
+// condition number of 10-15, a free edge or corner 30-60; a particle left in a thin sheet
+// or strand climbs past 1e3 within a few steps, and its gradients then drive the density
+// negative in one step (dam break along the wall, T ~ 2.2, at every resolution and CFL
+// number tried). Hence the default threshold 100 (mfree_system_set_shepard_condition).
+
+#if defined(__GNUC__) || defined(__clang__)
+#define FLUID_NOINLINE __attribute__((noinline))
+#else
+#define FLUID_NOINLINE
+#endif
+
+namespace {
+
+// The candidates cc[0 .. nc) of node k closer than 2h (r2 < R2: a symmetric test,
+// |x_j - x_k| is computed alike from both ends) written to js; returns their count.
+// Candidates out of range are written and then overwritten (no branch: a quarter of them
+// fall out). Not inlined into AVX2 code, where FMA contraction of r2 would move pairs at
+// exactly 2h in or out of the rows depending on the CPU.
+template <int D>
+FLUID_NOINLINE int kept_columns(const double *xn, int64_t k, const int32_t *cc, int64_t nc, double R2, int32_t *js) {
+  const double *xk = xn + k * D;
+  int q = 0;
+  for (int64_t e = 0; e < nc; ++e) {
+    const int32_t j = cc[e];
+    const double *xj = xn + static_cast<size_t>(j) * D;
+    double r2 = 0.0;
+    for (int c = 0; c < D; ++c) {
+      const double d = xj[c] - xk[c];
+      r2 += d * d;
+    }
+    js[q] = j;
+    q += r2 < R2;
+  }
+  return q;
+}
+
+#if MFREE_SIMD_X86
+struct PackTable {
+  int32_t d[16][8];  // mask -> 32-bit lane indices moving the kept doubles to the front
+  int32_t i[16][8];  // mask -> lane indices moving the kept 32-bit columns to the front
+};
+constexpr PackTable make_pack_table() {
+  PackTable t{};
+  for (int m = 0; m < 16; ++m) {
+    int q = 0;
+    for (int l = 0; l < 4; ++l)
+      if (m >> l & 1) {
+        t.d[m][2 * q] = 2 * l;
+        t.d[m][2 * q + 1] = 2 * l + 1;
+        t.i[m][q] = l;
+        ++q;
+      }
+  }
+  return t;
+}
+constexpr PackTable kPack = make_pack_table();
+
+// kept_columns<2> four candidates at a time with two 128-bit loads per pair of lanes, the
+// kept columns left-packed through a permutation table; the products are kept from FMA
+// contraction by an empty asm (the same test as the scalar loop, on any CPU).
+MFREE_TARGET_AVX2 FLUID_NOINLINE int kept_columns2_avx2(const double *xn, int64_t k, const int32_t *cc, int64_t nc,
+                                                       double R2, int32_t *js) {
+  const __m256d xk = _mm256_set1_pd(xn[2 * k]), yk = _mm256_set1_pd(xn[2 * k + 1]), r2v = _mm256_set1_pd(R2);
+  int q = 0;
+  int64_t e = 0;
+  for (; e + 4 <= nc; e += 4) {
+    const int32_t *j = cc + e;
+    const __m128d p0 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[0])), p1 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[1]));
+    const __m128d p2 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[2])), p3 = _mm_loadu_pd(xn + 2 * static_cast<size_t>(j[3]));
+    const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(p0), p2, 1);  // x0 y0 x2 y2
+    const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(p1), p3, 1);  // x1 y1 x3 y3
+    const __m256d dx = _mm256_sub_pd(_mm256_unpacklo_pd(lo, hi), xk), dy = _mm256_sub_pd(_mm256_unpackhi_pd(lo, hi), yk);
+    __m256d px = _mm256_mul_pd(dx, dx), py = _mm256_mul_pd(dy, dy);
+    __asm__("" : "+x"(px), "+x"(py));  // r2 = d0 d0 + d1 d1, rounded as kept_columns
+    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(_mm256_add_pd(px, py), r2v, _CMP_LT_OQ));
+    const __m256i pi = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.i[mask]));
+    const __m128i j4 = _mm_loadu_si128(reinterpret_cast<const __m128i *>(j));
+    const __m256i jp = _mm256_permutevar8x32_epi32(_mm256_zextsi128_si256(j4), pi);
+    _mm_storeu_si128(reinterpret_cast<__m128i *>(js + q), _mm256_castsi256_si128(jp));
+    q += __builtin_popcount(static_cast<unsigned>(mask));
+  }
+  for (; e < nc; ++e) {
+    const int32_t j = cc[e];
+    const double *xj = xn + static_cast<size_t>(j) * 2;
+    const double d0 = xj[0] - xn[2 * k], d1 = xj[1] - xn[2 * k + 1];
+    double p0 = d0 * d0, p1 = d1 * d1;
+    __asm__("" : "+x"(p0), "+x"(p1));
+    js[q] = j;
+    q += p0 + p1 < R2;
+  }
+  _mm256_zeroupper();
+  return q;
+}
+
+#endif
+
+}  // namespace
+
+// Rows [k0, k1) chunk by chunk: the kept candidates written to the chunk's rows (from
+// prepare's filter with the transpose, else filtered here), the approximants' fast path
+// (shape_fast.hpp; for 2D and AVX2 its fused rows) on them, the rows it leaves and those
+// worse conditioned than shepard_cond_ again by the general path (local.hpp), with the
+// approximants' fallbacks; with the transpose, then the rows' NT_ entries.
+bool FluidSystem::table_rows(int t, int32_t k0, int32_t k1, const double *xn, bool transpose) {
+  const int dim = dim_;
+  const int32_t nall = nq();
+  const double R2 = 4.0 * h_ * h_;
+  const int64_t *crp = cand_.rowptr.data();
+  const int32_t *ccols = cand_.cols.data();
+  const int32_t *cpos = cpos_.data();
+  int64_t *rbeg = rb_.data(), *rend = re_.data();
+  int64_t *rp = rows_ptr_.data() + static_cast<size_t>(t) * (nall + 1);
+  RowsScratch &w = rows_scratch_[t];
+  FastTables ft;
+  ft.rowptr = rp;
+  ft.cols = cols_.data();
+  ft.self = no_self_.data();  // (linear MLS does not use the site's place in its row)
+  for (int c = 0; c < dim; ++c) ft.x[c] = ft.sx[c] = xn + c;
+  ft.vol = xn;  // (read, never used: linear MLS does not weight by volume)
+  ft.stride = ft.sstride = dim;
+  ft.h = ft.sh = &h_;
+  ft.hstride = ft.shstride = 0;
+  ft.val = N_.data();
+  ft.grad = G_.data();
+  FastSites fs;
+  fs.status = site_status_.data();
+  fs.support = site_support_.data();
+  fs.order = site_order_.data();
+  fs.cond = cond_.data();
+  fs.order_used = 1;
+#if MFREE_SIMD_X86
+  const bool avx2 = dim == 2 && simd::use_avx2();
+#endif
+  for (int32_t c0 = k0; c0 < k1; c0 += kChunk) {
+    const int32_t c1 = std::min(k1, c0 + kChunk);
+    for (int32_t k = c0; k < c1; ++k) {
+      if (transpose) {  // the rows' places come from prepare's filter
+        for (int64_t e = crp[k]; e < crp[k + 1]; ++e)
+          if (cpos[e] >= 0) cols_[rbeg[k] + cpos[e]] = ccols[e];
+      } else {
+        const int64_t o = k == c0 ? crp[k] : rend[k - 1];
+        const int32_t *cc = ccols + crp[k];
+        const int64_t nc = crp[k + 1] - crp[k];
+        int n;
+#if MFREE_SIMD_X86
+        if (avx2) n = kept_columns2_avx2(xn, k, cc, nc, R2, cols_.data() + o);
+        else n = dim == 2 ? kept_columns<2>(xn, k, cc, nc, R2, cols_.data() + o) : kept_columns<3>(xn, k, cc, nc, R2, cols_.data() + o);
+#else
+        n = dim == 2 ? kept_columns<2>(xn, k, cc, nc, R2, cols_.data() + o) : kept_columns<3>(xn, k, cc, nc, R2, cols_.data() + o);
+#endif
+        rbeg[k] = o;
+        rend[k] = o + n;
+      }
+      rp[k] = rbeg[k];  // the chunk's rows lie one after another
+    }
+    rp[c1] = rend[c1 - 1];
+    fast_->run(ft, c0, c1, w.fast, fs);
+    for (int32_t k = c0; k < c1; ++k)
+      if (site_status_[k] != 0 || cond_[k] > shepard_cond_) general_row(k, xn, w);
+  }
+  if (!transpose) return false;
+  bool one_way = false;
+  const int64_t *ctr = ctrans_.data();
+  for (int32_t k = k0; k < k1; ++k) {  // N_k(x_j) is entry (j, k) of the transpose
+    int m = 0;
+    for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
+      if (cpos[e] < 0) continue;
+      const int64_t q = rbeg[k] + m++, tr = ctr[e];
+      if (tr < 0 || cpos[tr] < 0) {
+        one_way = true;
+        continue;
+      }
+      const int32_t j = ccols[e];
+      double *nt = NT_.data() + (rbeg[j] + cpos[tr]) * (dim + 1);  // one cache line per entry
+      nt[0] = N_[q];
+      for (int c = 0; c < dim; ++c) nt[1 + c] = G_[q * dim + c];
+    }
+  }
+  return one_way;
+}
+
+// Row k by the general path: linear MLS, then MLS of order 0 where that fails (singular,
+// too few neighbours), Shepard functions of w V where it is worse conditioned than
+// shepard_cond_ (the approximants' rules, Approximant::set_shepard_condition).
+void FluidSystem::general_row(int32_t k, const double *xn, RowsScratch &w) {
+  const int dim = dim_;
+  const int64_t o = rb_[k];
+  const int n = static_cast<int>(re_[k] - o);
+  const int32_t *js = cols_.data() + o;
+  w.d.resize(3 * static_cast<size_t>(n));
+  w.v.resize(n);
+  w.h.assign(n, h_);
+  LocalInput in;
+  in.n = n;
+  in.hs = h_;
+  for (int m = 0; m < n; ++m) {
+    for (int c = 0; c < 3; ++c) w.d[3 * m + c] = c < dim ? xn[static_cast<size_t>(js[m]) * dim + c] - xn[static_cast<size_t>(k) * dim + c] : 0.0;
+    w.v[m] = vol_[js[m]];
+    if (js[m] == k) in.self = m;
+  }
+  in.d = w.d.data();
+  in.vol = w.v.data();
+  in.h = w.h.data();
+  w.work.reserve(n, dim, dim + 1);
+  LocalOutput out;
+  out.phi = N_.data() + o;
+  out.grad = G_.data() + o * dim;
+  LocalConfig cfg;
+  cfg.method = MFREE_METHOD_MLS;
+  cfg.dim = dim;
+  cfg.order = 1;
+  cfg.kernel = &kernel_;
+  compute_site(cfg, in, w.work, out);
+  if (out.status) {
+    cfg.order = 0;
+    compute_site(cfg, in, w.work, out);
+    out.cond = 1.0;
+  } else if (out.cond > shepard_cond_) {
+    const double cond = out.cond;
+    cfg.method = MFREE_METHOD_SHEPARD;
+    cfg.order = 0;
+    compute_site(cfg, in, w.work, out);
+    out.cond = cond;
+  }
+  cond_[k] = out.cond;
+}
+
+Report FluidSystem::prepare(const double *y, bool checked) {
+  check_ready();
+  Report rep = checked ? Report() : check_state(y, -1);
+  if (!rep.ok()) return rep;
+  const int dim = dim_;
+  const int32_t nall = nq();
+  const size_t nd = static_cast<size_t>(dim) * n_;
+  const double *rho = y + 2 * nd;
+  parallel_blocks(n_, light_threads(n_), [&](int, int64_t b, int64_t e) {
+    for (int64_t i = b; i < e; ++i) vol_[i] = mass_[i] / rho[i];
+  });
+  const double *xn = node_positions(y);  // + dummies (fluid_wall.cpp)
+  Report r = candidates(xn);
+  if (!r.ok()) return r;
+  const int nt = num_threads(nall);
+  const int64_t *crp = cand_.rowptr.data();
+  const int32_t *ccols = cand_.cols.data();
+  const int64_t nchunk = (nall + kChunk - 1) / kChunk;  // the tables are written by chunks
+  const bool transpose = vci_;  // only consistent integration reads NT_ (fluid_wall.cpp)
+  if (transpose) {
+    // the transposed writes need every row's kept positions first: a filter pass (the
+    // rows filter on the fly otherwise), the same symmetric test as kept_columns
+    if (!ctrans_valid_) transposed_candidates();
+    const double R2 = 4.0 * h_ * h_;
+    auto filter = [&](auto dimc) {
+      constexpr int D = decltype(dimc)::value;
+      int32_t *cpos = cpos_.data();
+      int64_t *rbeg = rb_.data(), *rend = re_.data();
+      parallel_blocks(nchunk, nt, [&](int, int64_t cb, int64_t ce) {
+        for (int64_t k = cb * kChunk; k < std::min<int64_t>(nall, ce * kChunk); ++k) {
+          const double *xk = xn + k * D;
+          int32_t cnt = 0;
+          for (int64_t q = crp[k]; q < crp[k + 1]; ++q) {
+            const double *xj = xn + static_cast<size_t>(ccols[q]) * D;
+            double r2 = 0.0;
+            for (int c = 0; c < D; ++c) {
+              const double d = xj[c] - xk[c];
+              r2 += d * d;
+            }
+            const int32_t keep = r2 < R2;
+            cpos[q] = keep ? cnt : -1;
+            cnt += keep;
+          }
+          rbeg[k] = k % kChunk == 0 ? crp[k] : rend[k - 1];
+          rend[k] = rbeg[k] + cnt;
+        }
+      });
+    };
+    if (dim == 2) filter(std::integral_constant<int, 2>());
+    else filter(std::integral_constant<int, 3>());
+  }
+  if (rows_scratch_.size() < static_cast<size_t>(nt)) rows_scratch_.resize(nt);
+  for (int t = 0; t < nt; ++t) rows_scratch_[t].fast.reserve(static_cast<int>(maxrow_));
+  rows_ptr_.resize(static_cast<size_t>(nt) * (nall + 1));
+  site_status_.resize(nall);
+  site_support_.resize(nall);
+  site_order_.resize(nall);
+  no_self_.assign(nall, -1);
+  if (!fast_) fast_ = std::make_unique<FastPath>(dim, MFREE_METHOD_MLS, 1, kernel_, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT);
+  bool one_way[64] = {};  // parallel_blocks runs at most 64 threads
+  parallel_blocks(nchunk, nt, [&](int t, int64_t b, int64_t e) {
+    one_way[t] = table_rows(t, static_cast<int32_t>(b * kChunk), static_cast<int32_t>(std::min<int64_t>(nall, e * kChunk)), xn,
+                            transpose);
+  });
+  if (std::any_of(one_way, one_way + 64, [](bool f) { return f; })) {
+    // cannot happen with lists from one search radius; a failure rather than a wrong sum
+    rep.fail(MFREE_FAIL_NEIGHBORS, "the neighbour lists of the fluid are not symmetric");
+    lists_valid_ = false;
+    return rep;
+  }
+  fluid_share();
+  vci_setup();  // optional, fluid_wall.cpp
+  return rep;
+}
+
+void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, double *drho) const {
+  v = node_velocities(v);
+  const int dim = dim_;
+  const int64_t *rb = rb_.data(), *re = re_.data();
+  const int32_t *cols = cols_.data();
+  const double *N = N_.data(), *G = G_.data();
+  const bool avx2 = dim == 2 && simd::use_avx2();  // once per call: every thread runs the same copy
+  parallel_blocks(n_, num_threads(n_), [&](int, int64_t b, int64_t e) {
+#if MFREE_SIMD_X86
+    if (avx2) {
+      kinematics2_avx2(b, e, v, rho, vhat, drho);
+      return;
+    }
+#endif
+    for (int64_t k = b; k < e; ++k) {
+      double vh[3] = {0, 0, 0}, div = 0.0;
+      if (dim == 2) {
+        // independent sums (one chain through div was the bottleneck): v0 += N a0,
+        // v1 += N a1, d0 += a0 G0, d1 += a1 G1, in SSE2 pairs where there (same operations)
+        double v0 = 0, v1 = 0, d0 = 0, d1 = 0;
+#ifdef __SSE2__
+        __m128d vv = _mm_setzero_pd(), dd = _mm_setzero_pd();
+        for (int64_t q = rb[k]; q < re[k]; ++q) {
+          const __m128d a = _mm_loadu_pd(v + static_cast<size_t>(cols[q]) * 2);
+          vv = _mm_add_pd(vv, _mm_mul_pd(_mm_set1_pd(N[q]), a));
+          dd = _mm_add_pd(dd, _mm_mul_pd(a, _mm_loadu_pd(G + 2 * q)));
+        }
+        double t[4];
+        _mm_storeu_pd(t, vv);
+        _mm_storeu_pd(t + 2, dd);
+        v0 = t[0];
+        v1 = t[1];
+        d0 = t[2];
+        d1 = t[3];
+#else
+        for (int64_t q = rb[k]; q < re[k]; ++q) {
+          const double *vj = v + static_cast<size_t>(cols[q]) * 2;
+          const double a0 = vj[0], a1 = vj[1], nq = N[q];
+          v0 += nq * a0;
+          v1 += nq * a1;
+          d0 += a0 * G[2 * q];
+          d1 += a1 * G[2 * q + 1];
+        }
+#endif
+        vh[0] = v0;
+        vh[1] = v1;
+        div = d0 + d1;
+      } else {
+        double d[3] = {0, 0, 0};
+        for (int64_t q = rb[k]; q < re[k]; ++q) {
+          const double *vj = v + static_cast<size_t>(cols[q]) * dim;
+          for (int c = 0; c < dim; ++c) {
+            vh[c] += N[q] * vj[c];
+            d[c] += vj[c] * G[q * dim + c];
+          }
+        }
+        div = d[0] + d[1] + d[2];
+      }
+      if (vhat)
+        for (int c = 0; c < dim; ++c) vhat[k * dim + c] = vh[c];
+      if (drho) drho[k] = -rho[k] * div;  // 003 eq 70, nodal parameters v_j
+    }
+  });
+  if (drho) density_diffusion(rho, drho);  // optional, fluid_wall.cpp
+}
+
+FluidSystem::AccelArgs FluidSystem::accel_args(const double *v, const double *rho) {
+  const int dim = dim_;
+  const int32_t nall = nq();
+  AccelArgs aa;
+  aa.v = node_velocities(v);
+  aa.rho = node_densities(rho);
+  aa.rho0 = dummy_.n ? dummy_.rho0.data() : rho0_.data();
+  aa.mass = dummy_.n ? dummy_.mass.data() : mass_.data();
+  aa.keep_pack = vci_;  // vci_correct reads the points' stresses
+  if (aa.keep_pack) pack_.resize(static_cast<size_t>(nall) * (dim * dim + 2 + dim));
+  const int64_t na = static_cast<int64_t>(nall) * (2 * dim + 2);
+  acc_.resize(na);
+  double *acc = acc_.data();
+  parallel_blocks(na, light_threads(nall), [&](int, int64_t b, int64_t e) { std::fill(acc + b, acc + e, 0.0); });
+  return aa;
+}
+
+template <int D>
+MFREE_ALWAYS_INLINE void FluidSystem::point_terms(int64_t k, const AccelArgs &arg, const double (&vh)[D],
+                                                  const double (&L)[D][D], PointTerms<D> &pt) {
+  constexpr int P = D * D + 2 + D;  // pack_ per point: sigma V (D x D), M, lumping mass, wall force
+  const double *rho = arg.rho, *rho0 = arg.rho0, *mass = arg.mass;
+  double tr3 = 0.0;
+  for (int c = 0; c < D; ++c) tr3 += L[c][c];
+  tr3 /= 3.0;
+  const double p = kappa_ * (tait(rho[k], rho0[k]) - 1.0), Vk = vol_[k];
+  double(&S)[D][D] = pt.S;
+  for (int aa = 0; aa < D; ++aa)
+    for (int bb = 0; bb < D; ++bb) {
+      const double d = 0.5 * (L[aa][bb] + L[bb][aa]) - (aa == bb ? tr3 : 0.0);  // d' (003 eq 61)
+      S[aa][bb] = ((aa == bb ? -p : 0.0) + 2.0 * mu_ * d) * Vk;
+    }
+  const double Mk = mass[k];
+  // dummies carry no fluid mass; without dummies share() is 1 (no division on the row's path)
+  const double Lk = k < n_ ? (dummy_.n ? mass[k] / dummy_.share[k] : mass[k]) : 0.0;
+  pt.Mk = Mk;
+  pt.Lk = Lk;
+  double(&F)[D] = pt.F;
+  for (int c = 0; c < D; ++c) F[c] = 0.0;
+  bool wall = false;
+  if (walls_ && k < n_) {
+    // wall force (003 eqs 122-124) on approaching particles, spread through N_i(x_k)
+    for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
+      const int32_t w = wall_nbr_.cols[q];
+      const double *nw = &wall_n_[static_cast<size_t>(w) * D];
+      double r2 = 0.0, approach = 0.0;
+      for (int c = 0; c < D; ++c) {
+        const double d = xbound_[k * D + c] - walls_->x(w, c);
+        r2 += d * d;
+        approach += vh[c] * nw[c];
+      }
+      const double r = std::sqrt(r2);
+      if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // f1 = 0: moving away
+      const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
+      for (int c = 0; c < D; ++c) F[c] += f2 * nw[c];
+      wall = true;
+    }
+  }
+  if (arg.keep_pack) {
+    double *pk = &pack_[static_cast<size_t>(k) * P];
+    for (int aa = 0; aa < D; ++aa)
+      for (int bb = 0; bb < D; ++bb) pk[aa * D + bb] = S[aa][bb];
+    pk[D * D] = Mk;
+    pk[D * D + 1] = Lk;
+    for (int c = 0; c < D; ++c) pk[D * D + 2 + c] = F[c];
+  }
+  pt.wall = wall;
+}
+
+// Point k of accel: the stress (times V_k), interpolated velocity and wall force at x_k,
+// and the row's terms scattered to its nodes.
+template <int D>
+void FluidSystem::accel_point(int64_t k, const AccelArgs &arg) {
+  constexpr int A = 2 * D + 2;  // acc_ per node: force, mass sum_k N M, lumped mass, wall force
+  const double *v = arg.v;
+  const int64_t q0 = rb_[k], q1 = re_[k];
+  const int32_t *cols = cols_.data();
+  const double *N = N_.data(), *G = G_.data();
+  double *acc = acc_.data();
+  // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
+  double vh[D] = {}, L[D][D] = {};
+  if constexpr (D == 2) {
+    // six independent sums (the vectoriser's pairing made one dependent chain), in SSE2
+    // pairs where there: (v0, v1) += N a, (l00, l10) += a g0, (l01, l11) += a g1
+    double v0 = 0, v1 = 0, l00 = 0, l01 = 0, l10 = 0, l11 = 0;
+#ifdef __SSE2__
+    __m128d vv = _mm_setzero_pd(), c0 = _mm_setzero_pd(), c1 = _mm_setzero_pd();
+    for (int64_t q = q0; q < q1; ++q) {
+      const __m128d a = _mm_loadu_pd(v + static_cast<size_t>(cols[q]) * 2);
+      vv = _mm_add_pd(vv, _mm_mul_pd(_mm_set1_pd(N[q]), a));
+      c0 = _mm_add_pd(c0, _mm_mul_pd(a, _mm_set1_pd(G[2 * q])));
+      c1 = _mm_add_pd(c1, _mm_mul_pd(a, _mm_set1_pd(G[2 * q + 1])));
+    }
+    double t[6];
+    _mm_storeu_pd(t, vv);
+    _mm_storeu_pd(t + 2, c0);
+    _mm_storeu_pd(t + 4, c1);
+    v0 = t[0];
+    v1 = t[1];
+    l00 = t[2];
+    l10 = t[3];
+    l01 = t[4];
+    l11 = t[5];
+#else
+    for (int64_t q = q0; q < q1; ++q) {
+      const double *vj = v + static_cast<size_t>(cols[q]) * 2;
+      const double a0 = vj[0], a1 = vj[1], nq = N[q], g0 = G[2 * q], g1 = G[2 * q + 1];
+      v0 += nq * a0;
+      v1 += nq * a1;
+      l00 += a0 * g0;
+      l01 += a0 * g1;
+      l10 += a1 * g0;
+      l11 += a1 * g1;
+    }
+#endif
+    vh[0] = v0;
+    vh[1] = v1;
+    L[0][0] = l00;
+    L[0][1] = l01;
+    L[1][0] = l10;
+    L[1][1] = l11;
+  } else {
+    for (int64_t q = q0; q < q1; ++q) {
+      const double *vj = v + static_cast<size_t>(cols[q]) * D;
+      const double *gq = G + q * D;
+      for (int c = 0; c < D; ++c) {
+        vh[c] += N[q] * vj[c];
+        for (int bb = 0; bb < D; ++bb) L[c][bb] += vj[c] * gq[bb];
+      }
+    }
+  }
+  PointTerms<D> pt;
+  point_terms<D>(k, arg, vh, L, pt);
+  const double(&S)[D][D] = pt.S;
+  const double Mk = pt.Mk, Lk = pt.Lk, *F = pt.F;
+  // the row's terms to its nodes i: -sigma_k V_k grad N_i(x_k), N_i(x_k) M_k (003 eq 56)
+#ifdef __SSE2__
+  if constexpr (D == 2) {  // the same operations in the same order, two lanes at a time
+    const __m128d s0 = _mm_setr_pd(S[0][0], S[1][0]), s1 = _mm_setr_pd(S[0][1], S[1][1]);
+    const __m128d ml = _mm_setr_pd(Mk, Lk);
+    for (int64_t q = q0; q < q1; ++q) {
+      double *ai = acc + static_cast<size_t>(cols[q]) * A;
+      const __m128d sg = _mm_add_pd(_mm_mul_pd(s0, _mm_set1_pd(G[2 * q])), _mm_mul_pd(s1, _mm_set1_pd(G[2 * q + 1])));
+      _mm_storeu_pd(ai, _mm_sub_pd(_mm_loadu_pd(ai), sg));
+      _mm_storeu_pd(ai + 2, _mm_add_pd(_mm_loadu_pd(ai + 2), _mm_mul_pd(_mm_set1_pd(N[q]), ml)));
+    }
+  } else
+#endif
+  for (int64_t q = q0; q < q1; ++q) {
+    double *ai = acc + static_cast<size_t>(cols[q]) * A;
+    const double *gi = G + q * D, Ni = N[q];
+    for (int aa = 0; aa < D; ++aa) {
+      double sg = 0.0;
+      for (int bb = 0; bb < D; ++bb) sg += S[aa][bb] * gi[bb];
+      ai[aa] -= sg;
+    }
+    ai[D] += Ni * Mk;
+    ai[D + 1] += Ni * Lk;
+  }
+  if (pt.wall)
+    for (int64_t q = q0; q < q1; ++q) {
+      double *ai = acc + static_cast<size_t>(cols[q]) * A;
+      for (int c = 0; c < D; ++c) ai[D + 2 + c] += N[q] * F[c];
+    }
+}
+
+template <int D>
+Report FluidSystem::accel_end(const AccelArgs &aa, double *a) {
+  Report rep;
+  constexpr int P = D * D + 2 + D;
+  constexpr int A = 2 * D + 2;
+  const double *acc = acc_.data();
+  const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
+  int32_t bad = n_;  // the first node without a positive mass
+  int32_t first_bad[64];  // parallel_blocks runs at most 64 threads
+  std::fill(first_bad, first_bad + 64, n_);
+  parallel_blocks(n_, num_threads(n_), [&](int t, int64_t b, int64_t e) {
+    for (int64_t i = b; i < e; ++i) {
+      const double *ai = acc + static_cast<size_t>(i) * A;
+      const double m = galerkin ? ai[D + 1] : mass_[i];
+      if (!(m > 0.0)) {
+        if (first_bad[t] == n_) first_bad[t] = static_cast<int32_t>(i);
+        for (int c = 0; c < D; ++c) a[i * D + c] = 0.0;
+        continue;
+      }
+      // the boundary force acts as an acceleration (003 Sect. 6.1 step 7)
+#ifdef __SSE2__
+      if constexpr (D == 2) {  // both components in one division (the same operations)
+        const __m128d f = _mm_add_pd(_mm_loadu_pd(ai), _mm_mul_pd(_mm_set1_pd(ai[D]), _mm_loadu_pd(g_)));
+        _mm_storeu_pd(a + i * D, _mm_add_pd(_mm_div_pd(f, _mm_set1_pd(m)), _mm_loadu_pd(ai + D + 2)));
+        continue;
+      }
+#endif
+      for (int c = 0; c < D; ++c) a[i * D + c] = (ai[c] + ai[D] * g_[c]) / m + ai[D + 2 + c];
+    }
+  });
+  vci_correct(pack_.data(), P, a);  // optional, fluid_wall.cpp
+  velocity_smoothing(aa.v, galerkin ? acc + D + 1 : mass_.data(), galerkin ? A : 1, a);  // optional, fluid_wall.cpp
+  for (int32_t fbad : first_bad) bad = std::min(bad, fbad);
+  if (bad < n_) {
+    const double m = galerkin ? acc[static_cast<size_t>(bad) * A + D + 1] : mass_[bad];
+    rep.fail(MFREE_FAIL_SINGULAR, "particle " + std::to_string(bad) + " has a non-positive lumped mass " +
+                                      std::to_string(m));
+  }
+  return rep;
+}
+
+#if MFREE_SIMD_X86
+MFREE_AVX2_BEGIN
+namespace {
+
+// sum of the four lanes of each of a, b, c, d: (sum a, sum b, sum c, sum d)
+MFREE_TARGET_AVX2 MFREE_ALWAYS_INLINE __m256d hsum4(__m256d a, __m256d b, __m256d c, __m256d d) {
+  const __m256d ab = _mm256_hadd_pd(a, b), cd = _mm256_hadd_pd(c, d);  // (a01, b01, a23, b23), ...
+  return _mm256_add_pd(_mm256_permute2f128_pd(ab, cd, 0x20), _mm256_permute2f128_pd(ab, cd, 0x31));
+}
+
+// Table entries q .. q + 3 of a 2D row in registers, lanes in the order (q, q + 2, q + 1,
+// q + 3) that the in-lane unpacks of interleaved pairs give: velocities (vx, vy) of the
+// columns, values N and gradients (gx, gy).
+struct Entries4 {
+  __m256d vx, vy, n, gx, gy;
+};
+MFREE_ALWAYS_INLINE Entries4 entries4(const double *v, const int32_t *cols, const double *N, const double *G, int64_t q) {
+  Entries4 e;
+  const int32_t *c = cols + q;
+  const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(v + 2 * static_cast<size_t>(c[0]))),
+                                          _mm_loadu_pd(v + 2 * static_cast<size_t>(c[1])), 1);  // v0 | v1
+  const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(v + 2 * static_cast<size_t>(c[2]))),
+                                          _mm_loadu_pd(v + 2 * static_cast<size_t>(c[3])), 1);  // v2 | v3
+  e.vx = _mm256_unpacklo_pd(lo, hi);  // (v0x, v2x, v1x, v3x)
+  e.vy = _mm256_unpackhi_pd(lo, hi);
+  e.n = _mm256_permute4x64_pd(_mm256_loadu_pd(N + q), 0xD8);  // (N0, N2, N1, N3)
+  const __m256d g01 = _mm256_loadu_pd(G + 2 * q), g23 = _mm256_loadu_pd(G + 2 * q + 4);
+  e.gx = _mm256_unpacklo_pd(g01, g23);  // (g0x, g2x, g1x, g3x)
+  e.gy = _mm256_unpackhi_pd(g01, g23);
+  return e;
+}
+
+}  // namespace
+
+// accel_point<2> for rows [k0, k1): the gather of v_j and grad N_j four entries at a time
+// (six sums in registers), the point's terms, and the scatter of four entries at a time:
+// (fx, fy, N M_k, N L_k) in structure-of-arrays form, transposed by unpacks and lane
+// permutes into one 4-double update per node (acc_ holds them contiguously).
+void FluidSystem::accel_rows2_avx2(int64_t k0, int64_t k1, const AccelArgs &arg) {
+  constexpr int A = 6;
+  const double *v = arg.v;
+  const int32_t *cols = cols_.data();
+  const double *N = N_.data(), *G = G_.data();
+  double *acc = acc_.data();
+  const __m256d zero = _mm256_setzero_pd();
+  for (int64_t k = k0; k < k1; ++k) {
+    const int64_t q0 = rb_[k], q1 = re_[k];
+    __m256d sv0 = zero, sv1 = zero, s00 = zero, s01 = zero, s10 = zero, s11 = zero;
+    int64_t q = q0;
+    for (; q + 4 <= q1; q += 4) {
+      const Entries4 e = entries4(v, cols, N, G, q);
+      sv0 = _mm256_fmadd_pd(e.n, e.vx, sv0);
+      sv1 = _mm256_fmadd_pd(e.n, e.vy, sv1);
+      s00 = _mm256_fmadd_pd(e.vx, e.gx, s00);
+      s01 = _mm256_fmadd_pd(e.vx, e.gy, s01);
+      s10 = _mm256_fmadd_pd(e.vy, e.gx, s10);
+      s11 = _mm256_fmadd_pd(e.vy, e.gy, s11);
+    }
+    double t[8];
+    _mm256_storeu_pd(t, hsum4(sv0, sv1, s00, s01));
+    _mm256_storeu_pd(t + 4, hsum4(s10, s11, zero, zero));
+    double vh[2] = {t[0], t[1]}, L[2][2] = {{t[2], t[3]}, {t[4], t[5]}};
+    for (; q < q1; ++q) {
+      const double *vj = v + static_cast<size_t>(cols[q]) * 2;
+      const double a0 = vj[0], a1 = vj[1], nq = N[q], g0 = G[2 * q], g1 = G[2 * q + 1];
+      vh[0] += nq * a0;
+      vh[1] += nq * a1;
+      L[0][0] += a0 * g0;
+      L[0][1] += a0 * g1;
+      L[1][0] += a1 * g0;
+      L[1][1] += a1 * g1;
+    }
+    PointTerms<2> pt;
+    point_terms<2>(k, arg, vh, L, pt);
+    // the row's terms to its nodes i: -sigma_k V_k grad N_i(x_k), N_i(x_k) M_k (003 eq 56)
+    const __m256d n00 = _mm256_set1_pd(-pt.S[0][0]), n01 = _mm256_set1_pd(-pt.S[0][1]);
+    const __m256d n10 = _mm256_set1_pd(-pt.S[1][0]), n11 = _mm256_set1_pd(-pt.S[1][1]);
+    const __m256d mk = _mm256_set1_pd(pt.Mk), lk = _mm256_set1_pd(pt.Lk);
+    q = q0;
+    for (; q + 4 <= q1; q += 4) {
+      const int32_t *c = cols + q;
+      const __m256d nq = _mm256_permute4x64_pd(_mm256_loadu_pd(N + q), 0xD8);
+      const __m256d g01 = _mm256_loadu_pd(G + 2 * q), g23 = _mm256_loadu_pd(G + 2 * q + 4);
+      const __m256d gx = _mm256_unpacklo_pd(g01, g23), gy = _mm256_unpackhi_pd(g01, g23);
+      const __m256d fx = _mm256_fmadd_pd(n00, gx, _mm256_mul_pd(n01, gy));
+      const __m256d fy = _mm256_fmadd_pd(n10, gx, _mm256_mul_pd(n11, gy));
+      const __m256d cm = _mm256_mul_pd(nq, mk), cl = _mm256_mul_pd(nq, lk);
+      const __m256d t0 = _mm256_unpacklo_pd(fx, fy), t1 = _mm256_unpackhi_pd(fx, fy);  // entries 0 | 1, 2 | 3
+      const __m256d t2 = _mm256_unpacklo_pd(cm, cl), t3 = _mm256_unpackhi_pd(cm, cl);
+      double *a0 = acc + static_cast<size_t>(c[0]) * A, *a1 = acc + static_cast<size_t>(c[1]) * A;
+      double *a2 = acc + static_cast<size_t>(c[2]) * A, *a3 = acc + static_cast<size_t>(c[3]) * A;
+      _mm256_storeu_pd(a0, _mm256_add_pd(_mm256_loadu_pd(a0), _mm256_permute2f128_pd(t0, t2, 0x20)));
+      _mm256_storeu_pd(a1, _mm256_add_pd(_mm256_loadu_pd(a1), _mm256_permute2f128_pd(t0, t2, 0x31)));
+      _mm256_storeu_pd(a2, _mm256_add_pd(_mm256_loadu_pd(a2), _mm256_permute2f128_pd(t1, t3, 0x20)));
+      _mm256_storeu_pd(a3, _mm256_add_pd(_mm256_loadu_pd(a3), _mm256_permute2f128_pd(t1, t3, 0x31)));
+    }
+    for (; q < q1; ++q) {
+      double *ai = acc + static_cast<size_t>(cols[q]) * A;
+      const double gx = G[2 * q], gy = G[2 * q + 1];
+      ai[0] += -pt.S[0][0] * gx + -pt.S[0][1] * gy;
+      ai[1] += -pt.S[1][0] * gx + -pt.S[1][1] * gy;
+      ai[2] += N[q] * pt.Mk;
+      ai[3] += N[q] * pt.Lk;
+    }
+    if (pt.wall)
+      for (q = q0; q < q1; ++q) {
+        double *ai = acc + static_cast<size_t>(cols[q]) * A;
+        for (int c = 0; c < 2; ++c) ai[4 + c] += N[q] * pt.F[c];
+      }
+  }
+}
+
+// The 2D kinematics of nodes [k0, k1) four entries at a time: vhat_k = sum N_j v_j and
+// div_k = sum v_j . grad N_j in four sums of registers.
+void FluidSystem::kinematics2_avx2(int64_t k0, int64_t k1, const double *v, const double *rho, double *vhat,
+                                   double *drho) const {
+  const int32_t *cols = cols_.data();
+  const double *N = N_.data(), *G = G_.data();
+  const __m256d zero = _mm256_setzero_pd();
+  for (int64_t k = k0; k < k1; ++k) {
+    const int64_t q0 = rb_[k], q1 = re_[k];
+    __m256d sv0 = zero, sv1 = zero, d0 = zero, d1 = zero;
+    int64_t q = q0;
+    for (; q + 4 <= q1; q += 4) {
+      const Entries4 e = entries4(v, cols, N, G, q);
+      sv0 = _mm256_fmadd_pd(e.n, e.vx, sv0);
+      sv1 = _mm256_fmadd_pd(e.n, e.vy, sv1);
+      d0 = _mm256_fmadd_pd(e.vx, e.gx, d0);
+      d1 = _mm256_fmadd_pd(e.vy, e.gy, d1);
+    }
+    double t[4];
+    _mm256_storeu_pd(t, hsum4(sv0, sv1, d0, d1));
+    for (; q < q1; ++q) {
+      const double *vj = v + static_cast<size_t>(cols[q]) * 2;
+      t[0] += N[q] * vj[0];
+      t[1] += N[q] * vj[1];
+      t[2] += vj[0] * G[2 * q];
+      t[3] += vj[1] * G[2 * q + 1];
+    }
+    if (vhat) {
+      vhat[2 * k] = t[0];
+      vhat[2 * k + 1] = t[1];
+    }
+    if (drho) drho[k] = -rho[k] * (t[2] + t[3]);  // 003 eq 70, nodal parameters v_j
+  }
+}
+MFREE_AVX2_END
+#endif
+
+// 003 eqs 56, 61, 67-68 with nodal quadrature: the force on node i is
+//   f_i = sum_k [-sigma_k grad N_i(x_k) V_k + N_i(x_k) M_k g],  m_i = sum_k N_i(x_k) M_k,
+// over the quadrature points k whose row holds i. One pass over the rows computes per
+// point k the stress (times V_k), the interpolated velocity and the wall force and
+// scatters the row's terms to the nodes i of the row (acc_); the chunks of rows of one
+// colour touch disjoint nodes and run in parallel, the colours one after another, so that
+// every node sums its terms in the same order whatever the number of threads.
+Report FluidSystem::accel(const double *v, const double *rho, double *a) {
+  const AccelArgs aa = accel_args(v, rho);
+  const int32_t nall = nq();
+  const int nt = scatter_threads_ ? num_threads(nall) : 1;
+  const bool avx2 = dim_ == 2 && simd::use_avx2();  // once per call: every thread runs the same copy
+  for (size_t col = 0; col + 1 < color_ptr_.size(); ++col) {
+    const int32_t *chunks = chunk_order_.data() + color_ptr_[col];
+    parallel_blocks(color_ptr_[col + 1] - color_ptr_[col], nt, [&](int, int64_t b, int64_t e) {
+      for (int64_t c = b; c < e; ++c) {
+        const int64_t k0 = static_cast<int64_t>(chunks[c]) * kChunk, k1 = std::min<int64_t>(nall, k0 + kChunk);
+#if MFREE_SIMD_X86
+        if (avx2) {
+          accel_rows2_avx2(k0, k1, aa);
+          continue;
+        }
+#endif
+        for (int64_t k = k0; k < k1; ++k) {
+          if (dim_ == 2) accel_point<2>(k, aa);
+          else accel_point<3>(k, aa);
+        }
+      }
+    });
+  }
+  return dim_ == 2 ? accel_end<2>(aa, a) : accel_end<3>(aa, a);
 }
 
 Report FluidSystem::rhs(double t, const double *y, double *ydot) {
