@@ -10,13 +10,21 @@
 #include "core/base/parallel.hpp"
 #include "core/base/simd.hpp"
 #include "core/particles/neighbors.hpp"
-#include "core/shape/local.hpp"
+#include "core/shape/shape_fast_mls1.hpp"
 
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
 #if MFREE_SIMD_X86
 #include <immintrin.h>
+#endif
+
+// Loops over a row's neighbours written for the vectoriser (any OpenMP: omp simd).
+#define FLUID_PRAGMA(x) _Pragma(#x)
+#ifdef _OPENMP
+#define FLUID_SIMD(...) FLUID_PRAGMA(omp simd __VA_ARGS__)
+#else
+#define FLUID_SIMD(...)
 #endif
 
 namespace mfree {
@@ -28,8 +36,7 @@ namespace {
 inline int light_threads(int64_t n) { return num_threads(n / 4); }
 }  // namespace
 
-FluidSystem::FluidSystem(int dim, int32_t n)
-    : dim_(dim), n_(n), ps_(dim, n), kernel_(MFREE_KERNEL_CUBIC_SPLINE, dim == 3 ? 3 : 2, 0.0) {
+FluidSystem::FluidSystem(int dim, int32_t n) : dim_(dim), n_(n), ps_(dim, n) {
   if (dim != 2 && dim != 3) throw Error(MFREE_ERR_ARG, "the fluid system is 2D or 3D, not " + std::to_string(dim) + "D");
   rho0_.assign(n, 1000.0);
   vol_.assign(n > 0 ? n : 1, 1.0);
@@ -221,6 +228,79 @@ double FluidSystem::tait(double rho, double rho0) const {
   return std::pow(r, gamma_);
 }
 
+namespace {
+
+// a[m] = sqrt(a[m]), m < n, two at a time where SSE2 is there (compilers vectorise sqrt
+// only without errno, which the library does not switch off); correctly rounded either way.
+inline void sqrt_n(double *a, int n) {
+  int m = 0;
+#ifdef __SSE2__
+  for (; m + 2 <= n; m += 2) _mm_storeu_pd(a + m, _mm_sqrt_pd(_mm_loadu_pd(a + m)));
+#endif
+  for (; m < n; ++m) a[m] = std::sqrt(a[m]);
+}
+
+#if MFREE_SIMD_X86
+// sqrt_n four at a time, for the AVX2 copy of the row kernel (same correctly rounded values)
+MFREE_TARGET_AVX2 void sqrt_n_avx2(double *a, int n) {
+  int m = 0;
+  for (; m + 4 <= n; m += 4) _mm256_storeu_pd(a + m, _mm256_sqrt_pd(_mm256_loadu_pd(a + m)));
+  for (; m + 2 <= n; m += 2) _mm_storeu_pd(a + m, _mm_sqrt_pd(_mm_loadu_pd(a + m)));
+  for (; m < n; ++m) a[m] = std::sqrt(a[m]);
+}
+#endif
+
+// The approximants' singularity threshold on 1 / cond (local.cpp, shape_fast.cpp).
+constexpr double kMinRcond = 1e-12;
+
+// X = A^-1 for a symmetric positive definite A by A = U^T D U (unit upper U, built
+// column by column) and its exact 1-norm condition number ||A||_1 ||X||_1; false when a
+// pivot is not positive or the system is singular to kMinRcond.
+template <int L>
+MFREE_ALWAYS_INLINE bool spd_inverse(const double (&A)[L][L], double (&X)[L][L], double &cond) {
+  double U[L][L] = {}, D[L];
+  for (int j = 0; j < L; ++j) {
+    for (int i = 0; i < j; ++i) {
+      double v = A[i][j];
+      for (int m = 0; m < i; ++m) v -= U[m][i] * D[m] * U[m][j];
+      U[i][j] = v / D[i];
+    }
+    double dj = A[j][j];
+    for (int m = 0; m < j; ++m) dj -= U[m][j] * D[m] * U[m][j];
+    if (!(dj > 0.0)) return false;
+    D[j] = dj;
+  }
+  // X = U^-1 D^-1 U^-T with V = U^-1 (unit upper)
+  double V[L][L] = {};
+  for (int i = L - 1; i >= 0; --i) {
+    V[i][i] = 1.0;
+    for (int j = i + 1; j < L; ++j) {
+      double v = 0.0;
+      for (int m = i + 1; m <= j; ++m) v -= U[i][m] * V[m][j];
+      V[i][j] = v;
+    }
+  }
+  for (int a = 0; a < L; ++a)
+    for (int b = a; b < L; ++b) {
+      double v = 0.0;
+      for (int m = b; m < L; ++m) v += V[a][m] * V[b][m] / D[m];
+      X[a][b] = X[b][a] = v;
+    }
+  double na = 0.0, nx = 0.0;
+  for (int b = 0; b < L; ++b) {
+    double sa = 0.0, sx = 0.0;
+    for (int a = 0; a < L; ++a) {
+      sa += std::fabs(A[a][b]);
+      sx += std::fabs(X[a][b]);
+    }
+    na = std::max(na, sa);
+    nx = std::max(nx, sx);
+  }
+  cond = na * nx;
+  return std::isfinite(cond) && cond > 0.0 && 1.0 / cond >= kMinRcond;
+}
+
+}  // namespace
 
 Report FluidSystem::candidates(const double *xn) {
   const int dim = dim_;
@@ -355,13 +435,31 @@ void FluidSystem::color_chunks() {
   scatter_threads_ = !serial;
 }
 
-// Shepard functions replace the MLS rows where the moment matrix is singular or the row
-// too short (of the weights w: MLS of order 0), and where it is ill-conditioned, not only
-// singular (of w V_j: the approximants' Shepard method; 003 Sect. 6: a lattice node has a
+// Shepard functions N_j = o_j / S, S = sum o, of the weights o = w (the approximants'
+// fallback where the moment matrix is singular or the row too short), or of o = w V_j
+// where it is ill-conditioned, not only singular (003 Sect. 6: a lattice node has a
 // condition number of 10-15, a free edge or corner 30-60; a particle left in a thin sheet
 // or strand climbs past 1e3 within a few steps, and its gradients then drive the density
 // negative in one step (dam break along the wall, T ~ 2.2, at every resolution and CFL
 // number tried). Hence the default threshold 100 (mfree_system_set_shepard_condition).
+template <int D>
+void FluidSystem::shepard_row(int n, const double *w, const double *gf, double *const *s, double ih,
+                              bool volumes, const int32_t *js, double *Nk, double *Gk) const {
+  double S = 0.0, dS[D] = {};
+  for (int m = 0; m < n; ++m) {
+    const double V = volumes ? vol_[js[m]] : 1.0;
+    Nk[m] = w[m] * V;
+    S += Nk[m];
+    for (int c = 0; c < D; ++c) {
+      Gk[m * D + c] = gf[m] * s[c][m] * ih * V;
+      dS[c] += Gk[m * D + c];
+    }
+  }
+  for (int m = 0; m < n; ++m) {
+    Nk[m] /= S;
+    for (int c = 0; c < D; ++c) Gk[m * D + c] = (Gk[m * D + c] - Nk[m] * dS[c]) / S;
+  }
+}
 
 #if defined(__GNUC__) || defined(__clang__)
 #define FLUID_NOINLINE __attribute__((noinline))
@@ -371,13 +469,15 @@ void FluidSystem::color_chunks() {
 
 namespace {
 
-// The candidates cc[0 .. nc) of node k closer than 2h (r2 < R2: a symmetric test,
-// |x_j - x_k| is computed alike from both ends) written to js; returns their count.
-// Candidates out of range are written and then overwritten (no branch: a quarter of them
-// fall out). Not inlined into AVX2 code, where FMA contraction of r2 would move pairs at
-// exactly 2h in or out of the rows depending on the CPU.
+// The candidates of row k closer than 2h (r2 < R2, in the search's units: a symmetric
+// test, |x_j - x_k| is computed alike from both ends) in structure-of-arrays scratch:
+// scaled offsets s = (x_j - x_k) / h and columns js; returns their count. Candidates out
+// of range are written and then overwritten (no branch: a quarter of them fall out).
+// Not inlined into the AVX2 copy of the row kernel, where FMA contraction of r2 would
+// move pairs at exactly 2h in or out of the rows depending on the CPU.
 template <int D>
-FLUID_NOINLINE int kept_columns(const double *xn, int64_t k, const int32_t *cc, int64_t nc, double R2, int32_t *js) {
+FLUID_NOINLINE int kept_candidates(const double *xn, int64_t k, const int32_t *cc, int64_t nc, double R2, double ih,
+                                   double *const *s, int32_t *js) {
   const double *xk = xn + k * D;
   int q = 0;
   for (int64_t e = 0; e < nc; ++e) {
@@ -387,6 +487,7 @@ FLUID_NOINLINE int kept_columns(const double *xn, int64_t k, const int32_t *cc, 
     for (int c = 0; c < D; ++c) {
       const double d = xj[c] - xk[c];
       r2 += d * d;
+      s[c][q] = d * ih;
     }
     js[q] = j;
     q += r2 < R2;
@@ -395,6 +496,9 @@ FLUID_NOINLINE int kept_columns(const double *xn, int64_t k, const int32_t *cc, 
 }
 
 #if MFREE_SIMD_X86
+// kept_candidates four candidates at a time (AVX2 gathers, left-packed stores through a
+// permutation table): the same differences, products and sums, so the same rows and
+// offsets; the products are kept from FMA contraction by an empty asm.
 struct PackTable {
   int32_t d[16][8];  // mask -> 32-bit lane indices moving the kept doubles to the front
   int32_t i[16][8];  // mask -> lane indices moving the kept 32-bit columns to the front
@@ -415,9 +519,257 @@ constexpr PackTable make_pack_table() {
 }
 constexpr PackTable kPack = make_pack_table();
 
-// kept_columns<2> four candidates at a time with two 128-bit loads per pair of lanes, the
-// kept columns left-packed through a permutation table; the products are kept from FMA
-// contraction by an empty asm (the same test as the scalar loop, on any CPU).
+template <int D>
+MFREE_TARGET_AVX2 FLUID_NOINLINE int kept_candidates_avx2(const double *xn, int64_t k, const int32_t *cc, int64_t nc,
+                                                          double R2, double ih, double *const *s, int32_t *js) {
+  const double *xk = xn + k * D;
+  __m256d xkv[D];
+  for (int c = 0; c < D; ++c) xkv[c] = _mm256_set1_pd(xk[c]);
+  const __m256d r2v = _mm256_set1_pd(R2), ihv = _mm256_set1_pd(ih);
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  int q = 0;
+  int64_t e = 0;
+  for (; e + 4 <= nc; e += 4) {
+    const __m128i j4 = _mm_loadu_si128(reinterpret_cast<const __m128i *>(cc + e));
+    const __m128i idx = D == 2 ? _mm_slli_epi32(j4, 1) : _mm_add_epi32(_mm_slli_epi32(j4, 1), j4);  // j * D
+    __m256d d[D], p[D];
+    for (int c = 0; c < D; ++c) {
+      // the masked form: the plain one trips GCC 12's -Wmaybe-uninitialized
+      const __m256d xj = _mm256_mask_i32gather_pd(_mm256_setzero_pd(), xn + c, idx, all, 8);
+      d[c] = _mm256_sub_pd(xj, xkv[c]);
+      p[c] = _mm256_mul_pd(d[c], d[c]);
+      __asm__("" : "+x"(p[c]));  // r2 = (d0 d0 + d1 d1) + d2 d2, rounded as the scalar loop
+    }
+    __m256d r2 = p[0];
+    for (int c = 1; c < D; ++c) r2 = _mm256_add_pd(r2, p[c]);
+    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(r2, r2v, _CMP_LT_OQ));
+    const __m256i pd = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.d[mask]));
+    for (int c = 0; c < D; ++c) {
+      const __m256d sc = _mm256_mul_pd(d[c], ihv);
+      _mm256_storeu_pd(s[c] + q, _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(sc), pd)));
+    }
+    const __m256i pi = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.i[mask]));
+    const __m256i jp = _mm256_permutevar8x32_epi32(_mm256_zextsi128_si256(j4), pi);
+    _mm_storeu_si128(reinterpret_cast<__m128i *>(js + q), _mm256_castsi256_si128(jp));
+    q += __builtin_popcount(static_cast<unsigned>(mask));
+  }
+  for (; e < nc; ++e) {
+    const int32_t j = cc[e];
+    const double *xj = xn + static_cast<size_t>(j) * D;
+    double r2 = 0.0;
+    for (int c = 0; c < D; ++c) {
+      const double dc = xj[c] - xk[c];
+      double pc = dc * dc;
+      __asm__("" : "+x"(pc));
+      r2 += pc;
+      s[c][q] = dc * ih;
+    }
+    js[q] = j;
+    q += r2 < R2;
+  }
+  _mm256_zeroupper();
+  return q;
+}
+#endif
+
+}  // namespace
+
+template <int D>
+MFREE_ALWAYS_INLINE bool FluidSystem::table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch,
+                                                     int64_t *iscratch, bool transpose, bool wide) {
+  (void)wide;
+  constexpr int L = D + 1;
+  const double ih = 1.0 / h_, tol = shepard_cond_, R2 = 4.0 * h_ * h_;
+  const int64_t *crp = cand_.rowptr.data();
+  const int32_t *ccols = cand_.cols.data();
+  const int32_t *cpos = cpos_.data();
+  const int64_t *ctr = transpose ? ctrans_.data() : nullptr;
+  int64_t *rbeg = rb_.data(), *rend = re_.data();
+  bool one_way = false;
+  for (int32_t k = k0; k < k1; ++k) {  // k0 starts a chunk
+    const double *xk = xn + static_cast<size_t>(k) * D;
+    const int64_t o = transpose ? rbeg[k] : k % kChunk == 0 ? crp[k] : rend[k - 1];
+    double *Nk = N_.data() + o, *Gk = G_.data() + o * D;
+    // the row's neighbours in structure-of-arrays scratch: scaled offsets s = (x_j - x) / h,
+    // weights w = f(|s|) and gf = -f'(|s|) / |s|, so that grad_x w_j = gf s / h; the
+    // transposed candidates; the columns go straight to the row's place in cols_ (the
+    // candidates out of range land on entries of later rows of the chunk, or unused ones).
+    double *s[D], *w = scratch + D * static_cast<size_t>(maxrow_), *gf = w + maxrow_;
+    for (int c = 0; c < D; ++c) s[c] = scratch + c * static_cast<size_t>(maxrow_);
+    int32_t *js = cols_.data() + o;
+    int64_t *ts = iscratch;
+    int n = 0;
+    if (transpose) {  // the rows' ends and positions come from prepare's filter
+      for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
+        const int32_t j = ccols[e];
+        js[n] = j;
+        ts[n] = ctr[e];
+        for (int c = 0; c < D; ++c) s[c][n] = (xn[static_cast<size_t>(j) * D + c] - xk[c]) * ih;
+        n += cpos[e] >= 0;
+      }
+    } else {
+#if MFREE_SIMD_X86
+      if (wide) n = kept_candidates_avx2<D>(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, ih, s, js);
+      else n = kept_candidates<D>(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, ih, s, js);
+#else
+      n = kept_candidates<D>(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, ih, s, js);
+#endif
+      rbeg[k] = o;
+      rend[k] = o + n;
+    }
+    const double *s0 = s[0], *s1 = s[1], *s2 = s[D - 1];
+    FLUID_SIMD()
+    for (int m = 0; m < n; ++m) w[m] = s0[m] * s0[m] + s1[m] * s1[m] + (D == 3 ? s2[m] * s2[m] : 0.0);
+#if MFREE_SIMD_X86
+    if (wide) sqrt_n_avx2(w, n);  // |x_j - x| / h < 2
+    else sqrt_n(w, n);
+#else
+    sqrt_n(w, n);
+#endif
+    FLUID_SIMD()
+    for (int m = 0; m < n; ++m) {
+      // the cubic spline as B-spline pieces, f = (2 - r)_+^3 / 4 - (1 - r)_+^3, with
+      // (x)_+ = (x + |x|) / 2 (exact): no comparison, which the vectoriser would not
+      // if-convert under trapping math
+      const double r = w[m], a0 = 1.0 - r, b0 = 2.0 - r;
+      const double a = 0.5 * (a0 + std::fabs(a0)), b = 0.5 * (b0 + std::fabs(b0));
+      w[m] = 0.25 * b * b * b - a * a * a;
+      const double df = 3.0 * a * a - 0.75 * b * b;  // exactly 0 at r = 0
+      gf[m] = -df / (r + 1e-300);                    // r + 1e-300 = r unless r < 1e-284
+    }
+    // moments: M = sum w p p^T and M_,c = sum w_,c p p^T, p = (1, s), w_,c = gf s_c / h
+    // (the 1/h is applied after the sums)
+    double m0[L][L], mc[D][L][L];  // every entry is set below
+    if (D == 2) {
+      double a0 = 0, a1 = 0, a2 = 0, a11 = 0, a12 = 0, a22 = 0;
+      double b1 = 0, b2 = 0, b11 = 0, b12 = 0, b22 = 0, b111 = 0, b112 = 0, b122 = 0, b222 = 0;
+      FLUID_SIMD(reduction(+ : a0, a1, a2, a11, a12, a22, b1, b2, b11, b12, b22, b111, b112, b122, b222))
+      for (int m = 0; m < n; ++m) {
+        const double x1 = s0[m], x2 = s1[m], wm = w[m], gm = gf[m];
+        a0 += wm;
+        a1 += wm * x1;
+        a2 += wm * x2;
+        a11 += wm * x1 * x1;
+        a12 += wm * x1 * x2;
+        a22 += wm * x2 * x2;
+        const double g1 = gm * x1, g2 = gm * x2;
+        b1 += g1;
+        b2 += g2;
+        b11 += g1 * x1;
+        b12 += g1 * x2;
+        b22 += g2 * x2;
+        b111 += g1 * x1 * x1;
+        b112 += g1 * x1 * x2;
+        b122 += g1 * x2 * x2;
+        b222 += g2 * x2 * x2;
+      }
+      const double M[3][3] = {{a0, a1, a2}, {a1, a11, a12}, {a2, a12, a22}};
+      // w_,1 p p^T: gf s1 (1, s1, s2)(1, s1, s2)^T, likewise for s2
+      const double M1[3][3] = {{b1, b11, b12}, {b11, b111, b112}, {b12, b112, b122}};
+      const double M2[3][3] = {{b2, b12, b22}, {b12, b112, b122}, {b22, b122, b222}};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          m0[a][b] = M[a][b];
+          mc[0][a][b] = M1[a][b] * ih;
+          mc[D - 1][a][b] = M2[a][b] * ih;
+        }
+    } else {
+      double acc[L][L] = {}, accc[D][L][L] = {};
+      for (int m = 0; m < n; ++m) {
+        double p[L];
+        p[0] = 1.0;
+        for (int c = 0; c < D; ++c) p[1 + c] = s[c][m];
+        for (int a = 0; a < L; ++a)
+          for (int b = 0; b <= a; ++b) {
+            const double pp = p[a] * p[b];
+            acc[a][b] += w[m] * pp;
+            for (int c = 0; c < D; ++c) accc[c][a][b] += gf[m] * s[c][m] * pp;
+          }
+      }
+      for (int a = 0; a < L; ++a)
+        for (int b = 0; b <= a; ++b) {
+          m0[a][b] = m0[b][a] = acc[a][b];
+          for (int c = 0; c < D; ++c) mc[c][a][b] = mc[c][b][a] = accc[c][a][b] * ih;
+        }
+    }
+    double X[L][L], cond = 1.0;
+    // too few neighbours or a singular moment matrix: Shepard functions of the weights
+    // (the approximants' lower-order fallback, whose condition number is 1)
+    const bool mls = n >= L && spd_inverse<L>(m0, X, cond);
+    if (!mls) cond = 1.0;
+    cond_[k] = cond;
+    if (mls && !(cond > tol)) {
+      // 003 eqs 27-31 (MLS, basis shifted to the node and scaled by h): M g = p(0),
+      // M g_,c = e_c / h - M_,c g; N_j = w_j g.p_j, N_j,c = w_j g_,c.p_j + w_j,c g.p_j
+      double g[L], gc[D][L];
+      for (int a = 0; a < L; ++a) g[a] = X[a][0];
+      for (int c = 0; c < D; ++c) {
+        double rhs[L];
+        for (int a = 0; a < L; ++a) {
+          double t = 0.0;
+          for (int b = 0; b < L; ++b) t += mc[c][a][b] * g[b];
+          rhs[a] = -t;
+        }
+        rhs[1 + c] += ih;
+        for (int a = 0; a < L; ++a) {
+          double t = 0.0;
+          for (int b = 0; b < L; ++b) t += X[a][b] * rhs[b];
+          gc[c][a] = t;
+        }
+      }
+      // g.p_j and g_,c.p_j with the coefficients in scalars, for the vectoriser
+      const double g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[L - 1];
+      const double c00 = gc[0][0], c01 = gc[0][1], c02 = gc[0][2], c03 = gc[0][L - 1];
+      const double c10 = gc[1][0], c11 = gc[1][1], c12 = gc[1][2], c13 = gc[1][L - 1];
+      const double c20 = gc[D - 1][0], c21 = gc[D - 1][1], c22 = gc[D - 1][2], c23 = gc[D - 1][L - 1];
+      FLUID_SIMD()
+      for (int m = 0; m < n; ++m) {
+        const double x1 = s0[m], x2 = s1[m], x3 = D == 3 ? s2[m] : 0.0;
+        const double gp = g0 + g1 * x1 + g2 * x2 + (D == 3 ? g3 * x3 : 0.0);
+        const double wm = w[m], gq = gf[m] * ih * gp;
+        Nk[m] = wm * gp;
+        Gk[m * D] = wm * (c00 + c01 * x1 + c02 * x2 + (D == 3 ? c03 * x3 : 0.0)) + gq * x1;
+        Gk[m * D + 1] = wm * (c10 + c11 * x1 + c12 * x2 + (D == 3 ? c13 * x3 : 0.0)) + gq * x2;
+        if (D == 3) Gk[m * D + D - 1] = wm * (c20 + c21 * x1 + c22 * x2 + c23 * x3) + gq * x3;
+      }
+    } else {
+      shepard_row<D>(n, w, gf, s, ih, mls, js, Nk, Gk);
+    }
+    // the transposed copy: N_k(x_j) is entry (j, k) of the transpose
+    if (!transpose) continue;
+    for (int m = 0; m < n; ++m) {
+      const int32_t j = js[m];
+      const int64_t t = ts[m];
+      if (t < 0 || cpos[t] < 0) {
+        one_way = true;
+        continue;
+      }
+      double *nt = NT_.data() + (rbeg[j] + cpos[t]) * (D + 1);  // one cache line per entry
+      nt[0] = Nk[m];
+      for (int c = 0; c < D; ++c) nt[1 + c] = Gk[m * D + c];
+    }
+  }
+  return one_way;
+}
+
+template <int D>
+bool FluidSystem::table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
+                             bool transpose) {
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, false);
+}
+
+#if MFREE_SIMD_X86
+template <int D>
+MFREE_TARGET_AVX2 bool FluidSystem::table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch,
+                                                    int64_t *iscratch, bool transpose) {
+  return table_rows_body<D>(k0, k1, xn, scratch, iscratch, transpose, true);
+}
+#endif
+
+#if MFREE_SIMD_X86
+// The columns of kept_candidates<2> alone, four candidates at a time with two 128-bit loads
+// per pair of lanes (cheaper than gathers here), the test r2 < R2 rounded as there (no
+// FMA), the kept columns left-packed into js; returns their count.
 MFREE_TARGET_AVX2 FLUID_NOINLINE int kept_columns2_avx2(const double *xn, int64_t k, const int32_t *cc, int64_t nc,
                                                        double R2, int32_t *js) {
   const __m256d xk = _mm256_set1_pd(xn[2 * k]), yk = _mm256_set1_pd(xn[2 * k + 1]), r2v = _mm256_set1_pd(R2);
@@ -431,7 +783,7 @@ MFREE_TARGET_AVX2 FLUID_NOINLINE int kept_columns2_avx2(const double *xn, int64_
     const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(p1), p3, 1);  // x1 y1 x3 y3
     const __m256d dx = _mm256_sub_pd(_mm256_unpacklo_pd(lo, hi), xk), dy = _mm256_sub_pd(_mm256_unpackhi_pd(lo, hi), yk);
     __m256d px = _mm256_mul_pd(dx, dx), py = _mm256_mul_pd(dy, dy);
-    __asm__("" : "+x"(px), "+x"(py));  // r2 = d0 d0 + d1 d1, rounded as kept_columns
+    __asm__("" : "+x"(px), "+x"(py));  // r2 = d0 d0 + d1 d1, rounded as kept_candidates
     const int mask = _mm256_movemask_pd(_mm256_cmp_pd(_mm256_add_pd(px, py), r2v, _CMP_LT_OQ));
     const __m256i pi = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(kPack.i[mask]));
     const __m128i j4 = _mm_loadu_si128(reinterpret_cast<const __m128i *>(j));
@@ -452,32 +804,23 @@ MFREE_TARGET_AVX2 FLUID_NOINLINE int kept_columns2_avx2(const double *xn, int64_
   return q;
 }
 
-#endif
-
-}  // namespace
-
-// Rows [k0, k1) chunk by chunk: the kept candidates written to the chunk's rows (from
-// prepare's filter with the transpose, else filtered here), the approximants' fast path
-// (shape_fast.hpp; for 2D and AVX2 its fused rows) on them, the rows it leaves and those
-// worse conditioned than shepard_cond_ again by the general path (local.hpp), with the
-// approximants' fallbacks; with the transpose, then the rows' NT_ entries.
-bool FluidSystem::table_rows(int t, int32_t k0, int32_t k1, const double *xn, bool transpose) {
-  const int dim = dim_;
-  const int32_t nall = nq();
+// Rows [k0, k1) in chunks: the candidates closer than 2h filtered into the chunk's rows
+// (kept_candidates_avx2), then the approximants' fused linear-MLS rows on them
+// (shape_fast_mls1.hpp); the rows they leave (a moment matrix not positive definite or
+// singular) and those worse conditioned than shepard_cond_ are computed again by
+// table_rows_avx2, which writes their Shepard functions.
+void FluidSystem::table_rows2_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
+                                   FastScratch &fast, int64_t *rp) {
   const double R2 = 4.0 * h_ * h_;
   const int64_t *crp = cand_.rowptr.data();
   const int32_t *ccols = cand_.cols.data();
-  const int32_t *cpos = cpos_.data();
   int64_t *rbeg = rb_.data(), *rend = re_.data();
-  int64_t *rp = rows_ptr_.data() + static_cast<size_t>(t) * (nall + 1);
-  RowsScratch &w = rows_scratch_[t];
   FastTables ft;
   ft.rowptr = rp;
   ft.cols = cols_.data();
-  ft.self = no_self_.data();  // (linear MLS does not use the site's place in its row)
-  for (int c = 0; c < dim; ++c) ft.x[c] = ft.sx[c] = xn + c;
-  ft.vol = xn;  // (read, never used: linear MLS does not weight by volume)
-  ft.stride = ft.sstride = dim;
+  ft.x[0] = ft.sx[0] = xn;
+  ft.x[1] = ft.sx[1] = xn + 1;
+  ft.stride = ft.sstride = 2;
   ft.h = ft.sh = &h_;
   ft.hstride = ft.shstride = 0;
   ft.val = N_.data();
@@ -488,102 +831,22 @@ bool FluidSystem::table_rows(int t, int32_t k0, int32_t k1, const double *xn, bo
   fs.order = site_order_.data();
   fs.cond = cond_.data();
   fs.order_used = 1;
-#if MFREE_SIMD_X86
-  const bool avx2 = dim == 2 && simd::use_avx2();
-#endif
   for (int32_t c0 = k0; c0 < k1; c0 += kChunk) {
     const int32_t c1 = std::min(k1, c0 + kChunk);
     for (int32_t k = c0; k < c1; ++k) {
-      if (transpose) {  // the rows' places come from prepare's filter
-        for (int64_t e = crp[k]; e < crp[k + 1]; ++e)
-          if (cpos[e] >= 0) cols_[rbeg[k] + cpos[e]] = ccols[e];
-      } else {
-        const int64_t o = k == c0 ? crp[k] : rend[k - 1];
-        const int32_t *cc = ccols + crp[k];
-        const int64_t nc = crp[k + 1] - crp[k];
-        int n;
-#if MFREE_SIMD_X86
-        if (avx2) n = kept_columns2_avx2(xn, k, cc, nc, R2, cols_.data() + o);
-        else n = dim == 2 ? kept_columns<2>(xn, k, cc, nc, R2, cols_.data() + o) : kept_columns<3>(xn, k, cc, nc, R2, cols_.data() + o);
-#else
-        n = dim == 2 ? kept_columns<2>(xn, k, cc, nc, R2, cols_.data() + o) : kept_columns<3>(xn, k, cc, nc, R2, cols_.data() + o);
-#endif
-        rbeg[k] = o;
-        rend[k] = o + n;
-      }
-      rp[k] = rbeg[k];  // the chunk's rows lie one after another
+      const int64_t o = k == c0 ? crp[k] : rend[k - 1];
+      const int n = kept_columns2_avx2(xn, k, ccols + crp[k], crp[k + 1] - crp[k], R2, cols_.data() + o);
+      rbeg[k] = o;
+      rend[k] = o + n;
+      rp[k] = o;  // the chunk's rows lie one after another
     }
     rp[c1] = rend[c1 - 1];
-    fast_->run(ft, c0, c1, w.fast, fs);
+    mls1_rows2_avx2(ft, c0, c1, kMinRcond, fast, fs);
     for (int32_t k = c0; k < c1; ++k)
-      if (site_status_[k] != 0 || cond_[k] > shepard_cond_) general_row(k, xn, w);
+      if (site_status_[k] != 0 || cond_[k] > shepard_cond_) table_rows_avx2<2>(k, k + 1, xn, scratch, iscratch, false);
   }
-  if (!transpose) return false;
-  bool one_way = false;
-  const int64_t *ctr = ctrans_.data();
-  for (int32_t k = k0; k < k1; ++k) {  // N_k(x_j) is entry (j, k) of the transpose
-    int m = 0;
-    for (int64_t e = crp[k]; e < crp[k + 1]; ++e) {
-      if (cpos[e] < 0) continue;
-      const int64_t q = rbeg[k] + m++, tr = ctr[e];
-      if (tr < 0 || cpos[tr] < 0) {
-        one_way = true;
-        continue;
-      }
-      const int32_t j = ccols[e];
-      double *nt = NT_.data() + (rbeg[j] + cpos[tr]) * (dim + 1);  // one cache line per entry
-      nt[0] = N_[q];
-      for (int c = 0; c < dim; ++c) nt[1 + c] = G_[q * dim + c];
-    }
-  }
-  return one_way;
 }
-
-// Row k by the general path: linear MLS, then MLS of order 0 where that fails (singular,
-// too few neighbours), Shepard functions of w V where it is worse conditioned than
-// shepard_cond_ (the approximants' rules, Approximant::set_shepard_condition).
-void FluidSystem::general_row(int32_t k, const double *xn, RowsScratch &w) {
-  const int dim = dim_;
-  const int64_t o = rb_[k];
-  const int n = static_cast<int>(re_[k] - o);
-  const int32_t *js = cols_.data() + o;
-  w.d.resize(3 * static_cast<size_t>(n));
-  w.v.resize(n);
-  w.h.assign(n, h_);
-  LocalInput in;
-  in.n = n;
-  in.hs = h_;
-  for (int m = 0; m < n; ++m) {
-    for (int c = 0; c < 3; ++c) w.d[3 * m + c] = c < dim ? xn[static_cast<size_t>(js[m]) * dim + c] - xn[static_cast<size_t>(k) * dim + c] : 0.0;
-    w.v[m] = vol_[js[m]];
-    if (js[m] == k) in.self = m;
-  }
-  in.d = w.d.data();
-  in.vol = w.v.data();
-  in.h = w.h.data();
-  w.work.reserve(n, dim, dim + 1);
-  LocalOutput out;
-  out.phi = N_.data() + o;
-  out.grad = G_.data() + o * dim;
-  LocalConfig cfg;
-  cfg.method = MFREE_METHOD_MLS;
-  cfg.dim = dim;
-  cfg.order = 1;
-  cfg.kernel = &kernel_;
-  compute_site(cfg, in, w.work, out);
-  if (out.status) {
-    cfg.order = 0;
-    compute_site(cfg, in, w.work, out);
-    out.cond = 1.0;
-  } else if (out.cond > shepard_cond_) {
-    const double cond = out.cond;
-    cfg.method = MFREE_METHOD_SHEPARD;
-    cfg.order = 0;
-    compute_site(cfg, in, w.work, out);
-    out.cond = cond;
-  }
-  cond_[k] = out.cond;
-}
+#endif
 
 Report FluidSystem::prepare(const double *y, bool checked) {
   check_ready();
@@ -606,7 +869,7 @@ Report FluidSystem::prepare(const double *y, bool checked) {
   const bool transpose = vci_;  // only consistent integration reads NT_ (fluid_wall.cpp)
   if (transpose) {
     // the transposed writes need every row's kept positions first: a filter pass (the
-    // rows filter on the fly otherwise), the same symmetric test as kept_columns
+    // row kernel filters on the fly otherwise), the same symmetric test as kept_candidates
     if (!ctrans_valid_) transposed_candidates();
     const double R2 = 4.0 * h_ * h_;
     auto filter = [&](auto dimc) {
@@ -636,18 +899,39 @@ Report FluidSystem::prepare(const double *y, bool checked) {
     if (dim == 2) filter(std::integral_constant<int, 2>());
     else filter(std::integral_constant<int, 3>());
   }
-  if (rows_scratch_.size() < static_cast<size_t>(nt)) rows_scratch_.resize(nt);
-  for (int t = 0; t < nt; ++t) rows_scratch_[t].fast.reserve(static_cast<int>(maxrow_));
-  rows_ptr_.resize(static_cast<size_t>(nt) * (nall + 1));
-  site_status_.resize(nall);
-  site_support_.resize(nall);
-  site_order_.resize(nall);
-  no_self_.assign(nall, -1);
-  if (!fast_) fast_ = std::make_unique<FastPath>(dim, MFREE_METHOD_MLS, 1, kernel_, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT);
+  const size_t per_thread = static_cast<size_t>(dim + 2) * (maxrow_ + 8), iper_thread = static_cast<size_t>(maxrow_);
+  if (rows_scratch_.size() < per_thread * nt) rows_scratch_.resize(per_thread * nt);
+  if (rows_iscratch_.size() < iper_thread * nt) rows_iscratch_.resize(iper_thread * nt);
+#if MFREE_SIMD_X86
+  if (dim == 2 && !transpose && simd::use_avx2()) {  // table_rows2_avx2's per-thread scratch
+    if (fast_scratch_.size() < static_cast<size_t>(nt)) fast_scratch_.resize(nt);
+    for (int t = 0; t < nt; ++t) fast_scratch_[t].reserve(static_cast<int>(maxrow_));
+    rows_ptr_.resize(static_cast<size_t>(nt) * (nall + 1));
+    site_status_.resize(nall);
+    site_support_.resize(nall);
+    site_order_.resize(nall);
+  }
+#endif
   bool one_way[64] = {};  // parallel_blocks runs at most 64 threads
+  const bool avx2 = simd::use_avx2();  // once per step: every thread runs the same copy
+  (void)avx2;
+  auto rows = [&](int t, int32_t k0, int32_t k1) {
+    double *scratch = rows_scratch_.data() + per_thread * t;
+    int64_t *iscratch = rows_iscratch_.data() + iper_thread * t;
+#if MFREE_SIMD_X86
+    if (avx2 && dim == 2 && !transpose) {
+      table_rows2_avx2(k0, k1, xn, scratch, iscratch, fast_scratch_[t], rows_ptr_.data() + static_cast<size_t>(t) * (nall + 1));
+      return false;
+    }
+    if (avx2)
+      return dim == 2 ? table_rows_avx2<2>(k0, k1, xn, scratch, iscratch, transpose)
+                      : table_rows_avx2<3>(k0, k1, xn, scratch, iscratch, transpose);
+#endif
+    return dim == 2 ? table_rows<2>(k0, k1, xn, scratch, iscratch, transpose)
+                    : table_rows<3>(k0, k1, xn, scratch, iscratch, transpose);
+  };
   parallel_blocks(nchunk, nt, [&](int t, int64_t b, int64_t e) {
-    one_way[t] = table_rows(t, static_cast<int32_t>(b * kChunk), static_cast<int32_t>(std::min<int64_t>(nall, e * kChunk)), xn,
-                            transpose);
+    one_way[t] = rows(t, static_cast<int32_t>(b * kChunk), static_cast<int32_t>(std::min<int64_t>(nall, e * kChunk)));
   });
   if (std::any_of(one_way, one_way + 64, [](bool f) { return f; })) {
     // cannot happen with lists from one search radius; a failure rather than a wrong sum

@@ -58,20 +58,29 @@ class FluidSystem : public System {
   // Candidate neighbour lists (Verlet lists with a skin, see tables_) for the node
   // positions xn, rebuilt when a node moved more than half the skin since the last build.
   Report candidates(const double *xn);
-  // Tables rows [k0, k1) by thread t (fluid.cpp): linear MLS at the nodes, Shepard rows
-  // where singular or ill-conditioned; with transpose, also NT_ (true if a pair is in one
-  // node's row only, which the search rules out). k0 starts a chunk of kChunk rows (see rb_).
-  struct RowsScratch {
-    FastScratch fast;
-    std::vector<double> d, v, h;
-    LocalWork work;
-  };
-  bool table_rows(int t, int32_t k0, int32_t k1, const double *xn, bool transpose);
-  void general_row(int32_t k, const double *xn, RowsScratch &w);
+  // Tables rows [k0, k1): linear MLS at the nodes, Shepard rows where ill-conditioned;
+  // with transpose, also NT_ (true if a pair is in one node's row only, which the search
+  // rules out). k0 starts a chunk of kChunk rows (see rb_).
+  // table_rows_avx2 is the same code compiled for AVX2 + FMA (simd.hpp), chosen per step.
+  template <int D>
+  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  template <int D>
+  bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
+  // The 2D rows for AVX2 + FMA without the transpose (the dam break's configuration):
+  // the approximants' fused linear-MLS rows (shape_fast_mls1.hpp) on the filtered
+  // candidates; fast and rp are the thread's scratch (rp: nq() + 1 row offsets).
+  void table_rows2_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
+                        FastScratch &fast, int64_t *rp);
+  template <int D>
+  bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
+                       bool wide);  // wide: the AVX2 copy (gathers, 256-bit sqrt)
   // Chunks of kChunk rows coloured so that no two chunks of a colour touch a common
   // node (on the candidate pattern), for the scatter of accel (rebuilt with the lists).
   void color_chunks();
   void transposed_candidates();  // ctrans_, only for NT_ (consistent integration)
+  template <int D>
+  void shepard_row(int n, const double *w, const double *gf, double *const *s, double ih, bool volumes,
+                   const int32_t *js, double *Nk, double *Gk) const;
   // Acceleration parameters a (dim per particle) from the prepared tables and v, rho:
   // accel_args (node arrays, zeroed sums), accel_point for every row in colour order
   // (chunk_order_), accel_end (the nodes' accelerations).
@@ -173,14 +182,13 @@ class FluidSystem : public System {
   const double *xbound_ = nullptr;  // node positions ps_ borrows
   int64_t rebuilds_ = 0;
   int64_t maxrow_ = 0;               // longest candidate row
-  // table_rows: the nodes' kernel and the approximants' fast path of linear MLS with it;
-  // per thread, scratch and the row offsets of its chunks; per node, the fast path's
-  // status, support and order
-  Kernel kernel_;
-  std::unique_ptr<FastPath> fast_;
-  std::vector<RowsScratch> rows_scratch_;
+  std::vector<double> rows_scratch_;  // (dim + 2) (maxrow_ + 8) per thread
+  std::vector<int64_t> rows_iscratch_;  // maxrow_ per thread (transposed candidates)
+  // table_rows2_avx2: per thread, the fast path's scratch and row offsets; per node, the
+  // fast path's status, support and order
+  std::vector<FastScratch> fast_scratch_;
   std::vector<int64_t> rows_ptr_;
-  std::vector<int32_t> site_status_, site_support_, site_order_, no_self_;
+  std::vector<int32_t> site_status_, site_support_, site_order_;
   Csr wall_nbr_;
   // per node (reused): packed quadrature-point data of accel; integrate's states and rates
   std::vector<double> pack_, work_state_, stage_, rate_, vh_, dr_;
