@@ -64,6 +64,7 @@ using OuterFn = void (*)(const OuterJob &, int64_t, int64_t);
 constexpr int kBlock = 24;
 
 namespace base {
+constexpr int kChunk = MFREE_VECTOR_EXTENSIONS ? 2 : 1;
 inline void leave() {}
 #include "core/shape/apply_rows.inc"
 }  // namespace base
@@ -71,6 +72,7 @@ inline void leave() {}
 #if MFREE_SIMD_X86
 MFREE_AVX2_BEGIN
 namespace avx2 {
+constexpr int kChunk = 4;
 inline void leave() { MFREE_ZERO_UPPER(); }
 #include "core/shape/apply_rows.inc"
 }  // namespace avx2
