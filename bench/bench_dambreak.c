@@ -3,8 +3,7 @@
  * rebuilt every step at all particles (on Verlet candidate lists, which the first steps
  * from rest do not need to rebuild), forces, wall forces, kinematics, update. The column is nx x 2nx
  * particles (default nx = 112: 25,088 particles, close to PySPH's 25,153-particle WCSPH
- * dam break, 21 ms per step on this machine class = 1.2 million particle-steps/s; the
- * issue-8 target is 2x that per core). Usage: bench_dambreak [nx] [steps] [threads]: without
+ * dam break, the peer of BENCHMARKS.md's dam-break row). Usage: bench_dambreak [nx] [steps] [threads]: without
  * a thread count, one thread and then all. */
 #include "bench_util.h"
 

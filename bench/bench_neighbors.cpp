@@ -95,8 +95,8 @@ long minor_faults() {
 
 // What a first touch of a fresh small page costs here: 16 MiB mapped, kept off huge
 // pages, written one byte per page, best of three; seconds per fault. The first setup
-// of a new set pays this for every page of its lists and buffers (on this VM ~2.8 us,
-// about ten times bare metal: the part of the first setup no search can save).
+// of a new set pays this for every page of its lists and buffers (on virtual machines
+// several times bare metal's: the part of the first setup no search can save).
 double fault_cost() {
   const size_t bytes = size_t{16} << 20;
   double best = 1e300;

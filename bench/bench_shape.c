@@ -3,8 +3,8 @@
  * neighbours: value + gradient tables built by mfree_approximant_setup (pattern and
  * tables) and rebuilt by mfree_approximant_update (tables only, the per-step cost of a
  * moving-particle code), serial and on all cores. Reference: Compadre 1.7.5 GMLS
- * gradient weights at 100,489 points on this machine class (issue 8): order 1 0.33 s,
- * order 2 0.65 s; targets 10x faster. The like-for-like rows (2D) build the gradient
+ * gradient weights at 100,489 points (BENCHMARKS.md gives its figures beside ours).
+ * The like-for-like rows (2D) build the gradient
  * table only, as Compadre's figure does. Also the bytes per particle held by the set-up
  * approximant, counted through the context's allocator hook.
  * MFREE_BENCH_ALL_METHODS=1 adds every method's one-thread setup relative to SPH;

@@ -71,7 +71,7 @@ static inline int bench_side(int dim, double n_target) {
 }
 
 /* Search radius (lattice spacing 1) giving about 21 neighbours in 2D (pi r^2 = 21) and
- * 57 in 3D (4/3 pi r^3 = 57), the issue-8 benchmark densities. */
+ * 57 in 3D (4/3 pi r^3 = 57), the densities of every shape and pair benchmark. */
 static inline double bench_radius(int dim) {
   const double pi = 3.14159265358979323846;
   return dim == 2 ? sqrt(21.0 / pi) : cbrt(57.0 * 3.0 / (4.0 * pi));

@@ -1,4 +1,4 @@
-/* libFuzzer harness (issue 9): bytes -> a particle set (dimension, count, positions with
+/* libFuzzer harness: bytes -> a particle set (dimension, count, positions with
  * NaN/Inf/duplicates, supports and volumes with zero/negative/NaN values, ghosts,
  * search convention, periodic box, host neighbour lists or a half pair list), a method,
  * kernel, order, derivative flags, fallback, optional host points, and a field; then

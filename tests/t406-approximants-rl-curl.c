@@ -1,4 +1,4 @@
-/* Integrability of particle-only gradients (issue 3; paper 000 Sect. 4.4.6: Randles-
+/* Integrability of particle-only gradients (paper 000 Sect. 4.4.6: Randles-
  * Libersky derivatives "are not integrable"). For SPH and RL the row of particle i uses
  * x_i only as the evaluation point for the columns j != i, so moving particle i by
  * +-eps gives central differences of G_j(x) in x, and the curl

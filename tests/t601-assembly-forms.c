@@ -266,8 +266,8 @@ static int boundary_points(double *bx, double *bw, double *bn) {
 }
 
 /* Elasticity patch test with EFG (MLS, background cells) and Nitsche: the error in a
- * linear displacement field falls as the background quadrature order rises (issue 4;
- * Nitsche is consistent, so only quadrature error remains) and the matrix is
+ * linear displacement field falls as the background quadrature order rises
+ * (Nitsche is consistent, so only quadrature error remains) and the matrix is
  * symmetric (Bubnov). */
 static void test_efg_patch_nitsche(void **s) {
   (void)s;
@@ -421,7 +421,7 @@ static void test_fe_layer_patch(void **s) {
 
 /* Particles moved a little (same neighbours): update refills the values into the same
  * matrix, its pattern (pattern id) is kept, and the values equal a fresh assembly on the
- * moved particles (issue 4: symbolic and numeric parts are separate). */
+ * moved particles (symbolic and numeric parts are separate). */
 static void test_refill_after_move(void **s) {
   (void)s;
   mfree_particles_t *ps = cloud(1.6); /* borrows X */

@@ -1,7 +1,7 @@
 /* Galerkin-SPH fluid system (paper 003): exact conservation of linear and angular
  * momentum by the nodal-integrated internal forces (003 claims D3/D4; spec 003 section
  * 4), hydrostatic equilibrium of the interior at t = 0 with the initial densities of
- * 003 eq 65, and the failure modes of issue 5 (non-finite state, particle leaving the
+ * 003 eq 65, and the failure modes (non-finite state, particle leaving the
  * box, CFL violation), each keeping the last good state. */
 #include <math.h>
 #include <stdlib.h>

@@ -175,7 +175,7 @@ static void test_wave(void **s) {
   free_bar(&b);
 }
 
-/* A genuine blow-up (issue 5, bad input): with h = 1.5 dx the strip's growing modes
+/* A genuine blow-up (bad input): with h = 1.5 dx the strip's growing modes
  * overflow the state after some 15000 steps. The integration stops with
  * MFREE_FAIL_NONFINITE naming the step and the particle, and y, t hold the last good
  * (finite) state, from which a rerun reproduces the same failure at the same step. */

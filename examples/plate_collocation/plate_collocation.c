@@ -76,7 +76,7 @@ static const char *const kLayout[3] = {"rings", "rays", "polar"};
 static const char *const kCorner[3] = {"dirichlet", "symmetry", "hole"};
 static const char *const kSearch[4] = {"", "gather", "max", "mean"}; /* by MFREE_SEARCH_* */
 
-/* What was measured (issue 4), printed under the table. */
+/* What was measured, printed under the table. */
 static const char kNote[] =
     "The paper's plate size, hole radius and particle arrangement are unknown (spec 001\n"
     "erratum 11): compare orderings and rates, not the absolute errors. e(u2) scales as\n"

@@ -21,7 +21,7 @@
 #   MLS                 1.57 / 1.77         1.31 / 1.86          1.50/1.82  0.44 / 2.41    0.65/1.22
 #   EFG                 1.76 / 2.36         1.68 / 2.00          1.50/2.00  1.45 / 2.96    1.50/2.50
 #
-# Which levels (issue 4, fifth session). The paper gives no node counts. Over the long
+# Which levels. The paper gives no node counts. Over the long
 # range the energy errors of CD1 and CD2 level off near 8-10 % (257x33: 7.5 %, 9.3 %),
 # so the beam test asserts the issue's criteria on five levels at dx / sqrt 2 steps, 17x3,
 # 25x4, 33x5, 49x7, 65x9 (L/D = 8, s / dx = sqrt 2 fixed; the example's default, the
@@ -80,7 +80,7 @@
 # 0.33 Gauss; equal to three digits from 129x17 on): the nodal rule's larger coarse-level
 # errors steepen the slopes; the fine-level errors, and their stall, are the same.
 #
-# Checked in issue 4's third session (beam, 17x3 .. 257x33):
+# Checked on the beam (17x3 .. 257x33):
 # (a) u^h and grad u^h at the 5 x 5 Gauss points of the error norms are the trial
 # approximant's: CD1 = Shepard values (000 Sect. 4.6: Method 1's function is the Shepard
 # function) with Method 1's corrected derivatives, CD2 = Method 2's Phi (eq 63a, linear
@@ -110,9 +110,8 @@
 #
 # SPH and JB load their test functions with SPH's kernel estimate W dV (000 eq 21: the
 # symmetrisation and JB correct derivatives only), RL with Shepard values (000 eq 70);
-# the assembler does so since issue 4's second session. Before, all three used Shepard
-# values: then SPH and JB converged slowly on the hole (energy 0.76 and 0.47; SPH's error
-# falls 141 %, 108 %, 82 %, 65 %, 51 %, 41 % over 118 .. 3149 nodes) and JB's L2 error
+# the assembler does so. With Shepard values for all three, SPH and JB converged slowly
+# on the hole (energy 0.76 and 0.47; SPH's error falls 141 %, 108 %, 82 %, 65 %, 51 %, 41 % over 118 .. 3149 nodes) and JB's L2 error
 # fell at rate 2.5 on the beam. The kernel sums are not a partition of unity next to the
 # boundary, so the tractions' resultant is wrong by O(1) at every resolution: that, with
 # the derivatives' own O(1) boundary deficiency, is what 000 Table III's NC shows.
@@ -144,7 +143,7 @@
 # remains (tip deflection too small; the fifth session traced it to the loaded end, (2)
 # of "Where the stall comes from" above).
 #
-# Checked again (issue 4, second session): (a) with fe-gauss the interface column's
+# Checked again: (a) with fe-gauss the interface column's
 # volumes do lose the half cell inside the layer (fe_gauss_points subtracts a quarter of
 # each adjacent element), so nothing is counted twice; with the default layer the x = 0
 # nodes carry dx/2 dy (Voronoi, split among their elements, 000 Fig. 2) and the x = dx

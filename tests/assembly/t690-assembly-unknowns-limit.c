@@ -1,4 +1,4 @@
-/* Assembler size limit (issue 4, bad input "a matrix too large for int32 indices"): the
+/* Assembler size limit (bad input "a matrix too large for int32 indices"): the
  * unknowns of an assembled system (particles x components + Lagrange multipliers) are
  * int32_t indices of mfree_matrix_t, so mfree_assembler_setup refuses more than
  * INT32_MAX of them with MFREE_ERR_ARG and a message. Reaching that through the API

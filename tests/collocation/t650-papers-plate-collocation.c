@@ -30,7 +30,7 @@
  * "coarser with the distance from the hole" (Figs. 11, 13 missing) allows both; 0.6 is
  * the middle of the range where the ordering holds whatever else is chosen.
  *
- * Square-cell rings and the other arrangements measured (issue 4), e(u2) SSPH / MSPH,
+ * Square-cell rings and the other arrangements measured, e(u2) SSPH / MSPH,
  * default corner rows:
  *   rings b = 10, radial_step 1  209: 0.189 / 0.075  677: 0.0210 / 0.0150  1492: 0.0076 / 0.0103
  *   same, b = 5              142: 0.455 / 0.139   472: 0.0537 / 0.0111  1063: 0.0270 / 0.0092
@@ -64,7 +64,7 @@
  * against 0.185). The norm with the nodal values instead of the estimates differs by
  * < 1 %.
  *
- * Rechecked (issue 4, the choices the paper leaves open), SSPH/MSPH error ratio at the
+ * Rechecked (the choices the paper leaves open), SSPH/MSPH error ratio at the
  * paper's two resolutions, square-cell rings 209 / 677 and rays 187 / 693 (b = 10 a):
  *   as above (u on the estimate, gather h_i, corner rows "dirichlet"): 2.52 / 1.40, 1.14 / 1.38
  *   u_1 = 0, u_2 = 0 on the nodal unknowns:                           3.13 / 1.36, 0.87 / 1.37

@@ -1,4 +1,4 @@
-/* MPFEM bad input (issue 6): every case a documented status and a message naming the
+/* MPFEM bad input: every case a documented status and a message naming the
  * problem, nothing crashes.
  *  - connectivity out of range (copied: at add_elements; borrowed: at setup),
  *    a particle repeated within an element: MFREE_ERR_INPUT;

@@ -1,4 +1,4 @@
-/* Bad-input matrix of the core C ABI (issue 9): every public function of mfree.h
+/* Bad-input matrix of the core C ABI: every public function of mfree.h
  * against every class of bad argument that applies to it -- NULL handle, NULL array or
  * output, wrong dimension, negative or too small count / leading dimension / stride,
  * NaN or Inf in an array, zero or negative volume or support, unknown enumerator, wrong
@@ -1072,7 +1072,7 @@ static void rows_system(void) {
   ROW(MFREE_ERR_ARG, mfree_system_set_shepard_condition(F.sys, 0.5));
   ROW(MFREE_ERR_ARG, mfree_system_set_shepard_condition(F.sys, NAN));
 #endif
-  /* issue 5: dummy wall particles and density diffusion (failures change nothing) */
+  /* dummy wall particles and density diffusion (failures change nothing) */
   ROW0(MFREE_ERR_NULL, mfree_system_set_dummy_particles(NULL, 2, wx, &one, 0));
   ROW(MFREE_ERR_ARG, mfree_system_set_dummy_particles(F.sys, -1, wx, &one, 0));
   ROW(MFREE_ERR_NULL, mfree_system_set_dummy_particles(F.sys, 2, NULL, &one, 0));

@@ -1,4 +1,4 @@
-/* Degenerate geometry for every method (issue 9): particles on a line in 2D, on a
+/* Degenerate geometry for every method: particles on a line in 2D, on a
  * (tilted) plane in 3D, coincident particles, an isolated particle, clouds of 1, 2 and 3
  * particles in 1D, 2D and 3D, and supports smaller than the spacing. For every method
  * (and the orders its basis allows), without and with the lower-order fallback:

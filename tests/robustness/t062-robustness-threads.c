@@ -1,4 +1,4 @@
-/* Thread safety (issue 9, STYLE.md "apply on a set-up object is reentrant and
+/* Thread safety (STYLE.md "apply on a set-up object is reentrant and
  * deterministic; different objects may be used from different threads"):
  *  1. several threads apply ONE set-up approximant to different fields at once (values,
  *     gradients, Laplacians, divergence, apply_add) and get bitwise the results of one

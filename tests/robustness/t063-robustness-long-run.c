@@ -1,4 +1,4 @@
-/* Long run (issue 9): the dam break of paper 003 (the set-up of examples/dam_break: a
+/* Long run: the dam break of paper 003 (the set-up of examples/dam_break: a
  * column a x 2a released in a tank 5a long, walls of boundary particles, leap-frog with
  * the CFL step) at a coarse resolution, for 10,000 steps. The whole
  * state is finite (checked after each integration call); at the end no particle left the tank, the particle masses are
