@@ -2,7 +2,8 @@
 !> O(N^2) brute-force oracle written here, on random clouds in 2D and 3D with variable
 !> supports, for the three neighbour conventions, with ghosts and with a periodic box;
 !> then the oracle's lists handed back as the host's own 1-based CSR (index_base = 1,
-!> borrowed, rows in reverse order) come out as the same 0-based sorted lists.
+!> borrowed, rows in reverse order) come out as the same 0-based sorted lists; and the
+!> search with a Verlet skin gives the oracle's lists through small and large moves.
 program t201_neighbors_oracle_f
   use, intrinsic :: iso_c_binding
   use mfree
@@ -85,7 +86,7 @@ contains
     integer(c_int64_t), allocatable :: rowptr(:), orow(:), grow(:)
     integer(c_int32_t), allocatable :: cols(:), ocol(:), gcol(:)
     integer(c_int64_t) :: nnz, onnz, k
-    integer :: i, j, nown, bad
+    integer :: nown
     character(len=80) :: what
     real(c_double) :: lo(3), hi(3)
     integer(c_int32_t) :: per(3)
@@ -112,29 +113,11 @@ contains
     allocate (rowptr(nown + 1), cols(nnz))
     call check_ok(ctx, mfree_particles_get_neighbors(ps, rowptr, cols), 'get_neighbors')
 
-    ! the oracle, rows ascending like mfree's, 0-based
     allocate (orow(nown + 1), ocol(int(nown, c_int64_t) * n))
-    orow(1) = 0
-    onnz = 0
-    do i = 1, nown
-      do j = 1, n
-        if (oracle(dim, conv, i, j, periodic)) then
-          onnz = onnz + 1
-          ocol(onnz) = int(j - 1, c_int32_t)
-        end if
-      end do
-      orow(i + 1) = onnz
-    end do
+    call oracle_lists(dim, conv, nown, periodic, orow, ocol, onnz)
     call check(onnz == nnz, 'nnz equals the oracle''s: '//trim(what))
-    bad = 0
-    do i = 1, nown
-      if (orow(i + 1) /= rowptr(i + 1)) then
-        bad = bad + 1
-      else if (any(cols(rowptr(i) + 1:rowptr(i + 1)) /= ocol(orow(i) + 1:orow(i + 1)))) then
-        bad = bad + 1
-      end if
-    end do
-    call check(bad == 0, 'every row equals the oracle''s: '//trim(what))
+    call check(same_rows(nown, rowptr, cols, orow, ocol), &
+               'every row equals the oracle''s: '//trim(what))
     call check(onnz > 5 * nown, 'several neighbours per particle: '//trim(what))
 
     ! the oracle's lists as the host's own: 1-based, each row reversed, borrowed
@@ -162,6 +145,98 @@ contains
       deallocate (hrow, hcol)
     end if
     call check(mfree_particles_destroy(ps) == MFREE_SUCCESS, 'destroy')
+    if (.not. periodic) call compare_skin(dim, conv, ng, what)
   end subroutine compare
+
+  !> The same search with a Verlet skin s (mfree_particles_set_search_skin): the lists
+  !> equal the oracle's at the first setup, after moves shorter than s / 2 (no new
+  !> search: the count stays 1) and after a longer move (a second search); x is restored.
+  subroutine compare_skin(dim, conv, ng, what)
+    integer, intent(in) :: dim
+    integer(c_int), intent(in) :: conv
+    integer(c_int32_t), intent(in) :: ng
+    character(len=*), intent(in) :: what
+    real(c_double), parameter :: s = 0.02_c_double
+    real(c_double) :: x0(3, n)
+    type(mfree_particles) :: ps
+    integer(c_int64_t), allocatable :: rowptr(:), orow(:)
+    integer(c_int32_t), allocatable :: cols(:), ocol(:)
+    integer(c_int64_t) :: nnz, onnz, count
+    integer :: i, nown, pass
+    real(c_double) :: step, dx(3)
+
+    nown = n - ng
+    x0 = x
+    allocate (orow(nown + 1), ocol(int(nown, c_int64_t) * n))
+    call check_ok(ctx, mfree_particles_create(ctx, int(dim, c_int32_t), int(n, c_int32_t), &
+                                              ps), 'create (skin)')
+    call check_ok(ctx, mfree_particles_set_num_ghost(ps, ng), 'set_num_ghost (skin)')
+    call check_ok(ctx, mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, 3_c_int64_t, &
+                                                     MFREE_BORROW), 'set_positions (skin)')
+    call check_ok(ctx, mfree_particles_set_support(ps, h, 1_c_int64_t, MFREE_BORROW), &
+                  'set_support (skin)')
+    call check_ok(ctx, mfree_particles_set_search(ps, conv, kappa), 'set_search (skin)')
+    call check_ok(ctx, mfree_particles_set_search_skin(ps, s), 'set_search_skin')
+    do pass = 1, 3
+      ! pass 2: every particle moves by less than s / 2; pass 3: by more
+      step = merge(0.0_c_double, merge(0.2_c_double * s, 0.8_c_double * s, pass == 2), &
+                   pass == 1)
+      do i = 1, n
+        dx = [rng_uniform(), rng_uniform(), rng_uniform()] - 0.5_c_double
+        x(1:dim, i) = x(1:dim, i) + step * dx(1:dim)
+      end do
+      call check_ok(ctx, mfree_particles_setup(ps), 'setup (skin): '//trim(what))
+      call check_ok(ctx, mfree_particles_get_search_count(ps, count), 'get_search_count')
+      call check(count == merge(2, 1, pass == 3), 'searches run with the skin: '//trim(what))
+      call check_ok(ctx, mfree_particles_get_neighbor_nnz(ps, nnz), 'nnz (skin)')
+      allocate (rowptr(nown + 1), cols(nnz))
+      call check_ok(ctx, mfree_particles_get_neighbors(ps, rowptr, cols), 'get (skin)')
+      call oracle_lists(dim, conv, nown, .false., orow, ocol, onnz)
+      call check(onnz == nnz .and. same_rows(nown, rowptr, cols, orow, ocol), &
+                 'lists with the skin equal the oracle''s: '//trim(what))
+      deallocate (rowptr, cols)
+    end do
+    call check(mfree_particles_set_search_skin(ps, -1.0_c_double) == MFREE_ERR_ARG, &
+               'a negative skin is refused')
+    call check(mfree_particles_destroy(ps) == MFREE_SUCCESS, 'destroy (skin)')
+    x = x0
+  end subroutine compare_skin
+
+  !> The oracle's lists of the owned particles, rows ascending like mfree's, 0-based.
+  subroutine oracle_lists(dim, conv, nown, periodic, orow, ocol, onnz)
+    integer, intent(in) :: dim, nown
+    integer(c_int), intent(in) :: conv
+    logical, intent(in) :: periodic
+    integer(c_int64_t), intent(out) :: orow(:), onnz
+    integer(c_int32_t), intent(out) :: ocol(:)
+    integer :: i, j
+    orow(1) = 0
+    onnz = 0
+    do i = 1, nown
+      do j = 1, n
+        if (oracle(dim, conv, i, j, periodic)) then
+          onnz = onnz + 1
+          ocol(onnz) = int(j - 1, c_int32_t)
+        end if
+      end do
+      orow(i + 1) = onnz
+    end do
+  end subroutine oracle_lists
+
+  !> Whether the CSR lists (rowptr, cols) have the rows (orow, ocol).
+  logical function same_rows(nown, rowptr, cols, orow, ocol)
+    integer, intent(in) :: nown
+    integer(c_int64_t), intent(in) :: rowptr(:), orow(:)
+    integer(c_int32_t), intent(in) :: cols(:), ocol(:)
+    integer :: i
+    same_rows = .true.
+    do i = 1, nown
+      if (orow(i + 1) /= rowptr(i + 1)) then
+        same_rows = .false.
+      else if (any(cols(rowptr(i) + 1:rowptr(i + 1)) /= ocol(orow(i) + 1:orow(i + 1)))) then
+        same_rows = .false.
+      end if
+    end do
+  end function same_rows
 
 end program t201_neighbors_oracle_f
