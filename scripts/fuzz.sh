@@ -28,7 +28,7 @@ target_files() {
     approximant) echo "src/core/shape/approximant.cpp src/core/shape/apply.cpp src/core/shape/local.cpp src/core/shape/shape_fast.cpp src/capi/approximant.cpp" ;;
     mpfem) echo "src/core/shape/mpfem.cpp src/capi/mesh.cpp" ;;
     assembly) echo "src/core/discretize/assembler.cpp src/core/discretize/matrix.cpp src/capi/assembler.cpp src/capi/matrix.cpp" ;;
-    system) echo "src/core/systems/fluid.cpp src/core/systems/fluid_wall.cpp src/core/systems/elastodynamics.cpp src/capi/system.cpp" ;;
+    system) echo "src/core/systems/fluid.cpp src/core/systems/fluid_tables.cpp src/core/systems/fluid_accel.cpp src/core/systems/fluid_wall.cpp src/core/systems/elastodynamics.cpp src/capi/system.cpp" ;;
     adapters) echo "adapters/suitesparse/src/suitesparse.cpp adapters/sundials/src/sundials.cpp" ;;
   esac
 }

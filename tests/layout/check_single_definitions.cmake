@@ -62,8 +62,8 @@ set(re_threshold
 set(exceptions
   # the fluid's own rows (linear MLS, its SPD inverse and threshold) stay until the fluid
   # takes every row from the approximants with the same Shepard rule (src/core/README.md)
-  "spd|core/systems/fluid.cpp"
-  "threshold|core/systems/fluid.cpp"
+  "spd|core/systems/fluid_tables.cpp"
+  "threshold|core/systems/fluid_tables.cpp"
 )
 
 file(GLOB_RECURSE files RELATIVE "${SRC}" LIST_DIRECTORIES false

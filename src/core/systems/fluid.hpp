@@ -10,6 +10,7 @@
 
 #include "core/shape/approximant.hpp"
 #include "core/base/error.hpp"
+#include "core/base/parallel.hpp"
 #include "core/systems/fluid_wall.hpp"
 #include "core/discretize/matrix.hpp"
 #include "mfree.h"
@@ -52,6 +53,10 @@ class FluidSystem : public System {
 
  private:
   void check_ready() const;
+  // Threads for a loop of a few operations per particle (checks, volumes, updates): a team
+  // and its barrier (a few microseconds on idle cores, far more on a loaded machine) pay
+  // off from ~8,000 particles.
+  static int light_threads(int64_t n) { return num_threads(n / 4); }
   // Validate the state (unless checked: integrate's state after a step, which
   // check_state has just passed) and build the shape-function tables at the nodes (below).
   Report prepare(const double *y, bool checked = false);
