@@ -4,6 +4,8 @@
 // make the others wait, so that a failure on one rank never leaves another blocked.
 #include "mfree_mpi.h"
 
+#include "collective.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,8 +24,8 @@ struct mfree_halo {
   int rank = 0, size = 1, dim = 0;
   bool ready = false;
   bool ids_checked = false;  // the owned ids in ids[0, n_owned) passed the global check
-  mfree_status_t pending = MFREE_SUCCESS;  // mfree_halo_set_pending_error: the next
-  char pending_msg[512] = {0};             // collective call's outcome on this rank
+  mfree_mpi_detail::Pending pending;  // mfree_halo_set_pending_error: the next collective
+                                      // call's outcome on this rank
   int32_t n_owned = 0, n_ghost = 0;
   int64_t offset = 0, total = 0;
   std::vector<int> nbrs;                          // neighbour ranks, ascending
@@ -37,117 +39,23 @@ struct mfree_halo {
 
 namespace {
 
-// (const char *: no std::string is built outside a try on the callers' side)
-mfree_status_t record(mfree_context_t *ctx, mfree_status_t st, const char *fn, const char *msg) noexcept {
-  char text[640];
-  std::snprintf(text, sizeof text, "%s: %s", fn, msg);
-  return mfree_context_set_error(ctx, st, text);
+using namespace mfree_mpi_detail;
+
+// The agreement of collective.hpp over the plan's communicator.
+mfree_status_t agree(mfree_halo_t *h, const char *fn, const Local &l, Loc *vals = nullptr, int nv = 0) noexcept {
+  return mfree_mpi_detail::agree(h->ctx, h->comm, h->rank, fn, l, vals, nv);
 }
 
-// A local step's outcome: status and message, not yet shared with the other ranks.
-struct Local {
-  mfree_status_t st = MFREE_SUCCESS;
-  std::string msg;
-  void fail(mfree_status_t s, std::string m) {
-    if (st == MFREE_SUCCESS) {
-      st = s;
-      msg = std::move(m);
-    }
-  }
-};
-
-template <class Body>
-Local run_local(Body &&body) noexcept {
-  Local l;
-  try {
-    body(l);
-  } catch (const std::bad_alloc &) {
-    l.st = MFREE_ERR_ALLOC;
-    l.msg = "out of memory";
-  } catch (const std::exception &e) {
-    l.st = MFREE_ERR_INTERNAL;
-    try {
-      l.msg = std::string("internal error: ") + e.what();
-    } catch (...) {
-    }
-  } catch (...) {
-    l.st = MFREE_ERR_INTERNAL;
-  }
-  return l;
-}
-
-// One value of a rank in an agreement: its minimum over the ranks and the lowest rank
-// holding it come back (MPI_DOUBLE_INT, MPI_MINLOC; maxima as minima of the negatives).
-struct Loc {
-  double v;
-  int r;
-};
-
-// Every rank learns the lowest status of the ranks (the first rank holding it breaks
-// ties) and that rank's message; all return the same status. The same all-reduce carries
-// the nv values of vals (each rank's in, the minimum and its rank out), which the callers
-// compare to find ranks that disagree on an argument that must be common. MPI failures of
-// the agreement itself are internal errors.
-mfree_status_t agree(mfree_halo_t *h, const char *fn, const Local &l, Loc *vals = nullptr,
-                     int nv = 0) noexcept {
-  Loc buf_in[8], buf_out[8];
-  if (nv > 7) return record(h->ctx, MFREE_ERR_INTERNAL, fn, "too many values to agree on");
-  buf_in[0] = {static_cast<double>(l.st < 0 ? l.st : MFREE_SUCCESS), h->rank};
-  for (int k = 0; k < nv; ++k) buf_in[k + 1] = {vals[k].v, h->rank};
-  if (MPI_Allreduce(buf_in, buf_out, nv + 1, MPI_DOUBLE_INT, MPI_MINLOC, h->comm) != MPI_SUCCESS)
-    return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Allreduce failed");
-  for (int k = 0; k < nv; ++k) vals[k] = buf_out[k + 1];
-  const int worst = static_cast<int>(buf_out[0].v), who = buf_out[0].r;
-  if (worst == MFREE_SUCCESS) return MFREE_SUCCESS;
-  char buf[512] = {0};
-  if (h->rank == who) std::snprintf(buf, sizeof buf, "%s", l.msg.c_str());
-  if (MPI_Bcast(buf, static_cast<int>(sizeof buf), MPI_CHAR, who, h->comm) != MPI_SUCCESS)
-    return record(h->ctx, MFREE_ERR_INTERNAL, fn, "MPI_Bcast failed");
-  buf[sizeof buf - 1] = 0;
-  const mfree_status_t st = static_cast<mfree_status_t>(worst);
-  char text[560];
-  std::snprintf(text, sizeof text, "rank %d: %s", who, buf);
-  return record(h->ctx, st, fn, text);
-}
-
-// After an agreement on (v, -v): MFREE_ERR_ARG on every rank alike when the ranks passed
-// different values of an argument that must be common (the message names the lowest
-// ranks holding the smallest and the largest value).
 mfree_status_t same_everywhere(mfree_halo_t *h, const char *fn, const char *what, const Loc &lo,
                                const Loc &neg_hi) noexcept {
-  if (lo.v == -neg_hi.v) return MFREE_SUCCESS;
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "ranks disagree on %s: rank %d passes %.17g, rank %d passes %.17g (every rank must pass the same)",
-                what, lo.r, lo.v, neg_hi.r, -neg_hi.v);
-  return record(h->ctx, MFREE_ERR_ARG, fn, buf);
+  return mfree_mpi_detail::same_everywhere(h->ctx, fn, what, lo, neg_hi);
 }
 
 // A collective call's local step: the failure a binding handed over with
-// mfree_halo_set_pending_error (taken: it is reported once), else body's outcome.
+// mfree_halo_set_pending_error, else body's outcome.
 template <class Body>
 Local first_step(mfree_halo_t *h, Body &&body) noexcept {
-  if (h->pending == MFREE_SUCCESS) return run_local(body);
-  Local l;
-  l.st = h->pending;
-  h->pending = MFREE_SUCCESS;
-  try {
-    l.msg = h->pending_msg;
-  } catch (...) {
-  }
-  return l;
-}
-
-// A failure of a core call inside a local step: its status and the message it left on
-// the context it recorded it on.
-void core_fail(Local &l, mfree_status_t st, mfree_context_t *ctx) {
-  char msg[400] = {0};
-  mfree_context_get_last_error(ctx, nullptr, msg, sizeof msg);
-  l.fail(st, msg);
-}
-
-// An MPI call inside a local step: its failure becomes MFREE_ERR_INTERNAL.
-void mpi_ok(Local &l, int rc, const char *what) {
-  if (rc != MPI_SUCCESS) l.fail(MFREE_ERR_INTERNAL, std::string(what) + " failed");
+  return h->pending.first_step(body);
 }
 
 // The rank that checks global id g for duplicates (ids spread by a 64-bit mix).
@@ -418,17 +326,7 @@ mfree_status_t mfree_halo_get_context(const mfree_halo_t *h, mfree_context_t **c
 
 mfree_status_t mfree_halo_set_pending_error(mfree_halo_t *h) {
   if (!h) return MFREE_ERR_NULL;
-  mfree_status_t code = MFREE_SUCCESS;
-  char msg[sizeof h->pending_msg] = {0};
-  mfree_context_get_last_error(h->ctx, &code, msg, sizeof msg);
-  if (code >= 0)
-    return record(h->ctx, MFREE_ERR_STATE, "mfree_halo_set_pending_error", "the context holds no failure to hand over");
-  // "fn: reason" as mfree_context_set_error got it: the collective call adds its own name
-  const char *colon = std::strstr(msg, ": ");
-  const char *reason = colon && std::strncmp(msg, "mfree_", 6) == 0 ? colon + 2 : msg;
-  h->pending = code;
-  std::snprintf(h->pending_msg, sizeof h->pending_msg, "%s", reason);
-  return MFREE_SUCCESS;
+  return h->pending.take_from(h->ctx, "mfree_halo_set_pending_error");
 }
 
 mfree_status_t mfree_halo_get_size(const mfree_halo_t *h, int32_t *n_owned, int32_t *n_ghost) {
