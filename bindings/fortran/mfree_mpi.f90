@@ -28,6 +28,15 @@ module mfree_mpi
     type(c_ptr) :: ptr = c_null_ptr
   end type mfree_halo
 
+  !> A migration plan (C: mfree_migration_t *).
+  type, public :: mfree_migration
+    type(c_ptr) :: ptr = c_null_ptr
+  end type mfree_migration
+
+  !> Partitioners of mfree_migration_set_partitioner (mfree_partitioner_t).
+  integer(c_int), parameter, public :: MFREE_PARTITIONER_RCB = 1
+  integer(c_int), parameter, public :: MFREE_PARTITIONER_HSFC = 2
+
   ! ---- raw bind(C) interfaces: one per public function of mfree_mpi.h (but the C-only
   ! mfree_halo_create) ----
   interface
@@ -116,6 +125,101 @@ module mfree_mpi
       real(c_double), intent(inout) :: field(*)
       integer(c_int64_t), value :: ld
     end function mfree_halo_exchange_c
+
+    integer(c_int) function mfree_migration_create_f_c(ctx, fcomm, dim, migration) &
+        bind(C, name="mfree_migration_create_f")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: fcomm
+      integer(c_int32_t), value :: dim
+      type(c_ptr), intent(out) :: migration
+    end function mfree_migration_create_f_c
+
+    integer(c_int) function mfree_migration_destroy_c(migration) bind(C, name="mfree_migration_destroy")
+      import :: c_int, c_ptr
+      type(c_ptr), intent(inout) :: migration
+    end function mfree_migration_destroy_c
+
+    integer(c_int) function mfree_migration_set_partitioner_c(migration, method, imbalance_tol) &
+        bind(C, name="mfree_migration_set_partitioner")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: migration
+      integer(c_int32_t), value :: method
+      real(c_double), value :: imbalance_tol
+    end function mfree_migration_set_partitioner_c
+
+    integer(c_int) function mfree_migration_add_field_c(migration, data, item_bytes, stride_bytes) &
+        bind(C, name="mfree_migration_add_field")
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: migration
+      type(c_ptr), value :: data
+      integer(c_int64_t), value :: item_bytes
+      integer(c_int64_t), value :: stride_bytes
+    end function mfree_migration_add_field_c
+
+    integer(c_int) function mfree_migration_clear_fields_c(migration) &
+        bind(C, name="mfree_migration_clear_fields")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: migration
+    end function mfree_migration_clear_fields_c
+
+    integer(c_int) function mfree_migration_partition_c(migration, n_owned, x, ld, rebalance, n_new) &
+        bind(C, name="mfree_migration_partition")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: migration
+      integer(c_int32_t), value :: n_owned
+      real(c_double), intent(in) :: x(*)
+      integer(c_int64_t), value :: ld
+      integer(c_int32_t), value :: rebalance
+      integer(c_int32_t), intent(out) :: n_new
+    end function mfree_migration_partition_c
+
+    integer(c_int) function mfree_migration_set_owners_c(migration, n_owned, owners, n_new) &
+        bind(C, name="mfree_migration_set_owners")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: migration
+      integer(c_int32_t), value :: n_owned
+      integer(c_int32_t), intent(in) :: owners(*)
+      integer(c_int32_t), intent(out) :: n_new
+    end function mfree_migration_set_owners_c
+
+    integer(c_int) function mfree_migration_execute_c(migration, capacity) &
+        bind(C, name="mfree_migration_execute")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: migration
+      integer(c_int32_t), value :: capacity
+    end function mfree_migration_execute_c
+
+    integer(c_int) function mfree_migration_get_counts_c(migration, n_owned, n_new, n_send, n_recv) &
+        bind(C, name="mfree_migration_get_counts")
+      import :: c_int, c_int32_t, c_int64_t, c_ptr
+      type(c_ptr), value :: migration
+      integer(c_int32_t), intent(out) :: n_owned
+      integer(c_int32_t), intent(out) :: n_new
+      integer(c_int64_t), intent(out) :: n_send
+      integer(c_int64_t), intent(out) :: n_recv
+    end function mfree_migration_get_counts_c
+
+    integer(c_int) function mfree_migration_get_owners_c(migration, owners, capacity) &
+        bind(C, name="mfree_migration_get_owners")
+      import :: c_int, c_int32_t, c_int64_t, c_ptr
+      type(c_ptr), value :: migration
+      integer(c_int32_t), intent(out) :: owners(*)
+      integer(c_int64_t), value :: capacity
+    end function mfree_migration_get_owners_c
+
+    integer(c_int) function mfree_migration_get_context_c(migration, ctx) &
+        bind(C, name="mfree_migration_get_context")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: migration
+      type(c_ptr), intent(out) :: ctx
+    end function mfree_migration_get_context_c
+
+    integer(c_int) function mfree_migration_set_pending_error_c(migration) &
+        bind(C, name="mfree_migration_set_pending_error")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: migration
+    end function mfree_migration_set_pending_error_c
   end interface
 
   public :: mfree_halo_create_f_c, mfree_halo_destroy_c, mfree_halo_setup_c
@@ -127,8 +231,19 @@ module mfree_mpi
   public :: mfree_halo_get_size, mfree_halo_get_global_ids, mfree_halo_get_global_offset
   public :: mfree_halo_get_plan, mfree_halo_exchange, mfree_halo_get_context
   public :: mfree_halo_set_pending_error, mfree_halo_exchange_correction
+  public :: mfree_migration_create_f_c, mfree_migration_destroy_c, mfree_migration_set_partitioner_c
+  public :: mfree_migration_add_field_c, mfree_migration_clear_fields_c, mfree_migration_partition_c
+  public :: mfree_migration_set_owners_c, mfree_migration_execute_c, mfree_migration_get_counts_c
+  public :: mfree_migration_get_owners_c, mfree_migration_get_context_c
+  public :: mfree_migration_set_pending_error_c
+  public :: mfree_migration_create, mfree_migration_create_f, mfree_migration_destroy
+  public :: mfree_migration_set_partitioner, mfree_migration_add_field, mfree_migration_clear_fields
+  public :: mfree_migration_partition, mfree_migration_set_owners, mfree_migration_execute
+  public :: mfree_migration_get_counts, mfree_migration_get_owners, mfree_migration_get_context
+  public :: mfree_migration_set_pending_error
 
   real(c_double), target, save :: empty_dbl(0)
+  integer(c_int32_t), target, save :: empty_i32(0)
 
 contains
 
@@ -273,5 +388,141 @@ contains
     ctx = c_null_ptr
     st = mfree_halo_get_context_c(halo%ptr, ctx)
   end function halo_ctx
+
+  ! ---- migration (mfree_mpi.h, "Migration") ----
+
+  !> A migration plan on the communicator comm (an integer handle of `use mpi`). Collective.
+  integer(c_int) function mfree_migration_create(ctx, comm, dim, migration) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer, intent(in) :: comm
+    integer(c_int32_t), intent(in) :: dim
+    type(mfree_migration), intent(out) :: migration
+    st = mfree_migration_create_f_c(ctx%ptr, int(comm, c_int32_t), dim, migration%ptr)
+  end function mfree_migration_create
+
+  !> The same with the communicator already as integer(c_int32_t).
+  integer(c_int) function mfree_migration_create_f(ctx, fcomm, dim, migration) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: fcomm, dim
+    type(mfree_migration), intent(out) :: migration
+    st = mfree_migration_create_f_c(ctx%ptr, fcomm, dim, migration%ptr)
+  end function mfree_migration_create_f
+
+  !> Free the plan. Collective, like mfree_halo_destroy.
+  integer(c_int) function mfree_migration_destroy(migration) result(st)
+    type(mfree_migration), intent(inout) :: migration
+    st = mfree_migration_destroy_c(migration%ptr)
+  end function mfree_migration_destroy
+
+  !> MFREE_PARTITIONER_RCB or _HSFC and Zoltan's imbalance tolerance (>= 1).
+  integer(c_int) function mfree_migration_set_partitioner(migration, method, imbalance_tol) result(st)
+    type(mfree_migration), intent(in) :: migration
+    integer(c_int32_t), intent(in) :: method
+    real(c_double), intent(in) :: imbalance_tol
+    st = mfree_migration_set_partitioner_c(migration%ptr, method, imbalance_tol)
+  end function mfree_migration_set_partitioner
+
+  !> Register a field: data = c_loc of the first item of a contiguous array (with the
+  !> target attribute, alive until the fields are cleared) that holds the capacity given
+  !> to mfree_migration_execute; item_bytes per particle, stride_bytes between particles
+  !> (x(ld, n) of real(c_double): item 8 * dim, stride 8 * ld). The module cannot see the
+  !> array's size through a c_ptr: the host sizes it.
+  integer(c_int) function mfree_migration_add_field(migration, data, item_bytes, stride_bytes) result(st)
+    type(mfree_migration), intent(in) :: migration
+    type(c_ptr), intent(in) :: data
+    integer(c_int64_t), intent(in) :: item_bytes, stride_bytes
+    st = mfree_migration_add_field_c(migration%ptr, data, item_bytes, stride_bytes)
+  end function mfree_migration_add_field
+
+  integer(c_int) function mfree_migration_clear_fields(migration) result(st)
+    type(mfree_migration), intent(in) :: migration
+    st = mfree_migration_clear_fields_c(migration%ptr)
+  end function mfree_migration_clear_fields
+
+  !> Destinations by Zoltan from positions x(ld, n_owned); n_new after the migration.
+  !> Collective. x must hold ld * n_owned values, else MFREE_ERR_ARG on every rank.
+  integer(c_int) function mfree_migration_partition(migration, n_owned, x, ld, rebalance, n_new) result(st)
+    type(mfree_migration), intent(in) :: migration
+    integer(c_int32_t), intent(in) :: n_owned, rebalance
+    real(c_double), intent(in), target :: x(..)
+    integer(c_int64_t), intent(in) :: ld
+    integer(c_int32_t), intent(out) :: n_new
+    real(c_double), pointer :: px(:)
+    real(c_double), allocatable, target :: tx(:)
+    n_new = 0
+    st = mfree_wrapper_check_out(migration_ctx(migration), 'mfree_migration_partition', 'x', .true., &
+                                 size(x, kind=c_int64_t), ld * max(int(n_owned, c_int64_t), 0_c_int64_t))
+    if (st /= MFREE_SUCCESS) then
+      if (mfree_migration_set_pending_error_c(migration%ptr) /= MFREE_SUCCESS) return
+      st = mfree_migration_partition_c(migration%ptr, n_owned, empty_dbl, ld, rebalance, n_new)
+      return
+    end if
+    call mfree_wrapper_view_dbl(x, tx, px)
+    st = mfree_migration_partition_c(migration%ptr, n_owned, px, ld, rebalance, n_new)
+  end function mfree_migration_partition
+
+  !> Destinations chosen by the host: owners(n_owned) ranks in [0, size). Collective.
+  !> owners must hold n_owned values, else MFREE_ERR_ARG on every rank.
+  integer(c_int) function mfree_migration_set_owners(migration, n_owned, owners, n_new) result(st)
+    type(mfree_migration), intent(in) :: migration
+    integer(c_int32_t), intent(in) :: n_owned
+    integer(c_int32_t), intent(in), contiguous :: owners(:)
+    integer(c_int32_t), intent(out) :: n_new
+    n_new = 0
+    st = mfree_wrapper_check_out(migration_ctx(migration), 'mfree_migration_set_owners', 'owners', .true., &
+                                 size(owners, kind=c_int64_t), max(int(n_owned, c_int64_t), 0_c_int64_t))
+    if (st /= MFREE_SUCCESS) then
+      if (mfree_migration_set_pending_error_c(migration%ptr) /= MFREE_SUCCESS) return
+      st = mfree_migration_set_owners_c(migration%ptr, n_owned, empty_i32, n_new)
+      return
+    end if
+    st = mfree_migration_set_owners_c(migration%ptr, n_owned, owners, n_new)
+  end function mfree_migration_set_owners
+
+  !> Move the planned particles with every registered field. Collective.
+  integer(c_int) function mfree_migration_execute(migration, capacity) result(st)
+    type(mfree_migration), intent(in) :: migration
+    integer(c_int32_t), intent(in) :: capacity
+    st = mfree_migration_execute_c(migration%ptr, capacity)
+  end function mfree_migration_execute
+
+  integer(c_int) function mfree_migration_get_counts(migration, n_owned, n_new, n_send, n_recv) result(st)
+    type(mfree_migration), intent(in) :: migration
+    integer(c_int32_t), intent(out) :: n_owned, n_new
+    integer(c_int64_t), intent(out) :: n_send, n_recv
+    st = mfree_migration_get_counts_c(migration%ptr, n_owned, n_new, n_send, n_recv)
+  end function mfree_migration_get_counts
+
+  !> owners(n_owned): each planned particle's destination; contiguous and long enough,
+  !> else MFREE_ERR_ARG with nothing written.
+  integer(c_int) function mfree_migration_get_owners(migration, owners) result(st)
+    type(mfree_migration), intent(in) :: migration
+    integer(c_int32_t), intent(out) :: owners(:)
+    st = mfree_wrapper_check_out(migration_ctx(migration), 'mfree_migration_get_owners', 'owners', &
+                                 is_contiguous(owners), 0_c_int64_t, 0_c_int64_t)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_migration_get_owners_c(migration%ptr, owners, size(owners, kind=c_int64_t))
+  end function mfree_migration_get_owners
+
+  !> Typed wrapper of mfree_migration_get_context (mfree_mpi.h): the plan's context, borrowed.
+  integer(c_int) function mfree_migration_get_context(migration, ctx) result(st)
+    type(mfree_migration), intent(in) :: migration
+    type(mfree_context), intent(out) :: ctx
+    st = mfree_migration_get_context_c(migration%ptr, ctx%ptr)
+  end function mfree_migration_get_context
+
+  !> Typed wrapper of mfree_migration_set_pending_error (mfree_mpi.h).
+  integer(c_int) function mfree_migration_set_pending_error(migration) result(st)
+    type(mfree_migration), intent(in) :: migration
+    st = mfree_migration_set_pending_error_c(migration%ptr)
+  end function mfree_migration_set_pending_error
+
+  !> The context of a migration plan (NULL for a NULL handle).
+  type(c_ptr) function migration_ctx(migration) result(ctx)
+    type(mfree_migration), intent(in) :: migration
+    integer(c_int) :: st
+    ctx = c_null_ptr
+    st = mfree_migration_get_context_c(migration%ptr, ctx)
+  end function migration_ctx
 
 end module mfree_mpi

@@ -229,6 +229,203 @@ MFREE_MPI_API mfree_status_t mfree_halo_exchange(mfree_halo_t *halo, int32_t nco
  */
 MFREE_MPI_API mfree_status_t mfree_halo_exchange_correction(mfree_halo_t *halo, mfree_approximant_t *a);
 
+/* ------------------------------------------------------------------------------------ */
+/* Migration: owned particles and their fields moved to new owners, partitioned by       */
+/* Zoltan (RCB or HSFC) or by the host. docs/mpi.md, "Migration and load balance".       */
+/* ------------------------------------------------------------------------------------ */
+
+/** A migration plan: where each owned particle goes, and the fields that travel with it. */
+typedef struct mfree_migration mfree_migration_t;
+
+/** Partitioners of mfree_migration_partition (Zoltan's geometric methods). */
+typedef MFREE_ENUM(mfree_partitioner) {
+  MFREE_PARTITIONER_RCB = 1, /**< recursive coordinate bisection (Zoltan LB_METHOD RCB): box
+                                  regions, the default */
+  MFREE_PARTITIONER_HSFC = 2 /**< Hilbert space-filling curve (Zoltan LB_METHOD HSFC) */
+} mfree_partitioner_t;
+
+/**
+ * Create a migration plan on comm (duplicated). Collective over comm. Migration is the
+ * host's choice of moment (between integration windows): mfree_migration_partition or
+ * _set_owners decides where each owned particle goes, mfree_migration_execute moves it with
+ * every registered field; the host then rebuilds its halo (mfree_halo_setup) and particle set.
+ * @param[in]  ctx        context for errors (kept alive by the plan)
+ * @param[in]  comm       the ranks sharing the particles
+ * @param[in]  dim        1, 2 or 3, the same on every rank (else MFREE_ERR_ARG on every rank)
+ * @param[out] migration  the new plan; NULL on failure
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (local) for a NULL ctx or migration; MFREE_ERR_ARG,
+ *         MFREE_ERR_ALLOC or MFREE_ERR_INTERNAL on every rank when one rank fails or the
+ *         ranks pass different dimensions
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_create(mfree_context_t *ctx, MPI_Comm comm, int32_t dim,
+                                                    mfree_migration_t **migration);
+
+/**
+ * mfree_migration_create with a Fortran communicator handle (converted by MPI_Comm_f2c).
+ * @param[in]  ctx        context for errors
+ * @param[in]  fcomm      the Fortran handle (e.g. MPI_COMM_WORLD of `use mpi`)
+ * @param[in]  dim        1, 2 or 3
+ * @param[out] migration  the new plan
+ * @return as mfree_migration_create
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_create_f(mfree_context_t *ctx, int32_t fcomm, int32_t dim,
+                                                      mfree_migration_t **migration);
+
+/**
+ * Free a plan. Collective over the plan's communicator, like mfree_halo_destroy (it frees
+ * its duplicate communicator and Zoltan's); after MPI_Finalize only the memory is freed.
+ * @param[in,out] migration  may be NULL or point to NULL (nothing to do); set to NULL
+ * @return MFREE_SUCCESS
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_destroy(mfree_migration_t **migration);
+
+/**
+ * Choose the partitioner of the next mfree_migration_partition. Not collective; every rank
+ * must choose the same (checked by the partition call: MFREE_ERR_ARG on every rank).
+ * @param[in] migration      the plan
+ * @param[in] method         MFREE_PARTITIONER_RCB (the default) or MFREE_PARTITIONER_HSFC
+ * @param[in] imbalance_tol  the largest allowed ratio of a rank's count to the mean
+ *                           (Zoltan IMBALANCE_TOL), in [1, 10]; the default 1.05
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_ARG for an unknown method or a
+ *         tolerance outside [1, 10] (nothing changed)
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_set_partitioner(mfree_migration_t *migration, int32_t method,
+                                                             double imbalance_tol);
+
+/**
+ * Register a per-particle field that travels with its particle: positions, velocities,
+ * densities, masses, global ids, flags, any strided array. Particle i's item is the
+ * item_bytes bytes at (char *)data + i * stride_bytes, copied bit for bit. The array is
+ * the caller's; it must hold the capacity given to mfree_migration_execute (the items
+ * past the owned ones, ghosts, are not read and are overwritten by arrivals). Not
+ * collective; every rank registers the same fields in the same order (item sizes; checked
+ * by mfree_migration_execute). After the host reallocates an array, it clears the fields
+ * and registers them again.
+ * @param[in] migration     the plan
+ * @param[in] data          the array (may be NULL only while capacity 0 is passed)
+ * @param[in] item_bytes    bytes per particle copied (>= 1), e.g. 3 * sizeof(double)
+ * @param[in] stride_bytes  bytes from one particle to the next (>= item_bytes)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL plan; MFREE_ERR_ARG for item_bytes < 1
+ *         or stride_bytes < item_bytes (nothing registered)
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_add_field(mfree_migration_t *migration, void *data,
+                                                       int64_t item_bytes, int64_t stride_bytes);
+
+/**
+ * Forget every registered field. Not collective.
+ * @param[in] migration  the plan
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL plan
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_clear_fields(mfree_migration_t *migration);
+
+/**
+ * Decide where each owned particle goes by Zoltan's geometric partition of all ranks'
+ * positions, and how many particles this rank owns after mfree_migration_execute.
+ * Collective. With rebalance = 1 (and on the first call) Zoltan computes new regions,
+ * one per rank, balancing the counts to the tolerance of mfree_migration_set_partitioner;
+ * with rebalance = 0 the regions of the last rebalance are kept and only the particles
+ * that left this rank's region move to the rank whose region holds them (cheaper, no
+ * balancing). Positions are read during the call only. Moves nothing.
+ * @param[in]  migration  the plan
+ * @param[in]  n_owned    owned particles on this rank (>= 0)
+ * @param[in]  x          positions, AoS: particle i, component c at x[i*ld + c], finite
+ * @param[in]  ld         leading dimension (>= dim)
+ * @param[in]  rebalance  1: new regions; 0: the last regions (1 when there are none)
+ * @param[out] n_new      the particles this rank owns after the migration (may be NULL)
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG (a bad argument, rebalance not
+ *         0 or 1, ranks that disagree on the partitioner, its tolerance or rebalance, more
+ *         than 2^31 - 1 particles on a rank afterwards), MFREE_ERR_NULL, MFREE_ERR_INPUT (a
+ *         non-finite position), MFREE_ERR_UNSUPPORTED (libmfree_mpi built without Zoltan),
+ *         MFREE_ERR_ALLOC, MFREE_ERR_INTERNAL (an MPI or Zoltan failure); the message
+ *         starts with the failing rank. On failure the previous plan is gone
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_partition(mfree_migration_t *migration, int32_t n_owned,
+                                                       const double *x, int64_t ld, int32_t rebalance,
+                                                       int32_t *n_new);
+
+/**
+ * Decide where each owned particle goes by the host's choice (its own partitioner), and
+ * how many particles this rank owns after mfree_migration_execute. Collective. Moves
+ * nothing.
+ * @param[in]  migration  the plan
+ * @param[in]  n_owned    owned particles on this rank (>= 0)
+ * @param[in]  owners     n_owned ranks of the plan's communicator, in [0, size)
+ *                        (may be NULL when n_owned is 0); read during the call only
+ * @param[out] n_new      the particles this rank owns after the migration (may be NULL)
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG (n_owned < 0, more than
+ *         2^31 - 1 particles on a rank afterwards), MFREE_ERR_NULL, MFREE_ERR_INPUT (an
+ *         owner out of range: the message names the particle), MFREE_ERR_ALLOC,
+ *         MFREE_ERR_INTERNAL; the message starts with the failing rank. On failure the
+ *         previous plan is gone
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_set_owners(mfree_migration_t *migration, int32_t n_owned,
+                                                        const int32_t *owners, int32_t *n_new);
+
+/**
+ * Move the owned particles as planned, with every registered field, in place: afterwards
+ * items [0, n_new) of each field hold this rank's particles, first those it kept (in their
+ * order), then those it received (by sending rank, each in its order); every particle's
+ * bytes are those it left with. Collective. The checks come first and are agreed: when a
+ * rank's capacity is below its n_new, or the ranks registered different fields, every rank
+ * returns the same status with nothing moved, and the plan is kept (grow the arrays,
+ * register them again, call again). Then one MPI_Alltoallv of packed records.
+ * @param[in] migration  a plan from mfree_migration_partition or _set_owners, not yet executed
+ * @param[in] capacity   particles each registered array holds (>= n_new, the size needed,
+ *                       from the plan call or mfree_migration_get_counts)
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_STATE (no plan, or executed
+ *         already), MFREE_ERR_ARG (a capacity below n_new: "capacity C is below the N
+ *         particles this rank owns after the migration"; ranks whose registered fields
+ *         differ in number or item sizes: "ranks disagree on the registered fields"),
+ *         MFREE_ERR_NULL (a field without data and capacity > 0), MFREE_ERR_ALLOC,
+ *         MFREE_ERR_INTERNAL; the message starts with the failing rank
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_execute(mfree_migration_t *migration, int32_t capacity);
+
+/**
+ * The current plan's counts on this rank.
+ * @param[in]  migration  a plan from mfree_migration_partition or _set_owners
+ * @param[out] n_owned    owned particles before the migration (may be NULL)
+ * @param[out] n_new      owned particles after it (may be NULL)
+ * @param[out] n_send     particles this rank sends away (may be NULL)
+ * @param[out] n_recv     particles it receives (may be NULL)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL plan; MFREE_ERR_STATE without a plan
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_get_counts(const mfree_migration_t *migration, int32_t *n_owned,
+                                                        int32_t *n_new, int64_t *n_send, int64_t *n_recv);
+
+/**
+ * The destination rank of each owned particle of the current plan (this rank for those it
+ * keeps), for hosts that move data of their own along.
+ * @param[in]  migration  a plan from mfree_migration_partition or _set_owners
+ * @param[out] owners     n_owned values (may be NULL when n_owned is 0)
+ * @param[in]  capacity   values owners holds (>= n_owned, else MFREE_ERR_ARG with nothing
+ *                        written and the message giving n_owned)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_STATE without a plan; MFREE_ERR_ARG
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_get_owners(const mfree_migration_t *migration, int32_t *owners,
+                                                        int64_t capacity);
+
+/**
+ * The context of a plan, for bindings that check arguments themselves.
+ * @param[in]  migration  the plan
+ * @param[out] ctx        its context, borrowed
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (without a message) for a NULL handle or output
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_get_context(const mfree_migration_t *migration,
+                                                         mfree_context_t **ctx);
+
+/**
+ * Hand a failure found on this rank before a collective call to that call, as
+ * mfree_halo_set_pending_error does for a halo plan: the last failure on the plan's
+ * context becomes this rank's outcome of the next mfree_migration_partition, _set_owners
+ * or _execute, which reads and writes none of its arrays and returns it on every rank.
+ * Not collective.
+ * @param[in] migration  the plan
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle; MFREE_ERR_STATE when the
+ *         context holds no failure
+ */
+MFREE_MPI_API mfree_status_t mfree_migration_set_pending_error(mfree_migration_t *migration);
+
 #ifdef __cplusplus
 }
 #endif
