@@ -406,12 +406,14 @@ mfree_status_t mfree_migration_execute(mfree_migration_t *m, int32_t capacity) {
   // 1. checks and the layout of the registered fields, agreed: their number, the bytes of
   // a record and a signature of the item sizes in order (different layouts would
   // misread each other's records)
+  // (the signature: a 64-bit FNV-1a hash of the sizes, cut to 52 bits, exact in a double)
   int64_t rec = 0;
-  double sig = 0;
-  for (size_t f = 0; f < m->fields.size(); ++f) {
-    rec += m->fields[f].bytes;
-    sig = std::fmod(sig * 1000003.0 + static_cast<double>(m->fields[f].bytes), 9007199254740881.0);
+  uint64_t hash = 14695981039346656037ULL;
+  for (const auto &f : m->fields) {
+    rec += f.bytes;
+    for (int b = 0; b < 64; b += 8) hash = (hash ^ ((static_cast<uint64_t>(f.bytes) >> b) & 0xff)) * 1099511628211ULL;
   }
+  const double sig = static_cast<double>(hash >> 12);
   Local l = first_step(m, [&](Local &r) {
     if (!m->planned)
       return r.fail(MFREE_ERR_STATE, "no plan to execute (call mfree_migration_partition or _set_owners first)");
