@@ -118,3 +118,66 @@ void ex_progress_done(ex_progress_t *p, const char *what, double t) {
   if (p->tty && p->last >= 0) fprintf(stderr, "\n");
   else fprintf(stderr, "%s: integrated to t = %.4g s in %lld steps\n", what, t, (long long)p->base);
 }
+
+/* ---- VTU ---- */
+
+const char *ex_vtu_type_name(ex_vtu_type_t type) {
+  return type == EX_VTU_INT64 ? "Int64" : type == EX_VTU_INT32 ? "Int32" : "Float64";
+}
+
+int ex_vtu_file_components(int ncomp) { return ncomp == 2 ? 3 : ncomp; }
+
+/* Component c of item i of an array, printed; components past ncomp (a 2-vector's third)
+ * are 0. */
+static void vtu_value(FILE *f, const ex_vtu_array_t *a, int64_t i, int c) {
+  if (c >= a->ncomp) {
+    fputs("0", f);
+    return;
+  }
+  const int64_t k = i * a->ld + c;
+  if (a->type == EX_VTU_INT64) fprintf(f, "%lld", (long long)((const int64_t *)a->data)[k]);
+  else if (a->type == EX_VTU_INT32) fprintf(f, "%d", (int)((const int32_t *)a->data)[k]);
+  else fprintf(f, "%.17g", ((const double *)a->data)[k]);
+}
+
+static void vtu_array(FILE *f, const ex_vtu_array_t *a, int64_t n) {
+  const int nc = ex_vtu_file_components(a->ncomp);
+  fprintf(f, "<DataArray type=\"%s\"", ex_vtu_type_name(a->type));
+  if (a->name) fprintf(f, " Name=\"%s\"", a->name);
+  fprintf(f, " NumberOfComponents=\"%d\" format=\"ascii\">\n", nc);
+  for (int64_t i = 0; i < n; ++i)
+    for (int c = 0; c < nc; ++c) {
+      vtu_value(f, a, i, c);
+      fputc(c + 1 < nc ? ' ' : '\n', f);
+    }
+  fputs("</DataArray>\n", f);
+}
+
+int ex_vtu_write(const char *path, int64_t n, int dim, const double *x, int64_t ldx, int narrays,
+                 const ex_vtu_array_t *arrays) {
+  FILE *f = fopen(path, "w");
+  if (!f) return 1;
+  fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+             "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n"
+             "<Piece NumberOfPoints=\"%lld\" NumberOfCells=\"%lld\">\n<Points>\n",
+          (long long)n, (long long)n);
+  const ex_vtu_array_t points = {NULL, EX_VTU_FLOAT64, dim, x, ldx};
+  /* (the points always have three components: those past dim are 0) */
+  fprintf(f, "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+  for (int64_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      vtu_value(f, &points, i, c);
+      fputc(c < 2 ? ' ' : '\n', f);
+    }
+  fputs("</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n", f);
+  for (int64_t i = 0; i < n; ++i) fprintf(f, "%lld\n", (long long)i);
+  fputs("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n", f);
+  for (int64_t i = 0; i < n; ++i) fprintf(f, "%lld\n", (long long)i + 1);
+  fputs("</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n", f);
+  for (int64_t i = 0; i < n; ++i) fputs("1\n", f);
+  fputs("</DataArray>\n</Cells>\n<PointData>\n", f);
+  for (int a = 0; a < narrays; ++a) vtu_array(f, &arrays[a], n);
+  fputs("</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n", f);
+  const int bad = ferror(f);
+  return (fclose(f) != 0) || bad;
+}

@@ -56,4 +56,31 @@ void ex_progress_steps(ex_progress_t *p, int64_t steps);
 /* End of the run: ends the bar's line on a terminal, else prints one summary line. */
 void ex_progress_done(ex_progress_t *p, const char *what, double t);
 
+/* ---- VTU files for ParaView (a VTK XML unstructured grid of vertices) ---- */
+
+/* Element types of a point-data array. */
+typedef enum { EX_VTU_FLOAT64 = 0, EX_VTU_INT64 = 1, EX_VTU_INT32 = 2 } ex_vtu_type_t;
+
+/* A point-data array: item i, component c at ((const T *)data)[i * ld + c], T the C type
+ * of type (double, int64_t, int32_t). ncomp 1 to 3; 2 is written as a 3-vector with a zero
+ * third component (ParaView's vectors have three). */
+typedef struct {
+  const char *name;
+  ex_vtu_type_t type;
+  int ncomp;
+  const void *data;
+  int64_t ld;
+} ex_vtu_array_t;
+
+/* One VTU piece: n points x (dim 1 to 3 components, leading dimension ldx; missing
+ * components written as 0), one vertex cell each, and the narrays point-data arrays.
+ * ASCII; doubles with 17 significant digits, so that they read back bit for bit. Returns 0,
+ * or 1 when the file could not be written. */
+int ex_vtu_write(const char *path, int64_t n, int dim, const double *x, int64_t ldx, int narrays,
+                 const ex_vtu_array_t *arrays);
+/* The VTK type name of an array type ("Float64", "Int64", "Int32"). */
+const char *ex_vtu_type_name(ex_vtu_type_t type);
+/* Components an array has in the file (ncomp 2 is written as 3). */
+int ex_vtu_file_components(int ncomp);
+
 #endif
