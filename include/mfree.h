@@ -1825,6 +1825,29 @@ MFREE_API mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const do
                                                    double *vhat);
 
 /**
+ * Force the walls exert on the fluid at state y (the force on the walls is its opposite).
+ * total: the fluid's net force sum_i m_i a_i less its weight (m_i the masses the
+ * accelerations use: the lumped masses, or the particle masses with physical lumping;
+ * internal forces cancel), i.e. the wall particles' force ([CuetoFelgueroso2004] eqs
+ * 122-124) and, with dummy particles, their traction and no-slip smoothing; with
+ * consistent integration it includes that integration's momentum error. A leap-frog step
+ * of length dt from y changes sum_i m_i v_i by dt (M g + total). per_wall: each wall
+ * particle's share of the eqs 122-124 force, in the order of mfree_system_set_walls (its
+ * sum is total when there are no dummy particles and no consistent integration).
+ * @param[in]  sys       a fluid system
+ * @param[in]  y         state
+ * @param[out] total     dim values, or NULL
+ * @param[in]  nwall     number of wall particles per_wall holds: the system's wall count
+ *                       (else MFREE_ERR_ARG; ignored when per_wall is NULL)
+ * @param[out] per_wall  dim values per wall particle (AoS), or NULL (not both NULL)
+ * @return MFREE_SUCCESS, or a failure named with the parameters; a positive status
+ *         naming the particle for a non-finite or out-of-range state
+ */
+MFREE_API mfree_status_t mfree_system_get_wall_force(mfree_system_t *sys, const double *y,
+                                                     double *total, int32_t nwall,
+                                                     double *per_wall);
+
+/**
  * Integrate y from *t to t_end with a native scheme and the CFL step
  * dt = cfl h / max_i (c_i + |v_i|) ([CuetoFelgueroso2004] eqs 120-121) capped by dt_max
  * (docs/time-integration.md). A non-finite state, a particle outside the box or a step

@@ -1380,6 +1380,16 @@ module mfree
       real(c_double), intent(out) :: vhat(*)
     end function mfree_system_get_velocity_c
 
+    integer(c_int) function mfree_system_get_wall_force_c(sys, y, total, nwall, per_wall) &
+        bind(C, name="mfree_system_get_wall_force")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: y(*)
+      type(c_ptr), value :: total
+      integer(c_int32_t), value :: nwall
+      type(c_ptr), value :: per_wall
+    end function mfree_system_get_wall_force_c
+
     integer(c_int) function mfree_system_integrate_c(sys, scheme, y, t, t_end, cfl, dt_max, &
                                                      progress, user, nsteps) &
         bind(C, name="mfree_system_integrate")
@@ -1513,6 +1523,7 @@ module mfree
   public :: mfree_system_rhs_c, mfree_system_assemble_mass_c
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
+  public :: mfree_system_get_wall_force_c
   public :: mfree_system_create_elastodynamic_c, mfree_system_set_load_history_c
   public :: mfree_system_create_elastodynamic_galerkin_c
   public :: mfree_system_set_shepard_condition_c
@@ -1629,6 +1640,7 @@ module mfree
   public :: mfree_system_get_size, mfree_system_rhs, mfree_system_assemble_mass
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
+  public :: mfree_system_get_wall_force
   public :: mfree_system_create_elastodynamic, mfree_system_set_load_history
   public :: mfree_system_create_elastodynamic_galerkin
   public :: mfree_system_set_shepard_condition
@@ -3760,6 +3772,39 @@ contains
     if (size(vhat) > 0) call c_f_pointer(c_loc(vhat), pv, [size(vhat)])
     st = mfree_system_get_velocity_c(sys%ptr, y, pv)
   end function mfree_system_get_velocity
+
+  !> The walls' force on the fluid at state y: total (dim values, contiguous) and, when
+  !> present, per_wall(dim, nwall) for the system's nwall wall particles (contiguous;
+  !> its size a multiple of dim; else MFREE_ERR_ARG; an empty one is ignored).
+  integer(c_int) function mfree_system_get_wall_force(sys, y, total, per_wall) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: y(*)
+    real(c_double), intent(out), target :: total(:)
+    real(c_double), intent(out), target, optional :: per_wall(..)
+    integer(c_int32_t), target :: dim, n
+    integer(c_int32_t) :: nwall
+    type(c_ptr) :: ctx, pw
+    st = mfree_system_get_dimension_c(sys%ptr, c_loc(dim), c_loc(n))
+    if (st /= MFREE_SUCCESS) return
+    ctx = c_null_ptr
+    st = mfree_system_get_context_c(sys%ptr, ctx)
+    st = check_out(ctx, 'mfree_system_get_wall_force', 'total', is_contiguous(total), &
+                   size(total, kind=c_int64_t), int(dim, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
+    pw = c_null_ptr
+    nwall = 0
+    if (present(per_wall)) then
+      if (.not. is_contiguous(per_wall) .or. mod(size(per_wall), dim) /= 0) then
+        st = wrapper_error(ctx, MFREE_ERR_ARG, 'mfree_system_get_wall_force: per_wall is not ' // &
+                           'contiguous or its size ' // int_str(size(per_wall, kind=c_int64_t)) // &
+                           ' is not a multiple of dim')
+        return
+      end if
+      nwall = int(size(per_wall) / dim, c_int32_t)
+      if (size(per_wall) > 0) pw = c_loc(per_wall)
+    end if
+    st = mfree_system_get_wall_force_c(sys%ptr, y, c_loc(total), nwall, pw)
+  end function mfree_system_get_wall_force
 
   !> Integrate y (neq values, contiguous: else MFREE_ERR_ARG) from t to t_end (both updated
   !> in place); progress (optional) is called after every accepted step; nsteps

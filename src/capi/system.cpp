@@ -191,6 +191,16 @@ mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, d
   });
 }
 
+mfree_status_t mfree_system_get_wall_force(mfree_system_t *sys, const double *y, double *total, int32_t nwall,
+                                          double *per_wall) {
+  return mfree::with_handle(sys, "mfree_system_get_wall_force", [&](mfree::System &base) {
+    auto &f = kind<mfree::FluidSystem>(base, "wall force (not a fluid)");
+    MFREE_REQUIRE(total || per_wall, MFREE_ERR_NULL, "total and per_wall are both NULL");
+    MFREE_REQUIRE(y || f.size() == 0, MFREE_ERR_NULL, "y is NULL");
+    return mfree::finish(sys->ctx, "mfree_system_get_wall_force", f.wall_force(y, total, nwall, per_wall));
+  });
+}
+
 mfree_status_t mfree_system_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t,
                                       double t_end, double cfl, double dt_max, mfree_progress_fn progress,
                                       void *user, int64_t *nsteps) {

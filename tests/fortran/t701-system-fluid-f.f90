@@ -2,7 +2,8 @@
 !> driven from Fortran. On a free jittered patch with random velocities and densities the
 !> lumped-mass weighted accelerations sum to zero (linear momentum, 003 D3) to round-off;
 !> a native integration with a progress callback written in Fortran stops when the
-!> callback asks it to, and reports the steps taken.
+!> callback asks it to, and reports the steps taken. Without walls or gravity the walls' force
+!> (mfree_system_get_wall_force) vanishes.
 module t701_progress
   use, intrinsic :: iso_c_binding, only: c_ptr, c_int32_t, c_int64_t, c_double, c_f_pointer
   implicit none
@@ -39,6 +40,7 @@ program t701_system_fluid_f
   type(mfree_system) :: sys
   type(mfree_matrix) :: mm
   real(c_double) :: y(5 * n), yd(5 * n), m(n), kappa, mom(2), scale, fx, fz, t, hcol
+  real(c_double) :: ftot(2), pbad(3)
   integer(c_int64_t), pointer :: rowptr(:)
   integer(c_int32_t), pointer :: cols(:)
   real(c_double), pointer :: vals(:)
@@ -86,6 +88,13 @@ program t701_system_fluid_f
   end do
   call check(all(abs(mom) <= 1e-12_c_double * scale), &
              'lumped-mass accelerations conserve linear momentum (003 D3)')
+
+  ! no walls and no gravity: the walls' force (the lumped-mass weighted accelerations' sum)
+  ! vanishes to round-off; per_wall must hold dim values per wall particle
+  call check_ok(ctx, mfree_system_get_wall_force(sys, y, ftot), 'wall force')
+  call check(all(abs(ftot) <= 1e-12_c_double * scale), 'no walls: no wall force')
+  call check(mfree_system_get_wall_force(sys, y, ftot, pbad) == MFREE_ERR_ARG, &
+             'wall force: per_wall of 3 values in 2D is refused')
 
   calls = 0
   t = 0

@@ -1113,6 +1113,13 @@ static void rows_system(void) {
   ROW0(MFREE_ERR_NULL, mfree_system_get_velocity(NULL, F.y, p));
   ROW(MFREE_ERR_NULL, mfree_system_get_velocity(F.sys, NULL, p));
   ROW(MFREE_ERR_NULL, mfree_system_get_velocity(F.sys, F.y, NULL));
+  /* the fixture's fluid has no wall particles: per_wall must say 0 */
+  ROW0(MFREE_ERR_NULL, mfree_system_get_wall_force(NULL, F.y, p, 0, NULL));
+  ROW(MFREE_ERR_NULL, mfree_system_get_wall_force(F.sys, NULL, p, 0, NULL));
+  ROW(MFREE_ERR_NULL, mfree_system_get_wall_force(F.sys, F.y, NULL, 0, NULL));
+  ROW(MFREE_ERR_ARG, mfree_system_get_wall_force(F.sys, F.y, p, 2, sig));
+  ROW(MFREE_ERR_ARG, mfree_system_get_wall_force(F.sys, F.y, NULL, -1, sig));
+  ROW(MFREE_FAIL_NONFINITE, mfree_system_get_wall_force(F.sys, yb, p, 0, NULL));
   ROW0(MFREE_ERR_NULL, mfree_system_integrate(NULL, MFREE_INTEGRATOR_LEAPFROG, yb, &t, 1e-3, 0.2, 0, NULL, NULL, &steps));
   ROW(MFREE_ERR_ARG, mfree_system_integrate(F.sys, (mfree_integrator_t)0, yb, &t, 1e-3, 0.2, 0, NULL, NULL, &steps));
   ROW(MFREE_ERR_NULL, mfree_system_integrate(F.sys, MFREE_INTEGRATOR_LEAPFROG, NULL, &t, 1e-3, 0.2, 0, NULL, NULL, &steps));

@@ -48,6 +48,10 @@ class FluidSystem : public System {
   Report interpolation(const double *y, SparseMatrix &S);
   void pressure(const double *y, double *p) const;
   Report velocity(const double *y, double *vhat);
+  // The walls' force on the fluid at state y (fluid_wall.cpp): total (dim values, or
+  // NULL) and each wall particle's share of the eqs 122-124 force (per_wall: dim values
+  // for each of the nwall wall particles, or NULL).
+  Report wall_force(const double *y, double *total, int32_t nwall, double *per_wall);
   Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                    mfree_progress_fn progress, void *user, int64_t &nsteps) override;
 

@@ -351,3 +351,73 @@ void FluidSystem::velocity_smoothing(const double *v, const double *lumped, int 
 }
 
 }  // namespace mfree
+
+namespace mfree {
+
+// The walls' force on the fluid at state y, from the accelerations accel computes. The
+// shape functions are a partition of unity, so the fluid's internal forces cancel in
+// sum_i m_i a_i (m_i the masses accel divides by: the lumped masses of eq 56, or the
+// particle masses with physical lumping), and sum_i m_i a_i - M g, M the fluid's mass,
+// is what acts on the fluid from outside: the wall particles' force of eqs 122-124 and,
+// with dummy particles, their share of the Galerkin force (the wall traction) and of the
+// velocity smoothing (no-slip). With consistent integration, whose correction does not
+// conserve momentum, it also holds that correction's sum. Per wall particle w: its force
+// on point k, f1 f2 n_w (eqs 122-124), acts as an acceleration on the nodes i of row k
+// through N_i(x_k), hence on the fluid as (sum_i m_i N_i(x_k)) f1 f2 n_w; the same
+// test of approach as accel, with the interpolated velocity summed here.
+Report FluidSystem::wall_force(const double *y, double *total, int32_t nwall, double *per_wall) {
+  const int32_t nw = walls_ ? walls_->size() : 0;
+  if (per_wall && nwall != nw)
+    throw Error(MFREE_ERR_ARG, "per_wall holds " + std::to_string(nwall) + " wall particles, the system has " +
+                                   std::to_string(nw));
+  check_ready();
+  Report rep = prepare(y);
+  if (!rep.ok()) return rep;
+  const int dim = dim_;
+  const size_t nd = static_cast<size_t>(dim) * n_;
+  const double *v = y + nd, *rho = y + 2 * nd;
+  std::vector<double> a(nd), m(n_);
+  rep = accel(v, rho, a.data());
+  if (!rep.ok()) return rep;
+  const int A = 2 * dim + 2;  // acc_ per node: force, mass sum, lumped mass, wall force
+  const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
+  for (int32_t i = 0; i < n_; ++i) m[i] = galerkin ? acc_[static_cast<size_t>(i) * A + dim + 1] : mass_[i];
+  if (total) {
+    double f[3] = {0, 0, 0}, M = 0.0;
+    for (int32_t i = 0; i < n_; ++i) {
+      for (int c = 0; c < dim; ++c) f[c] += m[i] * a[static_cast<size_t>(i) * dim + c];
+      M += mass_[i];
+    }
+    for (int c = 0; c < dim; ++c) total[c] = f[c] - M * g_[c];
+  }
+  if (per_wall) {
+    std::fill(per_wall, per_wall + static_cast<size_t>(nw) * dim, 0.0);
+    const double *vn = node_velocities(v);
+    for (int32_t k = 0; k < n_ && nw > 0; ++k) {
+      if (wall_nbr_.rowptr[k] == wall_nbr_.rowptr[k + 1]) continue;
+      double vh[3] = {0, 0, 0}, mk = 0.0;
+      for (int64_t q = rb(k); q < re(k); ++q) {
+        const int32_t i = cols_[q];
+        for (int c = 0; c < dim; ++c) vh[c] += N_[q] * vn[static_cast<size_t>(i) * dim + c];
+        if (i < n_) mk += N_[q] * m[i];
+      }
+      for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
+        const int32_t w = wall_nbr_.cols[q];
+        const double *nrm = &wall_n_[static_cast<size_t>(w) * dim];
+        double r2 = 0.0, approach = 0.0;
+        for (int c = 0; c < dim; ++c) {
+          const double d = xbound_[static_cast<size_t>(k) * dim + c] - walls_->x(w, c);
+          r2 += d * d;
+          approach += vh[c] * nrm[c];
+        }
+        const double r = std::sqrt(r2);
+        if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // as in accel
+        const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
+        for (int c = 0; c < dim; ++c) per_wall[static_cast<size_t>(w) * dim + c] += mk * f2 * nrm[c];
+      }
+    }
+  }
+  return rep;
+}
+
+}  // namespace mfree
