@@ -16,8 +16,9 @@
 #endif
 
 /* The triad's arrays on transparent huge pages where the kernel offers them (madvise), like
- * mfree's own tables without an allocator hook (src/core/base/alloc.hpp), so that the ratio is
- * not skewed by the triad's TLB misses; MFREE_HUGEPAGES=0 turns both off. */
+ * mfree's own tables with the page hints this program asks for (bench_page_hints,
+ * src/core/base/alloc.hpp), so that the ratio is not skewed by the triad's TLB misses; the
+ * library's debugging override MFREE_HUGEPAGES=0 turns both off. */
 static double *triad_array(size_t len) {
   void *p = NULL;
   if (posix_memalign(&p, (size_t)2 << 20, len * sizeof(double)) != 0) return NULL;

@@ -35,6 +35,7 @@ static loop_t run_loop(int dim, int n, const double *x0, const double *vel, int 
                        int threads) {
   mfree_context_t *ctx = NULL;
   CHECK(mfree_context_create(&ctx));
+  bench_page_hints(ctx);
   CHECK(mfree_context_set_num_threads(ctx, threads));
   double *x = malloc(sizeof(double) * (size_t)dim * (size_t)n);
   for (size_t k = 0; k < (size_t)dim * (size_t)n; ++k) x[k] = x0[k];
