@@ -430,7 +430,12 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
         for (int64_t i = b; i < e; ++i) yn[2 * nd + i] = rho[i] + dt * dr[i];
       });
     } else {
-      // 003 eqs 111-119; f(t, y) on the tables prepared above
+      // 003 eqs 111-119; f(t, y) on the tables prepared above. The wall force's switch
+      // f1 (eq 123) is decided once per step, with the starting v_hat^k, as leap-frog
+      // decides it once with v^{k-1/2}: decided again at the predicted state, the half
+      // kick of the predictor makes an approaching particle recede there, the corrector
+      // stage (the only force of the final update) has no wall force, and a particle
+      // resting on the wall sinks through it (003's dam break: the bottom row, T = 0.36).
       Report r = accel(v, rho, rate + nd);
       if (!r.ok()) return step_failed(r, nsteps + 1, "");
       kinematics(v, rho, rate, rate + 2 * nd);
@@ -438,7 +443,15 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
       for (size_t q = 0; q < ny; ++q) yp[q] = y[q] + 0.5 * dt * rate[q];
       r = prepare(yp);
       if (!r.ok()) return step_failed(r, nsteps + 1, " (predictor)");  // the step being taken, as below
-      r = accel(yp + nd, yp + 2 * nd, rate);
+      vh_start_.assign(rate, rate + nd);  // v_hat^k, before accel overwrites rate
+      {
+        struct Reset {  // also when accel throws
+          const double *&p;
+          ~Reset() { p = nullptr; }
+        } reset{wall_switch_v_};
+        wall_switch_v_ = vh_start_.data();
+        r = accel(yp + nd, yp + 2 * nd, rate);
+      }
       if (!r.ok()) return step_failed(r, nsteps + 1, " (predictor)");
       for (size_t q = 0; q < nd; ++q) yn[nd + q] = v[q] + 0.5 * dt * rate[q];  // v^C
       kinematics(yn + nd, yp + 2 * nd, vh, dr);

@@ -200,7 +200,11 @@ class FluidSystem : public System {
   std::vector<int32_t> site_status_, site_support_, site_order_;
   Csr wall_nbr_;
   // per node (reused): packed quadrature-point data of accel; integrate's states and rates
-  std::vector<double> pack_, work_state_, stage_, rate_, vh_, dr_;
+  std::vector<double> pack_, work_state_, stage_, rate_, vh_, dr_, vh_start_;
+  // Velocities (dim per fluid particle) that decide the wall force's switch f1 (003 eq
+  // 123) in accel instead of v_hat at the point, or nullptr: the predictor-corrector's
+  // corrector stage decides it with the step's starting v_hat (fluid.cpp, integrate).
+  const double *wall_switch_v_ = nullptr;
   // accel scatters row k's contributions to the nodes of the row; rows go in chunks of
   // kChunk, chunk_order_[color_ptr_[c] .. color_ptr_[c + 1]) are the chunks of colour c,
   // which no two of touch a common node. Colours run one after another, so every node

@@ -123,7 +123,9 @@ MFREE_ALWAYS_INLINE void FluidSystem::point_terms(int64_t k, const AccelArgs &ar
   for (int c = 0; c < D; ++c) F[c] = 0.0;
   bool wall = false;
   if (walls_ && k < n_) {
-    // wall force (003 eqs 122-124) on approaching particles, spread through N_i(x_k)
+    // wall force (003 eqs 122-124) on approaching particles, spread through N_i(x_k);
+    // "approaching" by wall_switch_v_ when integrate sets it (see fluid.hpp)
+    const double *sv = wall_switch_v_ ? wall_switch_v_ + k * D : vh;
     for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
       const int32_t w = wall_nbr_.cols[q];
       const double *nw = &wall_n_[static_cast<size_t>(w) * D];
@@ -131,7 +133,7 @@ MFREE_ALWAYS_INLINE void FluidSystem::point_terms(int64_t k, const AccelArgs &ar
       for (int c = 0; c < D; ++c) {
         const double d = xbound_[k * D + c] - walls_->x(w, c);
         r2 += d * d;
-        approach += vh[c] * nw[c];
+        approach += sv[c] * nw[c];
       }
       const double r = std::sqrt(r2);
       if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // f1 = 0: moving away
