@@ -58,31 +58,15 @@ static void dam_create(dam_t *s, int nx, double max_cond) {
       s->m[q] = s->y[4 * (size_t)n + q] * d * d;
     }
   /* walls as in the example: floor and both ends, spacing d/3, set back by d/2 */
-  const double off = s->off, ws = d / 3.0, top = 1.5 * H;
-  const int nb = (int)ceil((L + 2 * off) / ws) + 1, ns = (int)ceil((top + off) / ws), nw = nb + 2 * ns;
-  double *wx = malloc(2 * (size_t)nw * sizeof *wx), *wn = malloc(2 * (size_t)nw * sizeof *wn);
-  assert_non_null(wx);
-  assert_non_null(wn);
-  int k = 0;
-  for (int q = 0; q < nb; ++q, ++k) {
-    wx[2 * k] = -off + q * (L + 2 * off) / (nb - 1), wx[2 * k + 1] = -off;
-    wn[2 * k] = 0.0, wn[2 * k + 1] = 1.0;
-  }
-  for (int q = 1; q <= ns; ++q)
-    for (int side = 0; side < 2; ++side, ++k) {
-      wx[2 * k] = side ? L + off : -off, wx[2 * k + 1] = -off + q * (top + off) / ns;
-      wn[2 * k] = side ? -1.0 : 1.0, wn[2 * k + 1] = 0.0;
-    }
+  double *wx = NULL, *wn = NULL;
+  const int nw = mfree_test_tank_walls(L, d, s->off, 1.5 * H, &wx, &wn);
   assert_ok(NULL, mfree_context_create(&s->ctx));
   mfree_context_t *ctx = s->ctx;
-  assert_ok(ctx, mfree_system_create_fluid(ctx, 2, n, &s->sys));
-  assert_ok(ctx, mfree_system_set_fluid(s->sys, &RHO0, 0, kappa, GAMMA, 0.5));
-  assert_ok(ctx, mfree_system_set_masses(s->sys, s->m, 1));
-  assert_ok(ctx, mfree_system_set_smoothing(s->sys, h));
+  s->sys = mfree_test_fluid_create(ctx, n, s->m, RHO0, kappa, GAMMA, 0.5, h);
   const double g[2] = {0.0, -G};
   assert_ok(ctx, mfree_system_set_gravity(s->sys, g));
   assert_ok(ctx, mfree_system_set_walls(s->sys, nw, wx, wn, 0.7 * h, 10.0));
-  const double lo[2] = {-off, -off}, hi[2] = {L + off, 10.0 * H};
+  const double lo[2] = {-s->off, -s->off}, hi[2] = {L + s->off, 10.0 * H};
   assert_ok(ctx, mfree_system_set_box(s->sys, lo, hi)); /* crossing a wall fails the run */
   if (max_cond > 0) assert_ok(ctx, mfree_system_set_shepard_condition(s->sys, max_cond));
   free(wx);

@@ -45,28 +45,13 @@ static void test_dam_break_10000_steps(void **state) {
   double m0[N];
   memcpy(m0, m, sizeof m);
   /* walls as in the example: floor and both ends, spacing d/3, set back by d/2 */
-  const double off = 0.5 * d, ws = d / 3.0, top = 1.5 * H;
-  const int nb = (int)ceil((L + 2 * off) / ws) + 1, ns = (int)ceil((top + off) / ws);
-  const int nw = nb + 2 * ns;
-  double *wx = malloc(2 * (size_t)nw * sizeof *wx), *wn = malloc(2 * (size_t)nw * sizeof *wn);
-  int k = 0;
-  for (int q = 0; q < nb; ++q, ++k) {
-    wx[2 * k] = -off + q * (L + 2 * off) / (nb - 1), wx[2 * k + 1] = -off;
-    wn[2 * k] = 0.0, wn[2 * k + 1] = 1.0;
-  }
-  for (int q = 1; q <= ns; ++q)
-    for (int side = 0; side < 2; ++side, ++k) {
-      wx[2 * k] = side ? L + off : -off, wx[2 * k + 1] = -off + q * (top + off) / ns;
-      wn[2 * k] = side ? -1.0 : 1.0, wn[2 * k + 1] = 0.0;
-    }
+  const double off = 0.5 * d;
+  double *wx = NULL, *wn = NULL;
+  const int nw = mfree_test_tank_walls(L, d, off, 1.5 * H, &wx, &wn);
 
   mfree_context_t *ctx = NULL;
-  mfree_system_t *sys = NULL;
   assert_ok(NULL, mfree_context_create(&ctx));
-  assert_ok(ctx, mfree_system_create_fluid(ctx, 2, N, &sys));
-  assert_ok(ctx, mfree_system_set_fluid(sys, &RHO0, 0, kappa, GAMMA, 0.5));
-  assert_ok(ctx, mfree_system_set_masses(sys, m, 1));
-  assert_ok(ctx, mfree_system_set_smoothing(sys, h));
+  mfree_system_t *sys = mfree_test_fluid_create(ctx, N, m, RHO0, kappa, GAMMA, 0.5, h);
   const double g[2] = {0.0, -G};
   assert_ok(ctx, mfree_system_set_gravity(sys, g));
   assert_ok(ctx, mfree_system_set_walls(sys, nw, wx, wn, 0.7 * h, 10.0));

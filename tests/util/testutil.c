@@ -63,6 +63,37 @@ double mfree_test_lumped_mass_rel_diff(mfree_context_t *ctx, mfree_system_t *sys
   return fabs(lumped - total) / total;
 }
 
+int mfree_test_tank_walls(double L, double d, double off, double top, double **x, double **normals) {
+  const double ws = d / 3.0;
+  const int nb = (int)ceil((L + 2 * off) / ws) + 1, ns = (int)ceil((top + off) / ws), nw = nb + 2 * ns;
+  double *wx = malloc(2 * (size_t)nw * sizeof *wx), *wn = malloc(2 * (size_t)nw * sizeof *wn);
+  assert_non_null(wx);
+  assert_non_null(wn);
+  int k = 0;
+  for (int q = 0; q < nb; ++q, ++k) {
+    wx[2 * k] = -off + q * (L + 2 * off) / (nb - 1), wx[2 * k + 1] = -off;
+    wn[2 * k] = 0.0, wn[2 * k + 1] = 1.0;
+  }
+  for (int q = 1; q <= ns; ++q)
+    for (int side = 0; side < 2; ++side, ++k) {
+      wx[2 * k] = side ? L + off : -off, wx[2 * k + 1] = -off + q * (top + off) / ns;
+      wn[2 * k] = side ? -1.0 : 1.0, wn[2 * k + 1] = 0.0;
+    }
+  *x = wx;
+  *normals = wn;
+  return nw;
+}
+
+mfree_system_t *mfree_test_fluid_create(mfree_context_t *ctx, int n, const double *m, double rho0, double kappa,
+                                        double gamma, double mu, double h) {
+  mfree_system_t *sys = NULL;
+  assert_ok(ctx, mfree_system_create_fluid(ctx, 2, n, &sys));
+  assert_ok(ctx, mfree_system_set_fluid(sys, &rho0, 0, kappa, gamma, mu));
+  assert_ok(ctx, mfree_system_set_masses(sys, m, 1));
+  assert_ok(ctx, mfree_system_set_smoothing(sys, h));
+  return sys;
+}
+
 int32_t mfree_test_backend(int argc, char **argv) {
   return argc > 1 && strcmp(argv[1], "ref") == 0 ? MFREE_BACKEND_REF : MFREE_BACKEND_OPT;
 }

@@ -50,6 +50,17 @@ void mfree_test_lumped_masses(mfree_context_t *ctx, mfree_system_t *sys, const d
 double mfree_test_lumped_mass_rel_diff(mfree_context_t *ctx, mfree_system_t *sys, const double *y,
                                        const double *m, int n);
 
+/* The wall particles of examples/dam_break's tank (003 Sect. 6.2): a floor and two end walls
+ * at spacing d / 3, set back by off from the fluid's edges x = 0, x = L and z = 0, up to
+ * z = top, unit normals into the fluid. Returns the count; *x and *normals (2 values per
+ * particle) are the caller's to free. */
+int mfree_test_tank_walls(double L, double d, double off, double top, double **x, double **normals);
+
+/* A 2D fluid system of n particles with masses m: one fluid of rest density rho0, Tait kappa
+ * and gamma, viscosity mu, smoothing length h (no gravity, no walls). */
+mfree_system_t *mfree_test_fluid_create(mfree_context_t *ctx, int n, const double *m, double rho0, double kappa,
+                                        double gamma, double mu, double h);
+
 /* The backend a conformance test runs on: MFREE_BACKEND_REF when its first argument is
  * "ref" (CTest registers those tests once more as <name>-ref), else MFREE_BACKEND_OPT. */
 int32_t mfree_test_backend(int argc, char **argv);
