@@ -6,6 +6,7 @@
  *  - every particle sent to the last rank (the others lose all theirs), then the halo
  *    rebuilt and a field exchanged with ranks that own nothing, then a repartition from
  *    the one rank that holds all, balanced again;
+ *  - a partition and an execute with no particles on any rank;
  * and after every move each particle's fields are bitwise those of its id and every id is
  * owned exactly once. */
 #include <math.h>
@@ -103,6 +104,21 @@ int main(int argc, char **argv) {
   window(ctx, m, &s, &c, t, 0, "kept regions from one rank");
   window(ctx, m, &s, &c, t, 1, "rebalance from one rank");
   check_balance(&s, "rebalance from one rank");
+#endif
+
+#ifdef MFREE_TEST_ZOLTAN
+  /* 4. no particles anywhere: a partition that has nothing to do */
+  {
+    mfree_migration_t *empty = NULL;
+    expect_ok(ctx, mfree_migration_create(ctx, MPI_COMM_WORLD, 2, &empty), "create (empty)");
+    for (int rebalance = 1; rebalance >= 0; --rebalance) {
+      n_new = -1;
+      expect_ok(ctx, mfree_migration_partition(empty, 0, NULL, 2, rebalance, &n_new), "partition of nothing");
+      expect_ok(ctx, mfree_migration_execute(empty, 0), "execute of nothing");
+      CHECK(n_new == 0, "n_new %d of nothing", n_new);
+    }
+    mfree_migration_destroy(&empty);
+  }
 #endif
 
   mfree_migration_destroy(&m);

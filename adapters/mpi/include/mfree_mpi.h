@@ -330,7 +330,8 @@ MFREE_MPI_API mfree_status_t mfree_migration_clear_fields(mfree_migration_t *mig
  * @param[in]  n_owned    owned particles on this rank (>= 0)
  * @param[in]  x          positions, AoS: particle i, component c at x[i*ld + c], finite
  * @param[in]  ld         leading dimension (>= dim)
- * @param[in]  rebalance  1: new regions; 0: the last regions (1 when there are none)
+ * @param[in]  rebalance  1: new regions; 0: the last regions (taken as 1 when there are
+ *                        none: the first call, or the partitioner changed since)
  * @param[out] n_new      the particles this rank owns after the migration (may be NULL)
  * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG (a bad argument, rebalance not
  *         0 or 1, ranks that disagree on the partitioner, its tolerance or rebalance, more
