@@ -112,7 +112,7 @@ static void test_compact_support(void **s) {
     }
 }
 
-/* Paper 001 claim (spec 12.B.16): every kernel but the super Gauss is >= 0 on its
+/* Paper 001 Sect. 6.2: every kernel but the super Gauss is >= 0 on its
  * support; the super Gauss (6.9) is negative for q^2 > 5/2. */
 static void test_sign(void **s) {
   (void)s;
@@ -171,9 +171,10 @@ static void check_rel(const char *what, double got, double want, double rtol) {
     fail_msg("%s: %.9g, expected %.9g (rtol %g)", what, got, want, rtol);
 }
 
-/* Normalisation constants: paper 000 eq 26 (cubic, 1D 2/3; 2D/3D constants from spec
- * 000 section 3.1), paper 001 Sect. 6 and spec 001 section 6 (linear, quadratic,
- * quartic, revised Gauss, revised super Gauss), and the standard literature values for
+/* Normalisation constants: paper 000 eq 26 (cubic, 1D 2/3; the usual 2D/3D constants,
+ * docs/papers.md, paper 000, errata 1), paper 001 Sect. 6 (linear, quadratic, quartic,
+ * revised Gauss, revised super Gauss; the constants the paper does not give are
+ * integrals of the kernels, docs/papers.md, paper 001, derived results 3), and the standard literature values for
  * the Wendland and Morris spline kernels. The Gauss family of 001 writes
  * W = G/(h sqrt(pi))^dim f, so G = C pi^(dim/2). */
 static void test_published_constants(void **s) {
@@ -195,7 +196,7 @@ static void test_published_constants(void **s) {
   assert_true(fabs(C(MFREE_KERNEL_REVISED_GAUSS, 1, 0) * sqrt(pi) - 1.04823) < 5e-6);
   assert_true(fabs(C(MFREE_KERNEL_REVISED_GAUSS, 2, 0) * pi - 1.10081) < 5e-6);
   assert_true(fabs(C(MFREE_KERNEL_REVISED_GAUSS, 3, 0) * pow(pi, 1.5) - 1.18516) < 6e-6);
-  /* closed forms (spec 001 section 6): 1D 1/(erf 2 - 4e^-4/sqrt(pi)), 2D 1/(1 - 5e^-4) */
+  /* closed forms (docs/papers.md, paper 001, derived results 3): 1D 1/(erf 2 - 4e^-4/sqrt(pi)), 2D 1/(1 - 5e^-4) */
   check_rel("revised Gauss 1D closed form", C(MFREE_KERNEL_REVISED_GAUSS, 1, 0) * sqrt(pi),
             1.0 / (erf(2.0) - 4.0 * exp(-4.0) / sqrt(pi)), 1e-12);
   check_rel("revised Gauss 2D closed form", C(MFREE_KERNEL_REVISED_GAUSS, 2, 0) * pi,
@@ -206,11 +207,11 @@ static void test_published_constants(void **s) {
   assert_true(fabs(C(MFREE_KERNEL_REVISED_SUPER_GAUSS, 1, 0) * sqrt(pi) - 0.285364) < 1e-6);
   assert_true(fabs(C(MFREE_KERNEL_REVISED_SUPER_GAUSS, 2, 0) * pi - 0.331311) < 1e-6);
   assert_true(fabs(C(MFREE_KERNEL_REVISED_SUPER_GAUSS, 3, 0) * pow(pi, 1.5) - 0.392110) < 1e-6);
-  /* a = 1.6, the paper's recommendation (spec 001 section 6 table) */
+  /* a = 1.6, the paper's recommendation (integrals of eq 6.17) */
   assert_true(fabs(C(MFREE_KERNEL_REVISED_SUPER_GAUSS, 1, 1.6) * sqrt(pi) - 0.343008) < 1e-6);
   assert_true(fabs(C(MFREE_KERNEL_REVISED_SUPER_GAUSS, 2, 1.6) * pi - 0.473928) < 1e-6);
   assert_true(fabs(C(MFREE_KERNEL_REVISED_SUPER_GAUSS, 3, 1.6) * pow(pi, 1.5) - 0.660122) < 1e-6);
-  /* 001 eq 6.9 untruncated: G = 1/2, 2/3, 1 (spec); mfree truncates at 3h and
+  /* 001 eq 6.9 untruncated: G = 1/2, 2/3, 1 (integrals); mfree truncates at 3h and
    * renormalises, which moves G by < 0.4 % (the 3D tail is the largest). */
   check_rel("super Gauss 1D", C(MFREE_KERNEL_SUPER_GAUSS, 1, 0) * sqrt(pi), 0.5, 1e-3);
   check_rel("super Gauss 2D", C(MFREE_KERNEL_SUPER_GAUSS, 2, 0) * pi, 2.0 / 3.0, 1e-3);
@@ -242,7 +243,8 @@ static void test_published_constants(void **s) {
 
 /* Paper 001 Sect. 6.2 eqs 6.13/6.14: decay coefficients
  * c1 = (w2/w0)/(1 + 16 w2/w1 + 18 w2/w0), c2 = (w2/w1)/(w2/w1 + 1/4), w_k = W(k Delta),
- * reproduced values in spec 001 section 6 (table of c1, c2), rows h = 1.2 and 1.4. */
+ * computed from the kernels (docs/papers.md, paper 001, derived results 2), rows
+ * h = 1.2 and 1.4. */
 static void test_decay_coefficients(void **s) {
   (void)s;
   typedef struct { mfree_kernel_t k; double a; double c1[2], c2[2]; } row_t;

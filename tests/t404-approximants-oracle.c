@@ -3,18 +3,17 @@
  * in long double with a small Gaussian elimination of our own:
  *  - SPH: Phi_j = W_j V_j, grad Phi_j = grad W_j V_j (000 eqs 21, 29), and the Hessian
  *    of the radial W, W'' n n^T + W'/r (I - n n^T);
- *  - Shepard: w_j / sum w and its quotient-rule derivative (000 eqs 38-39 and the
- *    [External/standard] derivative of section 4.2);
+ *  - Shepard: w_j / sum w and its quotient-rule derivative (000 eqs 38-39, Sect. 4.2);
  *  - MLS order 1 and 2: shifted, h-scaled basis, M gamma = p(0), derivatives with the
- *    shift point frozen, M gamma_,i = e_i / h - M_,i gamma (000 section 4.3
- *    [External/standard]);
+ *    shift point frozen, M gamma_,i = e_i / h - M_,i gamma (000 Sect. 4.3;
+ *    docs/papers.md, paper 000, choices 1);
  *  - SSPH order 2: K = sum p p^T W V, Phi_alpha,j = (K^-1 p_j)_alpha W_j V_j, value
- *    alpha = 0, derivatives alpha! Q_alpha / h^|alpha| (001 section 3, general lambda-D
- *    form, factor-2 erratum);
+ *    alpha = 0, derivatives alpha! Q_alpha / h^|alpha| (001 Sect. 3 in lambda dimensions,
+ *    the factor 2 of docs/papers.md, paper 001, errata 1);
  *  - KB Method 1: G_j = A^-T grad w^S_j with A_ab = sum_j (x_j - x)_a (grad w^S_j)_b
- *    (000 eqs 55-61 with the [Derived] index convention alpha = A^-T);
+ *    (000 eqs 55-61 with alpha = A^-T, docs/papers.md, paper 000, errata 4);
  *  - Randles-Libersky: K_ab = sum_j (x_j - x)_a (grad W_j)_b V_j, corrected kernel
- *    gradient K^-T grad W_j V_j, difference form (000 eqs 68-69, [Derived] index form).
+ *    gradient K^-T grad W_j V_j, difference form (000 eqs 68-69 in index form).
  * The library's tables (assemble_csr, compared as dense rows) must agree to 1e-12
  * relative to each row's largest entry, on a 2D cloud of 196 and a 3D cloud of 150
  * random particles with variable supports and volumes, for the gather and the

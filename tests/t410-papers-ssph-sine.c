@@ -2,12 +2,15 @@
  * its application to elastic problems", Comput Mech 43 (2009) 321-340), Sect. 6.1 and
  * Sect. 6.2 closed forms, through the public API:
  *  - Table 1 (sine test, 10 particles, revised Gauss, h = 1.5 Delta, quadratic basis);
- *  - Table 2 / Fig. 3 (rates over N = 10 ... 500) and the per-N values of spec 001 8.1;
- *  - MSPH and RKPM derivative norms (orderings; spec 001 8.1 on the support edge);
- *  - the interior closed forms 6.13/6.14 and the f_xx form of spec 001 section 6
- *    (claims 11, 12 of spec 001 section 12).
- * Setup (spec 001 sections 7, 8.1): particles at the cell centres x_i = (i - 1/2)/N,
- * volumes Delta = 1/N, gather support 2h, norms sqrt(Delta sum_i e_i^2). */
+ *  - Table 2 / Fig. 3 (rates over N = 10 ... 500) and the reproduced per-N values
+ *    ("reproduced": docs/papers.md, paper 001, derived results 4);
+ *  - MSPH and RKPM derivative norms (orderings; the support edge: docs/papers.md,
+ *    paper 001, choices 3);
+ *  - the interior closed forms 6.13-6.16 and the f_xx form that they imply
+ *    (docs/papers.md, paper 001, derived results 1).
+ * Setup (docs/papers.md, paper 001, choices 1, 2): particles at the cell centres
+ * x_i = (i - 1/2)/N, volumes Delta = 1/N, gather support 2h, norms
+ * sqrt(Delta sum_i e_i^2). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -99,7 +102,8 @@ static void sine(double x, double *f, double *fx, double *fxx) {
   *fxx = -64.0 * sin(8.0 * (1.0 - x)) / s8;
 }
 
-/* ||e||_0, ||e||_1, ||e||_2 of the sine test (001 eq 6.3, midpoint rule of spec 7). */
+/* ||e||_0, ||e||_1, ||e||_2 of the sine test (001 eq 6.3 by the midpoint rule:
+ * docs/papers.md, paper 001, choices 2). */
 static void sine_norms(mfree_method_t method, int n, double hfac, double e[3]) {
   double u[NMAX], ex[3][NMAX];
   est_t est;
@@ -163,9 +167,9 @@ static void test_table1_ssph(void **state) {
   expect_printed(e[0], 1.88e-2, 3, "001 Table 1, SSPH column, ||e||_0 (1.88E-2)");
   expect_printed(e[1], 1.21, 3, "001 Table 1, SSPH column, ||e||_1 (1.21)");
   expect_printed(e[2], 17.2, 3, "001 Table 1, SSPH column, ||e||_2 (17.2)");
-  expect_printed(e[0], 1.8790e-2, 5, "spec 001 8.1 [repro], SSPH N = 10, ||e||_0 1.8790e-2");
-  expect_printed(e[1], 1.2148, 5, "spec 001 8.1 [repro], SSPH N = 10, ||e||_1 1.2148");
-  expect_printed(e[2], 17.179, 5, "spec 001 8.1 [repro], SSPH N = 10, ||e||_2 1.7179e+1");
+  expect_printed(e[0], 1.8790e-2, 5, "001 Sect. 6.1, reproduced, SSPH N = 10, ||e||_0 1.8790e-2");
+  expect_printed(e[1], 1.2148, 5, "001 Sect. 6.1, reproduced, SSPH N = 10, ||e||_1 1.2148");
+  expect_printed(e[2], 17.179, 5, "001 Sect. 6.1, reproduced, SSPH N = 10, ||e||_2 1.7179e+1");
   /* SSPH never differentiates W, so the support-edge convention does not matter */
   double in[3], out[3];
   sine_norms(MFREE_METHOD_SSPH, 10, H_EDGE_IN, in);
@@ -176,7 +180,7 @@ static void test_table1_ssph(void **state) {
   }
 }
 
-/* 001 Sect. 4 / Table 1: RKPM and SSPH function estimates are identical (spec claim 4),
+/* 001 Sect. 4 / Table 1: RKPM and SSPH function estimates are identical,
  * at the particles for every N and at arbitrary points. */
 static void test_rkpm_value_equals_ssph(void **state) {
   (void)state;
@@ -232,7 +236,7 @@ static void test_rkpm_value_equals_ssph(void **state) {
 
 static void test_table2_ssph(void **state) {
   (void)state;
-  /* spec 001 8.1 [repro] SSPH reference values, N = 10 ... 500 */
+  /* 001 Sect. 6.1, reproduced SSPH reference values, N = 10 ... 500 */
   static const double ref[7][3] = {
       {1.8790e-2, 1.2148, 1.7179e+1}, {1.5839e-3, 3.4510e-1, 6.1998},
       {3.7231e-4, 1.5840e-1, 3.3987},  {6.0488e-5, 5.8289e-2, 1.5866},
@@ -243,24 +247,24 @@ static void test_table2_ssph(void **state) {
   for (int k = 0; k < 7; ++k) {
     sine_norms(MFREE_METHOD_SSPH, kN[k], H_AS_IS, e[k]);
     for (int c = 0; c < 3; ++c) {
-      snprintf(src, sizeof src, "spec 001 8.1 [repro] SSPH table, N = %d, ||e||_%d", kN[k], c);
+      snprintf(src, sizeof src, "001 Sect. 6.1, reproduced SSPH table, N = %d, ||e||_%d", kN[k], c);
       expect_printed(e[k][c], ref[k][c], 5, src);
       v[c][k] = e[k][c];
     }
   }
-  const double paper[3] = {3.54, 1.96, 1.49}, spec[3] = {3.541, 1.957, 1.493};
+  const double paper[3] = {3.54, 1.96, 1.49}, repro[3] = {3.541, 1.957, 1.493};
   for (int c = 0; c < 3; ++c) {
     const double r = rate(v[c]);
     snprintf(src, sizeof src, "001 Table 2, SSPH column, rate of ||e||_%d (%.2f)", c, paper[c]);
     expect_near(r, paper[c], 0.03, src);
-    snprintf(src, sizeof src, "spec 001 8.1 [repro] SSPH slope of ||e||_%d (%.3f)", c, spec[c]);
-    expect_printed(r, spec[c], 4, src);
+    snprintf(src, sizeof src, "001 Sect. 6.1, reproduced SSPH slope of ||e||_%d (%.3f)", c, repro[c]);
+    expect_printed(r, repro[c], 4, src);
   }
 }
 
 /* ---- MSPH and RKPM: Table 1 / Table 2 / Fig. 3 statements ----------------------------- */
 
-/* The paper's orderings (001 Sect. 6.1 text under Table 1 and Fig. 3; spec claims 24, 25),
+/* The paper's orderings (001 Sect. 6.1 text under Table 1 and Fig. 3),
  * checked for a set of norms e[method][N][norm]. */
 static void check_orderings(double e[3][7][3], const char *conv) {
   char src[200];
@@ -292,8 +296,8 @@ static void check_orderings(double e[3][7][3], const char *conv) {
 
 /* h = 1.5 Delta exactly, as the paper states it. Which of the pairs at exactly 2h count as
  * neighbours is then decided by the rounding of x_j - x_i (8 of the 14 at N = 10, 12 of
- * 34 at N = 20, 132 of 994 at N = 500), so MSPH and RKPM mix the two conventions of
- * spec 001 8.1. mfree gives, N = 10 (paper in brackets):
+ * 34 at N = 20, 132 of 994 at N = 500), so MSPH and RKPM mix the two conventions
+ * (docs/papers.md, paper 001, choices 3). mfree gives, N = 10 (paper in brackets):
  *   MSPH ||e||_0 3.54e-2 [2.86e-2, +24%], ||e||_1 1.28 [1.40, -8%], ||e||_2 19.4 [20.1, -4%]
  *   RKPM ||e||_0 1.88e-2 [1.88e-2],       ||e||_1 0.688 [0.59, +17%], ||e||_2 25.1 [32.8, -23%]
  * and rates MSPH 3.21 / 1.97 / 1.41 [3.52 / 1.92 / 1.47], RKPM 3.54 / 2.05 / 1.18
@@ -306,50 +310,50 @@ static void test_msph_rkpm_orderings_as_stated(void **state) {
   check_orderings(e, "h = 1.5 Delta");
 }
 
-/* The two support-edge conventions of spec 001 8.1 (an independent re-implementation):
+/* The two support-edge conventions (docs/papers.md, paper 001, choices 3; derived results 4):
  * mfree reproduces both to the printed digits, which pins its MSPH (eqs 2.9-2.15) and
  * RKPM (eqs 4.12-4.13) derivatives. */
-static void test_edge_conventions_spec(void **state) {
+static void test_edge_conventions_repro(void **state) {
   (void)state;
   static double in[3][7][3], out[3][7][3];
   double rin[3][3];
   all_norms(H_EDGE_IN, in);
   all_norms(H_EDGE_OUT, out);
   rates(in, rin);
-  /* spec 001 8.1, "My variant (N=10)" table */
-  expect_printed(in[MSPH][0][0], 3.67e-2, 3, "spec 001 8.1 [repro] MSPH edge included, ||e||_0 3.67e-2");
-  expect_printed(in[MSPH][0][1], 1.47, 3, "spec 001 8.1 [repro] MSPH edge included, ||e||_1 1.47");
-  expect_printed(in[MSPH][0][2], 21.3, 3, "spec 001 8.1 [repro] MSPH edge included, ||e||_2 21.3");
-  expect_printed(rin[MSPH][0], 3.547, 4, "spec 001 8.1 [repro] MSPH edge included, rates 3.547");
-  expect_printed(rin[MSPH][1], 1.941, 4, "spec 001 8.1 [repro] MSPH edge included, rates 1.941");
-  expect_printed(rin[MSPH][2], 1.493, 4, "spec 001 8.1 [repro] MSPH edge included, rates 1.493");
-  expect_printed(out[MSPH][0][0], 1.93e-2, 3, "spec 001 8.1 [repro] MSPH edge excluded, ||e||_0 1.93e-2");
-  expect_printed(out[MSPH][0][1], 1.24, 3, "spec 001 8.1 [repro] MSPH edge excluded, ||e||_1 1.24");
-  expect_printed(out[MSPH][0][2], 17.2, 3, "spec 001 8.1 [repro] MSPH edge excluded, ||e||_2 17.2");
-  expect_printed(in[RKPM][0][0], 1.879e-2, 4, "spec 001 8.1 [repro] RKPM edge included, ||e||_0 1.879e-2");
-  expect_printed(in[RKPM][0][1], 0.721, 3, "spec 001 8.1 [repro] RKPM edge included, ||e||_1 0.721");
-  expect_printed(in[RKPM][0][2], 33.4, 3, "spec 001 8.1 [repro] RKPM edge included, ||e||_2 33.4");
-  expect_printed(rin[RKPM][0], 3.541, 4, "spec 001 8.1 [repro] RKPM edge included, rates 3.541");
-  expect_printed(rin[RKPM][1], 1.877, 4, "spec 001 8.1 [repro] RKPM edge included, rates 1.877");
-  expect_printed(rin[RKPM][2], 1.510, 4, "spec 001 8.1 [repro] RKPM edge included, rates 1.510");
-  expect_printed(out[RKPM][0][0], 1.879e-2, 4, "spec 001 8.1 [repro] RKPM edge excluded, ||e||_0 1.879e-2");
-  expect_printed(out[RKPM][0][1], 0.730, 3, "spec 001 8.1 [repro] RKPM edge excluded, ||e||_1 0.730");
-  expect_printed(out[RKPM][0][2], 16.4, 3, "spec 001 8.1 [repro] RKPM edge excluded, ||e||_2 16.4");
-  /* spec claim 25: the L2 ordering holds in both conventions at every N */
+  /* the reproduced N = 10 values of both conventions */
+  expect_printed(in[MSPH][0][0], 3.67e-2, 3, "001 Sect. 6.1, reproduced MSPH edge included, ||e||_0 3.67e-2");
+  expect_printed(in[MSPH][0][1], 1.47, 3, "001 Sect. 6.1, reproduced MSPH edge included, ||e||_1 1.47");
+  expect_printed(in[MSPH][0][2], 21.3, 3, "001 Sect. 6.1, reproduced MSPH edge included, ||e||_2 21.3");
+  expect_printed(rin[MSPH][0], 3.547, 4, "001 Sect. 6.1, reproduced MSPH edge included, rates 3.547");
+  expect_printed(rin[MSPH][1], 1.941, 4, "001 Sect. 6.1, reproduced MSPH edge included, rates 1.941");
+  expect_printed(rin[MSPH][2], 1.493, 4, "001 Sect. 6.1, reproduced MSPH edge included, rates 1.493");
+  expect_printed(out[MSPH][0][0], 1.93e-2, 3, "001 Sect. 6.1, reproduced MSPH edge excluded, ||e||_0 1.93e-2");
+  expect_printed(out[MSPH][0][1], 1.24, 3, "001 Sect. 6.1, reproduced MSPH edge excluded, ||e||_1 1.24");
+  expect_printed(out[MSPH][0][2], 17.2, 3, "001 Sect. 6.1, reproduced MSPH edge excluded, ||e||_2 17.2");
+  expect_printed(in[RKPM][0][0], 1.879e-2, 4, "001 Sect. 6.1, reproduced RKPM edge included, ||e||_0 1.879e-2");
+  expect_printed(in[RKPM][0][1], 0.721, 3, "001 Sect. 6.1, reproduced RKPM edge included, ||e||_1 0.721");
+  expect_printed(in[RKPM][0][2], 33.4, 3, "001 Sect. 6.1, reproduced RKPM edge included, ||e||_2 33.4");
+  expect_printed(rin[RKPM][0], 3.541, 4, "001 Sect. 6.1, reproduced RKPM edge included, rates 3.541");
+  expect_printed(rin[RKPM][1], 1.877, 4, "001 Sect. 6.1, reproduced RKPM edge included, rates 1.877");
+  expect_printed(rin[RKPM][2], 1.510, 4, "001 Sect. 6.1, reproduced RKPM edge included, rates 1.510");
+  expect_printed(out[RKPM][0][0], 1.879e-2, 4, "001 Sect. 6.1, reproduced RKPM edge excluded, ||e||_0 1.879e-2");
+  expect_printed(out[RKPM][0][1], 0.730, 3, "001 Sect. 6.1, reproduced RKPM edge excluded, ||e||_1 0.730");
+  expect_printed(out[RKPM][0][2], 16.4, 3, "001 Sect. 6.1, reproduced RKPM edge excluded, ||e||_2 16.4");
+  /* the L2 ordering holds in both conventions at every N */
   for (int k = 0; k < 7; ++k) {
     expect_less(out[SSPH][k][0], out[MSPH][k][0],
-                "001 Sect. 6.1 (Fig. 3): L2 of SSPH below MSPH at every N, edge excluded (spec claim 25)");
+                "001 Sect. 6.1 (Fig. 3): L2 of SSPH below MSPH at every N, edge excluded");
     expect_less(in[SSPH][k][0], in[MSPH][k][0],
-                "001 Sect. 6.1 (Fig. 3): L2 of SSPH below MSPH at every N, edge included (spec claim 25)");
+                "001 Sect. 6.1 (Fig. 3): L2 of SSPH below MSPH at every N, edge included");
   }
 }
 
-/* The paper against the edge-included ("d <= 2", spec 001 section 10) convention, the one
+/* The paper against the edge-included ("d <= 2") convention, the one
  * closest to it. mfree (paper): MSPH 3.67e-2 (2.86e-2, +28%), 1.47 (1.40, +5%),
  * 21.3 (20.1, +6%); RKPM 0.721 (0.59, +22%), 33.4 (32.8, +2%). The paper's MSPH ||e||_0 is
  * not within 25% of either convention; it lies between them (1.93e-2 and 3.67e-2), which
  * is what is asserted for it. The paper's code evidently differs in an undocumented
- * detail at the support edge (spec 001 section 11, item 16). */
+ * detail at the support edge (docs/papers.md, paper 001, choices 3). */
 static void test_msph_rkpm_vs_paper(void **state) {
   (void)state;
   static double in[3][7][3], out[3][7][3];
@@ -365,17 +369,17 @@ static void test_msph_rkpm_vs_paper(void **state) {
   expect_printed(in[RKPM][0][0], 1.88e-2, 3, "001 Table 1, RKPM ||e||_0 1.88E-2");
   expect_less(out[MSPH][0][0], 2.86e-2, "001 Table 1, MSPH ||e||_0 2.86E-2 above the edge-excluded value");
   expect_less(2.86e-2, in[MSPH][0][0], "001 Table 1, MSPH ||e||_0 2.86E-2 below the edge-included value");
-  /* 001 Table 2: MSPH 3.52 / 1.92 / 1.47, RKPM 3.54 / 1.80 / 1.54 (spec claim 23: RKPM H1
-   * +-0.15; mfree 1.877) */
+  /* 001 Table 2: MSPH 3.52 / 1.92 / 1.47, RKPM 3.54 / 1.80 / 1.54 (RKPM H1 within
+   * +-0.15: mfree 1.877) */
   expect_near(r[MSPH][0], 3.52, 0.03, "001 Table 2, MSPH column, rate of ||e||_0 3.52");
   expect_near(r[MSPH][1], 1.92, 0.03, "001 Table 2, MSPH column, rate of ||e||_1 1.92");
   expect_near(r[MSPH][2], 1.47, 0.03, "001 Table 2, MSPH column, rate of ||e||_2 1.47");
   expect_near(r[RKPM][0], 3.54, 0.03, "001 Table 2, RKPM column, rate of ||e||_0 3.54");
-  expect_near(r[RKPM][1], 1.80, 0.15, "001 Table 2, RKPM column, rate of ||e||_1 1.80 (spec claim 23: +-0.15)");
+  expect_near(r[RKPM][1], 1.80, 0.15, "001 Table 2, RKPM column, rate of ||e||_1 1.80 (+-0.15)");
   expect_near(r[RKPM][2], 1.54, 0.03, "001 Table 2, RKPM column, rate of ||e||_2 1.54");
 }
 
-/* ---- closed forms (001 eqs 6.13-6.16, spec 001 section 6; spec claims 11, 12) ---------- */
+/* ---- closed forms (001 eqs 6.13-6.16; f_xx: docs/papers.md, paper 001, derived results 1) */
 
 /* The six kernels of 001 Sect. 6.2 (shape only: G cancels in SSPH), written from the
  * paper's equations, not from mfree; the revised super Gauss at a = 1 and 1.6. */
@@ -429,7 +433,7 @@ static void test_closed_forms_interior(void **state) {
         expect_near(est.f[i], f, 1e-12, src);
         snprintf(src, sizeof src, "001 eq 6.14 (f_x with c2), %s, h = %.1f Delta, i = %d", kKerName[k], ratios[r], i);
         expect_near(est.fx[i], fx, 1e-12 / delta, src);
-        snprintf(src, sizeof src, "spec 001 section 6 f_xx closed form, %s, h = %.1f Delta, i = %d", kKerName[k], ratios[r], i);
+        snprintf(src, sizeof src, "f_xx closed form (docs/papers.md, paper 001, derived results 1), %s, h = %.1f Delta, i = %d", kKerName[k], ratios[r], i);
         expect_near(est.fxx[i], fxx, 1e-11 / (delta * delta), src);
       }
     }
@@ -449,8 +453,8 @@ static void test_closed_forms_nearest(void **state) {
     for (int r = 0; r < 3; ++r) {
       est_t est;
       int32_t failed[N];
-      /* the end particles see one neighbour: K is singular there (001 eq 3.5, spec
-       * claim 3), reported as too few neighbours, rows zero */
+      /* the end particles see one neighbour: K is singular there (001 eq 3.5),
+       * reported as too few neighbours, rows zero */
       estimate_status(MFREE_METHOD_SSPH, kKer[k], kKerA[k], N, ratios[r], 1, u, &est,
                       MFREE_FAIL_NEIGHBORS, failed);
       for (int i = 0; i < N; ++i) {
@@ -463,7 +467,7 @@ static void test_closed_forms_nearest(void **state) {
         expect_near(est.f[i], u[i], 1e-12, src);
         snprintf(src, sizeof src, "001 eq 6.16 (central difference), %s, h = %.1f Delta, i = %d", kKerName[k], ratios[r], i);
         expect_near(est.fx[i], (u[i + 1] - u[i - 1]) / (2 * delta), 1e-12 / delta, src);
-        snprintf(src, sizeof src, "spec 001 claim 12 (second difference), %s, h = %.1f Delta, i = %d", kKerName[k], ratios[r], i);
+        snprintf(src, sizeof src, "f_xx closed form with w2 = 0 (second difference), %s, h = %.1f Delta, i = %d", kKerName[k], ratios[r], i);
         expect_near(est.fxx[i], (u[i + 1] - 2 * u[i] + u[i - 1]) / (delta * delta), 1e-11 / (delta * delta), src);
       }
     }
@@ -475,7 +479,7 @@ int main(void) {
       cmocka_unit_test(test_rkpm_value_equals_ssph),
       cmocka_unit_test(test_table2_ssph),
       cmocka_unit_test(test_msph_rkpm_orderings_as_stated),
-      cmocka_unit_test(test_edge_conventions_spec),
+      cmocka_unit_test(test_edge_conventions_repro),
       cmocka_unit_test(test_msph_rkpm_vs_paper),
       cmocka_unit_test(test_closed_forms_interior),
       cmocka_unit_test(test_closed_forms_nearest),

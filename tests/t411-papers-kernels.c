@@ -2,12 +2,12 @@
  * kernels on f = exp(-x^2), through the public API.
  *  - Tables 3 (h = 1.2 Delta), 4 (h = 1.4 Delta) and 5 (cubic, quartic, revised super
  *    Gauss a = 1.0 ... 1.6): every entry to the printed digits and every rank in
- *    parentheses (spec 001 8.2 reproduced all of them);
+ *    parentheses (all reproduced: docs/papers.md, paper 001, derived results 4);
  *  - the rankings equal those of the decay coefficients c1 (L2) and c2 (H1) of eqs
- *    6.13/6.14 (spec claim 28);
- *  - Table 6: H1 convergence rates per kernel, RSG a = 1.6 (spec claim 30);
- *  - the recommendation of RSG a = 1.6: smallest errors of all (spec claim 29).
- * Setup (spec 001 8.2): 20 particles at the cell centres of [0, 1], Delta = 0.05, volumes
+ *    6.13/6.14;
+ *  - Table 6: H1 convergence rates per kernel, RSG a = 1.6;
+ *  - the recommendation of RSG a = 1.6: smallest errors of all.
+ * Setup (docs/papers.md, paper 001, choices 1, 2): 20 particles at the cell centres of [0, 1], Delta = 0.05, volumes
  * Delta, quadratic basis, norms sqrt(Delta sum e_i^2) of the errors in f and f_x. */
 #include <math.h>
 #include <stdio.h>
@@ -104,8 +104,8 @@ static const table_t kTables[4] = {
      {{4, 6, 5, 3, 2, 1}, {4, 6, 5, 3, 2, 1}}},
 };
 
-/* spec 001 8.2 [repro], four significant digits, same layout (h = 1.2, 1.4; nine kernels) */
-static const double kSpec[2][2][NK] = {
+/* 001 Sect. 6.2, reproduced, four significant digits, same layout (h = 1.2, 1.4; nine kernels) */
+static const double kRepro[2][2][NK] = {
     {{6.842e-6, 3.008e-6, 1.603e-6, 2.431e-6, 4.301e-6, 2.627e-6, 1.769e-6, 1.141e-6, 7.115e-7},
      {3.125e-3, 2.119e-3, 1.564e-3, 1.703e-3, 2.192e-3, 1.803e-3, 1.640e-3, 1.522e-3, 1.440e-3}},
     {{7.817e-6, 4.864e-6, 4.442e-6, 5.427e-6, 6.363e-6, 5.063e-6, 4.144e-6, 3.298e-6, 2.551e-6},
@@ -129,10 +129,10 @@ static void test_tables_3_4_5(void **state) {
         snprintf(src, sizeof src, "%s, row %s, column %s, printed %.2f", T->name, norm,
                  kName[T->col[c]], T->value[q][c]);
         if (t == 0 && q == 1 && T->col[c] == LIN) {
-          /* printed 3.12 although the value is 3.1253 (spec 001 8.2 reproduces 3.125e-3):
-           * the paper truncated this one entry */
+          /* printed 3.12 although the value is 3.1253 (reproduced 3.125e-3):
+           * the paper truncated this one entry, docs/papers.md, paper 001, errata 7 */
           if (!(floor(v[q][c] * 100.0) == 312.0)) fail_msg("%s (truncated): got %.5f", src, v[q][c]);
-          expect_near(v[q][c], 3.125, 0.0005, "spec 001 8.2 [repro], Table 3 linear ||e||_1 3.125e-3");
+          expect_near(v[q][c], 3.125, 0.0005, "001 Sect. 6.2, reproduced, Table 3 linear ||e||_1 3.125e-3");
         } else {
           expect_near(v[q][c], T->value[q][c], 0.005 + 1e-9, src);
         }
@@ -142,15 +142,15 @@ static void test_tables_3_4_5(void **state) {
         if (r != T->rank[q][c]) fail_msg("%s: got rank %d", src, r);
       }
   }
-  /* four digits: spec 001 8.2 [repro] table, all nine kernels at both h */
+  /* four digits: the reproduced table, all nine kernels at both h */
   for (int h = 0; h < 2; ++h)
     for (int k = 0; k < NK; ++k) {
       double e[2];
       norms(k, 20, h ? 1.4 : 1.2, e);
       for (int q = 0; q < 2; ++q) {
-        const double ref = kSpec[h][q][k];
+        const double ref = kRepro[h][q][k];
         const double unit = pow(10.0, floor(log10(ref)) - 3);
-        snprintf(src, sizeof src, "spec 001 8.2 [repro], h = %.1f Delta, %s, ||e||_%d = %.4g",
+        snprintf(src, sizeof src, "001 Sect. 6.2, reproduced, h = %.1f Delta, %s, ||e||_%d = %.4g",
                  h ? 1.4 : 1.2, kName[k], q, ref);
         expect_near(e[q], ref, 0.5 * unit * (1 + 1e-9), src);
       }
@@ -158,7 +158,7 @@ static void test_tables_3_4_5(void **state) {
 }
 
 /* 001 Sect. 6.2: "The error norms follow the ranking predicted by values of coefficients
- * c1 and c2" (eqs 6.13, 6.14), for the six kernels of Tables 3 and 4 (spec claim 28).
+ * c1 and c2" (eqs 6.13, 6.14), for the six kernels of Tables 3 and 4.
  * c1, c2 are computed from mfree's kernels at 0, Delta, 2 Delta. */
 static void test_rankings_follow_c1_c2(void **state) {
   (void)state;
@@ -189,14 +189,14 @@ static void test_rankings_follow_c1_c2(void **state) {
 }
 
 /* 001 Table 6: H1 rates (slope of ln ||e||_1 against ln Delta), N = 10 ... 500 (the
- * paper's N are not stated; spec 001 8.2 reproduced the rates with these to 0.001). */
+ * paper's N are not stated: docs/papers.md, paper 001, choices 4). */
 static void test_table6_rates(void **state) {
   (void)state;
   static const int N[7] = {10, 20, 30, 50, 100, 250, 500};
   static const int cols[6] = {LIN, QUAD, CUB, QUART, RGAUSS, RSG16};
   static const double paper[2][6] = {{1.9902, 2.0006, 2.0140, 2.0096, 1.9993, 2.0189},
                                      {1.9882, 1.9926, 1.9993, 1.9956, 1.9927, 2.0064}};
-  static const double spec[2][6] = {{1.9907, 2.0006, 2.0134, 2.0091, 1.9993, 2.0180},
+  static const double repro[2][6] = {{1.9907, 2.0006, 2.0134, 2.0091, 1.9993, 2.0180},
                                     {1.9888, 1.9930, 1.9993, 1.9958, 1.9930, 2.0061}};
   char src[200];
   double rate[2][6];
@@ -219,10 +219,10 @@ static void test_table6_rates(void **state) {
       snprintf(src, sizeof src, "001 Table 6, h = %.1f Delta, %s (%.4f)", h ? 1.4 : 1.2,
                kName[cols[c]], paper[h][c]);
       expect_near(rate[h][c], paper[h][c], 0.01, src);
-      snprintf(src, sizeof src, "spec 001 8.2 [repro] Table 6 rates, h = %.1f Delta, %s (%.4f)",
-               h ? 1.4 : 1.2, kName[cols[c]], spec[h][c]);
-      expect_near(rate[h][c], spec[h][c], 0.002, src);
-      snprintf(src, sizeof src, "001 Sect. 6.2: \"convergence rates are not affected by the choice of the kernel\" (2.00 +- 0.02, spec claim 30), %s",
+      snprintf(src, sizeof src, "001 Sect. 6.2, reproduced Table 6 rates, h = %.1f Delta, %s (%.4f)",
+               h ? 1.4 : 1.2, kName[cols[c]], repro[h][c]);
+      expect_near(rate[h][c], repro[h][c], 0.002, src);
+      snprintf(src, sizeof src, "001 Sect. 6.2: \"convergence rates are not affected by the choice of the kernel\" (2.00 +- 0.02), %s",
                kName[cols[c]]);
       expect_near(rate[h][c], 2.0, 0.02, src);
     }
@@ -235,7 +235,7 @@ static void test_table6_rates(void **state) {
 
 /* 001 Sect. 6.2 / Sect. 7 conclusion 7: the revised super Gauss with a = 1.6 "has the
  * least error and is recommended": smallest ||e||_0 and ||e||_1 of all nine variants, at
- * both smoothing lengths (spec claim 29); and the errors decrease with a (Table 5). */
+ * both smoothing lengths; and the errors decrease with a (Table 5). */
 static void test_rsg16_recommended(void **state) {
   (void)state;
   char src[200];

@@ -1,7 +1,7 @@
 /* Completeness of every method on an irregular 2D cloud, computed with
- * mfree_approximant_check_reproduction and compared with the summary table of paper 000
+ * mfree_approximant_check_reproduction and compared with the statements of paper 000
  * (Belytschko, Krongauz, Dolbow, Gerlach, "On the completeness of meshfree particle
- * methods", IJNME 43 (1998) 785-819, Sect. 4; spec 000 section 4.11) and, for MSPH and
+ * methods", IJNME 43 (1998) 785-819, Sect. 4, eqs 21-70) and, for MSPH and
  * SSPH, with paper 001 (Zhang & Batra, Comput Mech 43 (2009) 321-340, Sects. 2-3).
  *  - function order: largest k <= 3 with every reproducing condition of degree <= k
  *    (000 eqs 5-7) met to 1e-10 at every particle, -1 when constants fail;
@@ -84,8 +84,8 @@ typedef struct {
   const char *source;
 } row_t;
 
-/* Paper 000 Sect. 4 summary (spec 000 4.11) and paper 001 for MSPH/SSPH. 3 means ">= 3"
- * (check_reproduction covers degrees up to 3). */
+/* Paper 000 Sect. 4 (docs/papers.md, paper 000, derived results 2) and paper 001 for
+ * MSPH/SSPH. 3 means ">= 3" (check_reproduction covers degrees up to 3). */
 static const row_t kRows[] = {
     {MFREE_METHOD_SPH, 0, -1, -1, "000 Sect. 4.1 (eqs 21, 29; eq 37): SPH reproduces nothing, not even constants"},
     {MFREE_METHOD_SPH_SYMMETRIC, 0, -1, 0, "000 Sect. 4.4 (eq 47): symmetrised SPH, derivatives of constants only; function not corrected"},
@@ -127,7 +127,7 @@ static void test_summary_table(void **state) {
   mfree_particles_destroy(&ps);
 }
 
-/* 001 Sect. 3 ("consistent to orders m, m-1 and m-2") and spec 001 claim 7: SSPH (and,
+/* 001 Sect. 3 ("consistent to orders m, m-1 and m-2"): SSPH (and,
  * by the same argument, MSPH) reproduces degree m exactly in the second-derivative table
  * as well, boundary particles included, and not degree m + 1. */
 static void test_second_derivatives(void **state) {
@@ -139,7 +139,7 @@ static void test_second_derivatives(void **state) {
     int order;
     const char *source;
   } rows[] = {
-      {MFREE_METHOD_SSPH, 2, "001 Sect. 3 / spec 001 claim 7: SSPH m = 2, f, grad f, Hessian exact for degree 2"},
+      {MFREE_METHOD_SSPH, 2, "001 Sect. 3: SSPH m = 2, f, grad f, Hessian exact for degree 2"},
       {MFREE_METHOD_MSPH, 2, "001 Sect. 2 (eq 2.15): MSPH m = 2, f, grad f, Hessian exact for degree 2"},
       {MFREE_METHOD_SSPH, 3, "001 Sect. 3 (general m): SSPH m = 3, Hessian exact for degree 3"},
   };
@@ -162,7 +162,7 @@ static void test_second_derivatives(void **state) {
 
 /* 000 eqs 53-54: JB gives D_x = a (1 + rho_J) for v_x = a (x + y), with
  * rho_J = sum_I dW_JI/dx V_I (y_I - y_J) / sum_I dW_JI/dx V_I (x_I - x_J), non-zero on
- * irregular particles, while v_x = a x is differentiated exactly (spec 000 claim 11).
+ * irregular particles, while v_x = a x is differentiated exactly (000 Sect. 4.4.2).
  * rho_J is computed here from the neighbour lists and mfree_kernel_eval. */
 static void test_johnson_beissel_counterexample(void **state) {
   (void)state;
@@ -214,7 +214,8 @@ static void test_johnson_beissel_counterexample(void **state) {
   mfree_approximant_destroy(&a);
   mfree_particles_destroy(&ps);
 
-  /* spec 000 claim 11 [D]: on a regular lattice rho_J = 0 at interior nodes, JB exact */
+  /* on a regular lattice rho_J = 0 at interior nodes, JB exact (docs/papers.md, paper 000,
+   * derived results 1) */
   static cloud_t g;
   ps = make_cloud(&g, 12, 0.0, 1.5, 1);
   a = make(ps, MFREE_METHOD_JOHNSON_BEISSEL, 1, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT);
@@ -226,7 +227,7 @@ static void test_johnson_beissel_counterexample(void **state) {
     if (px < edge || px > 1 - edge || py < edge || py > 1 - edge) continue;
     ++interior;
     if (!(fabs(gxy[2 * i] - alpha) < 1e-12 && fabs(gxy[2 * i + 1] - alpha) < 1e-12))
-      fail_msg("spec 000 4.5 [D]: JB exact for a(x+y) at interior lattice node %d: %.15g, %.15g", i,
+      fail_msg("000 Sect. 4.4.2, lattice: JB exact for a(x+y) at interior lattice node %d: %.15g, %.15g", i,
                gxy[2 * i], gxy[2 * i + 1]);
   }
   assert_true(interior > 0);
@@ -278,8 +279,8 @@ static double curl(mfree_particles_t *ps, const cloud_t *c, mfree_method_t metho
   return worst;
 }
 
-/* 000 Sect. 4 (eq 18; spec 000 claims 17, 18): Shepard and MLS derivatives are true
- * derivatives, hence integrable; KB Methods 1, 2, 3 corrected derivatives are not. The
+/* 000 Sects. 2.3, 4 (eq 18; docs/papers.md, paper 000, derived results 3): Shepard and
+ * MLS derivatives are true derivatives, hence integrable; KB Methods 1, 2, 3 corrected derivatives are not. The
  * curl of a true gradient is zero up to the O(e^2) difference error (~1e-10 here); the
  * corrected ones give ~1e-2. */
 static void test_integrability(void **state) {

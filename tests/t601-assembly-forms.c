@@ -108,8 +108,8 @@ static void quad_b(void *u, const double *x, double *v) {
 }
 
 /* SSPH and MSPH collocation reproduce a quadratic elasticity field exactly (001 Sect.
- * 6.3 form; SSPH is exact for degree <= 2 in value and both derivatives, spec 001
- * claim 7), so the nodal solution equals u(x_J) to round-off. */
+ * 6.3 form; SSPH is exact for degree <= 2 in value and both derivatives, 001 Sect. 3
+ * consistency), so the nodal solution equals u(x_J) to round-off. */
 static void test_collocation_exact(void **s) {
   (void)s;
   const mfree_method_t methods[2] = {MFREE_METHOD_SSPH, MFREE_METHOD_MSPH};

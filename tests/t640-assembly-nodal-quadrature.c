@@ -1,5 +1,5 @@
-/* Assembler, nodal quadrature (paper 000 Sect. 5.3, eq 95; spec 000 Sect. 5.5): the
- * plane-stress stiffness of every nodal-quadrature scheme of 000 Sect. 6.2 equals
+/* Assembler, nodal quadrature (paper 000 Sect. 5.2, eq 95; docs/papers.md, paper 000,
+ * choices 3): the plane-stress stiffness of every nodal-quadrature scheme of 000 Sect. 6.2 equals
  * K_JK = sum_I dV_I B_test,J(x_I)^T D B_trial,K(x_I) built independently from the
  * approximants' gradient tables (mfree_approximant_assemble_csr), for Bubnov (SPH
  * symmetrised, JB, RL, MLS) and Petrov-Galerkin (KB Method 1 and 2 trial, Shepard test)

@@ -1,6 +1,6 @@
 /* Galerkin-SPH fluid system (paper 003): exact conservation of linear and angular
- * momentum by the nodal-integrated internal forces (003 claims D3/D4; spec 003 section
- * 4), hydrostatic equilibrium of the interior at t = 0 with the initial densities of
+ * momentum by the nodal-integrated internal forces (docs/papers.md, paper 003, derived
+ * results 1), hydrostatic equilibrium of the interior at t = 0 with the initial densities of
  * 003 eq 65, and the failure modes (non-finite state, particle leaving the
  * box, CFL violation), each keeping the last good state. */
 #include <math.h>
@@ -59,7 +59,8 @@ static mfree_system_t *fluid(const double *m, double H, double mu, int gravity) 
 /* Free patch, no walls, no gravity, random velocities and densities: the lumped-mass
  * weighted accelerations sum to zero (linear momentum, test functions constant
  * complete) and so do their moments (angular momentum, linear completeness and a
- * symmetric Cauchy stress), 003 D3/D4 and spec 000 eqs 106-111, to round-off. */
+ * symmetric Cauchy stress), docs/papers.md, paper 003, derived results 1, and 000 eqs
+ * 106-111, to round-off. */
 static void test_conservation(void **s) {
   (void)s;
   for (int lump = MFREE_LUMP_GALERKIN; lump <= MFREE_LUMP_PHYSICAL; ++lump) {

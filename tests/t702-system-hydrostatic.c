@@ -1,4 +1,5 @@
-/* Still water in a tank with the Galerkin-SPH fluid of paper 003 (spec 003 B5).
+/* Still water in a tank with the Galerkin-SPH fluid of paper 003 (docs/papers.md,
+ * paper 003, choices 3).
  *
  * 1. Zero-energy modes of nodal integration (003 Sect. 4.2.3): on a lattice, checkerboard
  *    velocity parameters have zero velocity gradient at every interior particle (no
@@ -174,8 +175,8 @@ static void test_hydrostatic_column(void **s) {
   mfree_system_destroy(&sys);
 }
 
-/* 3. The issue's criterion in the paper's setting (spec 003 B5): still water 0.1 m deep
- *    in a tank 0.1 m wide, d = H/20 (400 particles), h = 1.5 d, rho0 = 1000, gamma = 7,
+/* 3. The issue's criterion in the paper's setting (docs/papers.md, paper 003, choices 3):
+ *    still water 0.1 m deep in a tank 0.1 m wide, d = H/20 (400 particles), h = 1.5 d, rho0 = 1000, gamma = 7,
  *    kappa = 100 rho0 (2 g H) / gamma (eq 125), initial densities of eq 65, masses
  *    rho_i d^2, the paper's mu = 0.5, Galerkin lumping, leap-frog at CFL 0.2, no damping.
  *    Four options that paper 003 does not have:

@@ -1,10 +1,10 @@
 /* Shared helpers for the paper-reproduction examples (papers 000 and 001).
  *
- * Paper 001 (Zhang & Batra, Comput Mech 43 (2009) 321-340), Sect. 6, as reproduced in
- * spec 001 sections 7 and 8: N particles at the cell centres x_i = (i - 1/2)/N of [0, 1]
- * (spec 8.1: the only layout that reproduces Table 1), volumes Delta = 1/N, support
- * h = hfac * Delta, kernel support 2h (gather), estimates at the particles, error norms
- * by the midpoint rule ||e||_k = sqrt(Delta * sum_i e_i^2) (spec 7). */
+ * Paper 001 (Zhang & Batra, Comput Mech 43 (2009) 321-340), Sect. 6, with the choices of
+ * docs/papers.md, paper 001, choices 1 and 2: N particles at the cell centres
+ * x_i = (i - 1/2)/N of [0, 1] (the only layout that reproduces Table 1), volumes
+ * Delta = 1/N, support h = hfac * Delta, kernel support 2h (gather), estimates at the
+ * particles, error norms by the midpoint rule ||e||_k = sqrt(Delta * sum_i e_i^2). */
 #ifndef MFREE_EXAMPLES_PAPERS_H
 #define MFREE_EXAMPLES_PAPERS_H
 

@@ -1,6 +1,6 @@
 /* Completeness (reproducing conditions) of every mfree method on an irregular 2D cloud,
- * computed, next to the summary table of paper 000 (Belytschko, Krongauz, Dolbow,
- * Gerlach, IJNME 43 (1998) 785-819, Sect. 4; spec 000 section 4.11) and the consistency
+ * computed, next to the completeness paper 000 states for each method (Belytschko,
+ * Krongauz, Dolbow, Gerlach, IJNME 43 (1998) 785-819, Sect. 4) and the consistency
  * statements of paper 001 (Zhang & Batra 2009, Sects. 2-3) for MSPH and SSPH.
  *
  * For each method the function order is the largest k in 0..3 for which every
@@ -39,7 +39,7 @@ typedef struct {
   int particles_only;
 } entry_t;
 
-/* Paper 000 Sect. 4 (spec 000 section 4.11) and paper 001 Sects. 2-4. */
+/* Paper 000 Sect. 4 (docs/papers.md, paper 000, derived results 2) and paper 001 Sects. 2-4. */
 static const entry_t kEntries[] = {
     {MFREE_METHOD_SPH, 0, "SPH", -1, -1, "reproduction", 1, 0},
     {MFREE_METHOD_SPH_SYMMETRIC, 0, "SPH symmetric", -1, 0, "reproduction", 0, 1},

@@ -12,7 +12,8 @@
  *    tests/assembly/check_table3.cmake records why);
  *  - plate with a hole, 000 eqs 127-129: quarter model [0,5]^2 minus the disc r < 1
  *    (a = 1, b = 5), Kirsch tractions on x = 5 and y = 5, u_y = 0 on y = 0, u_x = 0 on
- *    x = 0, free hole; exact displacements of spec 000 Sect. 6.2.2 (plane-stress kappa);
+ *    x = 0, free hole; exact displacements of Timoshenko-Goodier with the plane-stress
+ *    kappa (docs/papers.md, paper 000, choices 2);
  *  - a Galerkin patch test: a linear field on an irregular cloud, Dirichlet everywhere.
  * Cubic spline kernel with s = sqrt(2) dx (000 eqs 126, 130): support 2s, 21 neighbours.
  *

@@ -2,8 +2,8 @@
  * convergence study behind Table III, shared by the example program and its tests.
  *
  *  - es_geometry.c: the problems (cantilever beam 000 eqs 120-125, Kirsch plate with a
- *    hole 000 eqs 127-129 with the displacements of spec 000 Sect. 6.2.2, a linear patch
- *    test), their node clouds, Voronoi nodal volumes, boundary segments and background
+ *    hole 000 eqs 127-129 with the displacements of docs/papers.md, paper 000, choices 2,
+ *    a linear patch test), their node clouds, Voronoi nodal volumes, boundary segments and background
  *    Gauss points;
  *  - es_solve.c: the seven schemes of 000 Sect. 6.2 on mfree's assembler, the essential
  *    boundary-condition variants, the UMFPACK solve and the error norms 000 eqs 114-119.

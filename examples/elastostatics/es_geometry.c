@@ -34,8 +34,9 @@ void es_exact(const es_problem_t *p, const double *x, double *u, double *eps, do
     s[1] = 0.0;
     s[2] = P / (2.0 * I) * (D * D / 4.0 - Y * Y);
   } else if (p->kind == ES_HOLE) {
-    /* Kirsch, 000 eqs 127-129 (unit traction in x at infinity); displacements of spec
-     * 000 Sect. 6.2.2 [External] with the plane-stress kappa = (3 - nu)/(1 + nu). */
+    /* Kirsch, 000 eqs 127-129 (unit traction in x at infinity); the classical
+     * displacements with the plane-stress kappa = (3 - nu)/(1 + nu) (docs/papers.md,
+     * paper 000, choices 2). */
     const double a = p->a, r = hypot(x[0], x[1]), t = atan2(x[1], x[0]);
     const double a2 = a * a / (r * r), a4 = a2 * a2;
     s[0] = 1.0 - a2 * (1.5 * cos(2 * t) + cos(4 * t)) + 1.5 * a4 * cos(4 * t);

@@ -1,12 +1,12 @@
 /* Paper 001 (Zhang & Batra, Comput Mech 43 (2009) 321-340), Sect. 6.2: the kernel
  * comparison with SSPH. f = exp(-x^2) on [0, 1], 20 particles at the cell centres
  * (Delta = 0.05), quadratic basis, h = 1.2 Delta and 1.4 Delta; L2 errors of f and f_x
- * (sqrt(Delta sum e_i^2), spec 001 section 7) for the linear (eq 6.4), quadratic (6.5),
+ * (sqrt(Delta sum e_i^2), docs/papers.md, paper 001, choices 2) for the linear (eq 6.4), quadratic (6.5),
  * cubic B-spline (6.6), quartic (6.7), revised Gauss (6.8) and revised super Gauss
  * (6.10/6.17, a = 1.0, 1.2, 1.4, 1.6) kernels: Tables 3, 4 and 5 with the rankings in
  * parentheses, and Table 6, the H1 convergence rates (least-squares slope of
  * ln ||e||_1 against ln Delta over N = 10, 20, 30, 50, 100, 250, 500; the paper does
- * not state its N, spec 001 section 8.2) with the revised super Gauss at a = 1.6.
+ * not state its N, docs/papers.md, paper 001, choices 4) with the revised super Gauss at a = 1.6.
  *
  * Usage: mfree_kernels [--json] [--out DIR] [--no-plot]; DIR/kernels.png plots Table 6's
  * convergence (gnuplot on PATH).

@@ -1,7 +1,7 @@
 /* Plate with a circular hole by SSPH/MSPH collocation (paper 001 Sect. 6.3); see plate.h.
  *
- * Particle arrangement (the paper's Figs. 10, 11 and 13 are not available, spec 001
- * erratum 11): rings refined towards the hole.
+ * Particle arrangement (the paper's Figs. 10, 11 and 13 are not available,
+ * docs/papers.md, paper 001, choices 5): rings refined towards the hole.
  *  - Rays: for t in [0, 1], the straight line from the hole point
  *    H(t) = a (cos(pi t/2), sin(pi t/2)) to the point P(t) of the outer edges (x = b,
  *    then y = b) at the fraction t of their length; P(1/2) is the corner (b, b).
@@ -48,13 +48,14 @@
  *
  * Volumes: spacing along the ring times the spacing across the rings, halved on the
  * boundary. Supports: h_i = hfac Delta_i, Delta_i the distance from particle i to its
- * nearest neighbour (spec 001 8.3: "the smallest distance between particle i and other
- * particles in its compact support"; the nearest particle always lies in the support
- * 2 h_i = 3 Delta_i, so the two readings agree); gather search with kappa = 2 (the kernel
- * support is 2 h_i), W_ij = W(x_i - x_j, h_i) as in spec 001 3 (cfg->search can make it
+ * nearest neighbour (001 Sect. 6.3 takes the smallest distance to the other particles of
+ * the support; the nearest particle always lies in the support 2 h_i = 3 Delta_i, so the
+ * two readings agree: docs/papers.md, paper 001, choices 6); gather search with
+ * kappa = 2 (the kernel support is 2 h_i), W_ij = W(x_i - x_j, h_i) as in 001 eq 3.3
+ * (cfg->search can make it
  * symmetric, a measurement only).
  *
- * Boundary rows (spec 001 8.3 table; mixed conditions as in (6.24)/(6.25)):
+ * Boundary rows (001 Sect. 6.3, boundaries 1-5; mixed conditions as in (6.24)/(6.25)):
  *  - hole r = a: traction rows sigma n = 0 for both components, n = -(x, y)/a (the
  *    outward normal of the body, pointing into the hole);
  *  - y = 0: u_2 = 0 (a Dirichlet row) and t_1 = 0 (the traction row with n = (0, -1)
@@ -66,7 +67,7 @@
  *    hole traction t_2 = 0 and u_1 = 0; (b, 0) exact t_1 on x = b and u_2 = 0; (0, b)
  *    exact t_2 on y = b and u_1 = 0: one rule at every corner on a symmetry line, its
  *    displacement condition and the other boundary's traction for the other component
- *    (PLATE_CORNER_DIRICHLET; the paper does not say, erratum 11). The alternatives at the
+ *    (PLATE_CORNER_DIRICHLET; the paper does not say, docs/papers.md, paper 001, choices 7). The alternatives at the
  *    hole corners, PLATE_CORNER_SYMMETRY (u_n = 0 and sigma_12 = 0 of the symmetry line)
  *    and PLATE_CORNER_HOLE (both hole tractions), are there to measure the choice.
  * Interior particles carry the two Navier equations (6.22). */

@@ -1,5 +1,5 @@
-/* Paper 001 (Zhang & Batra, Comput Mech 43 (2009) 321-340) Sect. 6.3, as specified in
- * spec 001 section 8.3 with errata 3, 4 and 11: an infinite plate with a circular hole
+/* Paper 001 (Zhang & Batra, Comput Mech 43 (2009) 321-340) Sect. 6.3, with the errata
+ * and choices of docs/papers.md (paper 001, errata 2, 3, choices 5-7): an infinite plate with a circular hole
  * under remote uniaxial tension sigma0 along x, modelled by a quarter of a finite square
  * plate with the exact Kirsch tractions on its outer edges, and solved by strong-form
  * collocation (MFREE_FORM_COLLOCATION_PLANE_STRAIN) with SSPH or MSPH shape functions.
@@ -8,7 +8,7 @@
  * (tests/collocation/), so that both run the very same problem.
  *
  * Notation: hole radius a, plate half-width b (the quarter model is [0, b]^2 minus the
- * disc r < a). Spec 001 calls the hole radius b; paper 000 and Timoshenko-Goodier call
+ * disc r < a). Paper 001 calls the hole radius b; paper 000 and Timoshenko-Goodier call
  * it a, as here. */
 #ifndef MFREE_EXAMPLES_PLATE_H
 #define MFREE_EXAMPLES_PLATE_H
@@ -53,7 +53,7 @@ typedef struct {
   int layout;             /* PLATE_LAYOUT_* */
   int hole_corner;        /* PLATE_CORNER_* */
   int search;             /* pair support: MFREE_SEARCH_GATHER, W(x_i - x_j, h_i) with
-                             particle i's own h_i (spec 001 3, "W_i"; the default), or
+                             particle i's own h_i (001 eq 3.3, "W_i"; the default), or
                              MFREE_SEARCH_SYMMETRIC_MEAN / _MAX, h_ij = (h_i + h_j)/2 or
                              max(h_i, h_j) (measured, not the paper's reading) */
   int patch;              /* nonzero: uniform tension sigma_11 = sigma0 everywhere (its
@@ -140,7 +140,8 @@ enum {
 int plate_particles(const plate_config_t *cfg, int *n, double **x, double **vol, double **h,
                     int32_t **tag);
 
-/* Kirsch solution (spec 001 (6.18) with erratum 3, spec 000 section 6.2.2) at (x, y),
+/* Kirsch solution (001 eq 6.18 with docs/papers.md, paper 001, errata 2; 000 eqs 127-129
+ * and docs/papers.md, paper 000, choices 2) at (x, y),
  * r >= a: stresses s = {s11, s22, s12}; plane-strain displacements u = {u1, u2}. */
 void plate_kirsch_stress(double a, double sigma0, double x, double y, double s[3]);
 void plate_kirsch_displacement(double a, double sigma0, double young, double poisson,

@@ -2,7 +2,7 @@
  * its application to elastic problems", Comput Mech 43 (2009) 321-340), Sect. 6.3:
  * stress concentration around a circular hole in an infinite plate under remote
  * uniaxial tension, by strong-form collocation with SSPH and MSPH shape functions
- * (spec 001 section 8.3, errata 3, 4 and 11).
+ * (docs/papers.md, paper 001: errata 2, 3 and choices 5-7).
  *
  * Setup (plate.c has the details): a quarter of a square plate [0, b]^2 with a hole of
  * radius a = 1, exact Kirsch tractions on x = b and y = b, symmetry conditions on the
@@ -10,7 +10,7 @@
  * Gauss kernel with a = 1.6, quadratic basis, h_i = 1.5 Delta_i; Navier rows at the
  * interior particles (MFREE_FORM_COLLOCATION_PLANE_STRAIN); UMFPACK.
  *
- * The plate size. The paper does not give it (erratum 11). b = 10 a is used: with the
+ * The plate size. The paper does not give it (docs/papers.md, paper 001, choices 5). b = 10 a is used: with the
  * paper's 11 (21) particles on the quarter hole and 17 (31) rings, graded geometrically
  * from a first radial step of 0.6 a dtheta at the hole (dtheta = pi / (2 (nt - 1)), the
  * angular spacing on the hole), a plate of half-width 10 a takes 203 (679) particles,
@@ -66,7 +66,7 @@
 static const mfree_method_t kMethod[NM] = {MFREE_METHOD_SSPH, MFREE_METHOD_MSPH};
 static const char *const kName[NM] = {"SSPH", "MSPH"};
 
-/* Paper 001 Sect. 6.3 (spec 001 8.3 results table): particles, particles on the
+/* Paper 001 Sect. 6.3 (the results in its text): particles, particles on the
  * quarter hole, error norm of u_2 along x_2 for SSPH and MSPH, CPU seconds. */
 static const int kPaperN[2] = {188, 686};
 static const int kPaperHole[2] = {11, 21};
@@ -78,8 +78,8 @@ static const char *const kSearch[4] = {"", "gather", "max", "mean"}; /* by MFREE
 
 /* What was measured, printed under the table. */
 static const char kNote[] =
-    "The paper's plate size, hole radius and particle arrangement are unknown (spec 001\n"
-    "erratum 11): compare orderings and rates, not the absolute errors. e(u2) scales as\n"
+    "The paper's plate size, hole radius and particle arrangement are unknown (docs/papers.md,\n"
+    "paper 001, choices 5): compare orderings and rates, not the absolute errors. e(u2) scales as\n"
     "a^(3/2) with the hole radius a at a fixed shape (--radius 0.3 gives 0.0153 / 0.0175\n"
     "and 0.0020 / 0.0037 on the default rings, the paper's magnitudes).\n"
     "The ordering SSPH <= MSPH comes with the radially refined layer at the hole\n"

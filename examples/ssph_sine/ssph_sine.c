@@ -6,15 +6,16 @@
  * 50, 100, 250, 500: least-squares slopes of ln ||e|| against ln Delta).
  *
  * Particles sit at the cell centres x_i = (i - 1/2)/N, the only layout that reproduces
- * the paper's SSPH numbers (spec 001 section 8.1); norms are sqrt(Delta sum e_i^2)
- * (section 7).
+ * the paper's SSPH numbers; norms are sqrt(Delta sum e_i^2), the midpoint rule
+ * (docs/papers.md, paper 001, choices 1 and 2).
  *
  * Support edge: with h = 1.5 Delta the neighbours i +- 3 lie exactly at distance 2h,
  * where the revised Gauss kernel vanishes but its derivative jumps. SSPH never uses W',
  * so it does not care; MSPH and RKPM do. With h = 1.5 Delta computed in floating point,
  * whether such a pair counts as inside depends on the rounding of x_j - x_i, pair by
  * pair. --edge include / exclude shift h by a relative 1e-12 so that all of them are
- * inside / outside (the paper's "d <= 2" convention is include; see spec 001 section 8.1).
+ * inside / outside (the paper's "d <= 2" convention is include; see docs/papers.md,
+ * paper 001, choices 3).
  *
  * Output: a table (default) or one JSON object (--json) on stdout; the convergence data
  * go to DIR/ssph_sine.dat with a gnuplot script DIR/ssph_sine.gp, which is run to make

@@ -1,15 +1,15 @@
 /* t650: paper 001 (Zhang & Batra, Comput Mech 43 (2009) 321-340) Sect. 6.3, the plate
  * with a circular hole under remote tension (Kirsch), by strong-form collocation
  * (MFREE_FORM_COLLOCATION_PLANE_STRAIN) with SSPH and MSPH shape functions and UMFPACK;
- * spec 001 section 8.3 and claims 32-35 of its section 12. The problem code is the
+ * the errata and choices of docs/papers.md, paper 001. The problem code is the
  * example's (examples/plate_collocation/plate.c): quarter plate [0, 10]^2, hole radius
  * 1, E = 1, nu = 0.25, sigma0 = 1, revised super Gauss a = 1.6, quadratic basis,
  * h_i = 1.5 Delta_i; rings graded from a radially refined layer at the hole (first
  * radial step 0.6 of the hole spacing, plate.h radial_step); 11, 21 and 31 particles on
  * the quarter hole (203, 679 and 1502 particles; the paper: 188 with 11 and 686 with 21).
  *
- * The paper's plate size, hole radius and particle arrangement are unknown (spec 001
- * erratum 11), so its error norms (SSPH 0.0216 / 0.0044, MSPH 0.0304 / 0.0050) are not
+ * The paper's plate size, hole radius and particle arrangement are unknown
+ * (docs/papers.md, paper 001, choices 5), so its error norms (SSPH 0.0216 / 0.0044, MSPH 0.0304 / 0.0050) are not
  * compared directly; the checks are the paper's claims that do not depend on them.
  *
  * The layer at the hole decides the paper's ordering SSPH <= MSPH. With radial_step 0.6
@@ -184,7 +184,7 @@ static int group_teardown(void **state) {
   return 0;
 }
 
-/* ---- the analytic solution (spec 001 claim 32) ---------------------------------------- */
+/* ---- the analytic solution (001 eq 6.18, docs/papers.md, paper 001, errata 2) -------- */
 
 static void kirsch_solution(void **state) {
   (void)state;
@@ -198,7 +198,7 @@ static void kirsch_solution(void **state) {
   for (int q = 0; q < 4; ++q) {
     const double x = pts[q][0], y = pts[q][1], d = 1e-5;
     /* plane-strain Hooke's law of the displacements (central differences) gives the
-     * stresses: the corrected (6.18) of erratum 3 */
+     * stresses: the corrected (6.18), docs/papers.md, paper 001, errata 2 */
     double up[2], um[2], vp[2], vm[2];
     plate_kirsch_displacement(a, s0, E, nu, x + d, y, up);
     plate_kirsch_displacement(a, s0, E, nu, x - d, y, um);
@@ -209,7 +209,7 @@ static void kirsch_solution(void **state) {
     plate_kirsch_stress(a, s0, x, y, s);
     if (!(fabs((lam + 2 * mu) * e11 + lam * e22 - s[0]) < 1e-8 &&
           fabs(lam * e11 + (lam + 2 * mu) * e22 - s[1]) < 1e-8 && fabs(mu * g12 - s[2]) < 1e-8))
-      fail_msg("spec 001 claim 32: Hooke's law of u differs from sigma at (%g, %g)", x, y);
+      fail_msg("001 eq 6.18 corrected: Hooke's law of u differs from sigma at (%g, %g)", x, y);
   }
   /* traction-free hole: sigma_rr = sigma_rtheta = 0 at r = a */
   for (int q = 0; q <= 8; ++q) {
@@ -219,8 +219,8 @@ static void kirsch_solution(void **state) {
     const double srt = (s[1] - s[0]) * c * sn + s[2] * (c * c - sn * sn);
     assert_true(fabs(srr) < 1e-13 && fabs(srt) < 1e-13);
   }
-  /* symmetry: u_1 = 0 on x = 0, u_2 = 0 on y = 0; u_2 on the x_2 axis is spec 001's
-   * theta = pi/2 formula, (1 + nub)/Eb sigma0 (-nub/(1 + nub) x2 - (1 - nub)/(1 + nub)
+  /* symmetry: u_1 = 0 on x = 0, u_2 = 0 on y = 0; u_2 on the x_2 axis is the paper's
+   * theta = pi/2 formula (Sect. 6.3), (1 + nub)/Eb sigma0 (-nub/(1 + nub) x2 - (1 - nub)/(1 + nub)
    * b^2/x2 - b^2/(2 x2) + b^4/(2 x2^3)), nub = nu/(1 - nu), Eb = E/(1 - nu^2) */
   const double Eb = E / (1 - nu * nu), nub = nu / (1 - nu);
   for (int q = 0; q < 6; ++q) {
@@ -403,7 +403,7 @@ static void boundary_fits_are_complete(void **state) {
     }
 }
 
-/* Paper 001 Sect. 6.3, Fig. 15 (spec 001 claim 34): both methods predict the stress
+/* Paper 001 Sect. 6.3, Fig. 15: both methods predict the stress
  * concentration 3.0 at 686 particles. Measured s11(0, a) at 679 particles:
  * SSPH 3.0124 (+0.4 %), MSPH 3.0044 (+0.1 %); at 1502: 2.9999, 2.9980; at 203: 3.104,
  * 3.058 (not checked, the paper claims only 686). (The shape functions applied to the
@@ -423,7 +423,7 @@ static void stress_concentration(void **state) {
     assert_true(fabs(f->res[2][m].scf - 3.0) < fabs(f->res[1][m].scf - 3.0));
 }
 
-/* Paper 001 Sect. 6.3 (spec 001 claim 33): the error of u_2 along x_2 falls with
+/* Paper 001 Sect. 6.3: the error of u_2 along x_2 falls with
  * refinement, about 5x for SSPH from 188 to 686 particles (0.0216 -> 0.0044) and 6x for
  * MSPH (0.0304 -> 0.0050). Measured, 203 -> 679 -> 1502 particles:
  * SSPH 0.09326 -> 0.01224 -> 0.00275 (7.6x, then 4.5x),
@@ -445,7 +445,7 @@ static void error_falls_with_refinement(void **state) {
   }
 }
 
-/* Paper 001 Sect. 6.3 (spec 001 claim 33): SSPH's error is below MSPH's (0.0216 vs
+/* Paper 001 Sect. 6.3: SSPH's error is below MSPH's (0.0216 vs
  * 0.0304 at 188 particles, ratio 0.71; 0.0044 vs 0.0050 at 686, 0.88). Measured on the
  * default rings: 0.09326 / 0.10664 = 0.87 at 203 particles, 0.01224 / 0.02242 = 0.55 at
  * 679, 0.00275 / 0.00491 = 0.56 at 1502. This holds because of the radially refined

@@ -1,5 +1,6 @@
-# Paper 000 (Belytschko, Krongauz, Dolbow, Gerlach, IJNME 43 (1998) 785-819) Sect. 4
-# summary table (spec 000 section 4.11) and paper 001 (Zhang & Batra 2009) Sects. 2-3,
+# Paper 000 (Belytschko, Krongauz, Dolbow, Gerlach, IJNME 43 (1998) 785-819) Sect. 4,
+# the completeness it states per method (docs/papers.md, paper 000, derived results 2),
+# and paper 001 (Zhang & Batra 2009) Sects. 2-3,
 # through examples/completeness --json: the reproduction orders mfree reaches on an
 # irregular 2D cloud, and integrability where the example measures it.
 # Usage: cmake -DEXE=<mfree_completeness> -DOUT=<dir> -P check_completeness.cmake

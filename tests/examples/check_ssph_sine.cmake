@@ -1,6 +1,7 @@
 # Paper 001 (Zhang & Batra, Comput Mech 43 (2009) 321-340) Sect. 6.1 through
 # examples/ssph_sine --json: Table 1 (N = 10), Table 2 (rates), the orderings stated in
-# the text, and the spec 001 8.1 reproduction of both support-edge conventions.
+# the text, and the reproduced values of both support-edge conventions (docs/papers.md,
+# paper 001, choices 3 and derived results 4).
 # Usage: cmake -DEXE=<mfree_ssph_sine> -DOUT=<dir> -P check_ssph_sine.cmake
 cmake_minimum_required(VERSION 3.20)
 include(${CMAKE_CURRENT_LIST_DIR}/json_checks.cmake)
@@ -16,23 +17,23 @@ foreach(m MSPH SSPH RKPM)
     string(JSON ${m}_r${k} GET "${j}" rates ${m} e${k})
   endforeach()
 endforeach()
-# 001 Table 1, SSPH column, to the printed digits; spec 001 8.1 [repro] to 5 digits
+# 001 Table 1, SSPH column, to the printed digits; reproduced values to 5 digits
 expect_range(${SSPH_e0} 0.01875 0.01885 "001 Table 1, SSPH, ||e||_0 = 1.88E-2")
 expect_range(${SSPH_e1} 1.205 1.215 "001 Table 1, SSPH, ||e||_1 = 1.21")
 expect_range(${SSPH_e2} 17.15 17.25 "001 Table 1, SSPH, ||e||_2 = 17.2")
-expect_range(${SSPH_e0} 0.0187895 0.0187905 "spec 001 8.1 [repro], SSPH N = 10, ||e||_0 = 1.8790e-2")
-expect_range(${SSPH_e1} 1.21475 1.21485 "spec 001 8.1 [repro], SSPH N = 10, ||e||_1 = 1.2148")
-expect_range(${SSPH_e2} 17.1785 17.1795 "spec 001 8.1 [repro], SSPH N = 10, ||e||_2 = 1.7179e+1")
+expect_range(${SSPH_e0} 0.0187895 0.0187905 "001 Sect. 6.1, reproduced, SSPH N = 10, ||e||_0 = 1.8790e-2")
+expect_range(${SSPH_e1} 1.21475 1.21485 "001 Sect. 6.1, reproduced, SSPH N = 10, ||e||_1 = 1.2148")
+expect_range(${SSPH_e2} 17.1785 17.1795 "001 Sect. 6.1, reproduced, SSPH N = 10, ||e||_2 = 1.7179e+1")
 # 001 Table 1: RKPM ||e||_0 = SSPH ||e||_0 (identical function estimates, 001 Sect. 4)
 expect_range(${RKPM_e0} 0.0187895 0.0187905 "001 Table 1 / Sect. 4: RKPM ||e||_0 equals SSPH's (1.8790e-2)")
-# 001 Table 2, SSPH column (+-0.03) and spec 001 8.1 slopes 3.541 / 1.957 / 1.493
+# 001 Table 2, SSPH column (+-0.03) and the reproduced slopes 3.541 / 1.957 / 1.493
 expect_range(${SSPH_r0} 3.51 3.57 "001 Table 2, SSPH, rate of ||e||_0 = 3.54")
 expect_range(${SSPH_r1} 1.93 1.99 "001 Table 2, SSPH, rate of ||e||_1 = 1.96")
 expect_range(${SSPH_r2} 1.46 1.52 "001 Table 2, SSPH, rate of ||e||_2 = 1.49")
-expect_range(${SSPH_r0} 3.5405 3.5415 "spec 001 8.1 [repro] SSPH slope 3.541")
-expect_range(${SSPH_r1} 1.9565 1.9575 "spec 001 8.1 [repro] SSPH slope 1.957")
-expect_range(${SSPH_r2} 1.4925 1.4935 "spec 001 8.1 [repro] SSPH slope 1.493")
-expect_range(${RKPM_r0} 3.5405 3.5415 "001 Table 2: RKPM L2 rate equals SSPH's (3.54; spec 8.1 3.541)")
+expect_range(${SSPH_r0} 3.5405 3.5415 "001 Sect. 6.1, reproduced, SSPH slope 3.541")
+expect_range(${SSPH_r1} 1.9565 1.9575 "001 Sect. 6.1, reproduced, SSPH slope 1.957")
+expect_range(${SSPH_r2} 1.4925 1.4935 "001 Sect. 6.1, reproduced, SSPH slope 1.493")
+expect_range(${RKPM_r0} 3.5405 3.5415 "001 Table 2: RKPM L2 rate equals SSPH's (3.54; reproduced 3.541)")
 # 001 Sect. 6.1, text under Table 1: SSPH norms all below MSPH's; RKPM smallest H1 and
 # largest H2
 foreach(k 0 1 2)
@@ -64,7 +65,7 @@ else()
   expect_equal(${nrows} 7 "examples/ssph_sine data file rows (N = 10 ... 500)")
 endif()
 
-# ---- all neighbours at exactly 2h inside (the paper's d <= 2): spec 001 8.1 variant ----
+# ---- all neighbours at exactly 2h inside (the paper's d <= 2): reproduced variant ----
 run_json(j --json --no-plot --edge include --out ${OUT})
 foreach(m MSPH RKPM)
   foreach(k 0 1 2)
@@ -72,16 +73,16 @@ foreach(m MSPH RKPM)
     string(JSON ${m}_r${k} GET "${j}" rates ${m} e${k})
   endforeach()
 endforeach()
-expect_range(${MSPH_e0} 0.03665 0.03675 "spec 001 8.1 [repro], MSPH edge included, ||e||_0 = 3.67e-2")
-expect_range(${MSPH_e1} 1.465 1.475 "spec 001 8.1 [repro], MSPH edge included, ||e||_1 = 1.47")
-expect_range(${MSPH_e2} 21.25 21.35 "spec 001 8.1 [repro], MSPH edge included, ||e||_2 = 21.3")
-expect_range(${RKPM_e1} 0.7205 0.7215 "spec 001 8.1 [repro], RKPM edge included, ||e||_1 = 0.721")
-expect_range(${RKPM_e2} 33.35 33.45 "spec 001 8.1 [repro], RKPM edge included, ||e||_2 = 33.4")
-expect_range(${MSPH_r0} 3.5465 3.5475 "spec 001 8.1 [repro], MSPH edge included, rate 3.547")
-expect_range(${MSPH_r1} 1.9405 1.9415 "spec 001 8.1 [repro], MSPH edge included, rate 1.941")
-expect_range(${MSPH_r2} 1.4925 1.4935 "spec 001 8.1 [repro], MSPH edge included, rate 1.493")
-expect_range(${RKPM_r1} 1.8765 1.8775 "spec 001 8.1 [repro], RKPM edge included, rate 1.877")
-expect_range(${RKPM_r2} 1.5095 1.5105 "spec 001 8.1 [repro], RKPM edge included, rate 1.510")
+expect_range(${MSPH_e0} 0.03665 0.03675 "001 Sect. 6.1, reproduced, MSPH edge included, ||e||_0 = 3.67e-2")
+expect_range(${MSPH_e1} 1.465 1.475 "001 Sect. 6.1, reproduced, MSPH edge included, ||e||_1 = 1.47")
+expect_range(${MSPH_e2} 21.25 21.35 "001 Sect. 6.1, reproduced, MSPH edge included, ||e||_2 = 21.3")
+expect_range(${RKPM_e1} 0.7205 0.7215 "001 Sect. 6.1, reproduced, RKPM edge included, ||e||_1 = 0.721")
+expect_range(${RKPM_e2} 33.35 33.45 "001 Sect. 6.1, reproduced, RKPM edge included, ||e||_2 = 33.4")
+expect_range(${MSPH_r0} 3.5465 3.5475 "001 Sect. 6.1, reproduced, MSPH edge included, rate 3.547")
+expect_range(${MSPH_r1} 1.9405 1.9415 "001 Sect. 6.1, reproduced, MSPH edge included, rate 1.941")
+expect_range(${MSPH_r2} 1.4925 1.4935 "001 Sect. 6.1, reproduced, MSPH edge included, rate 1.493")
+expect_range(${RKPM_r1} 1.8765 1.8775 "001 Sect. 6.1, reproduced, RKPM edge included, rate 1.877")
+expect_range(${RKPM_r2} 1.5095 1.5105 "001 Sect. 6.1, reproduced, RKPM edge included, rate 1.510")
 # the paper, within the tolerance that holds for this convention (see t410):
 # Table 1 MSPH 1.40 / 20.1, RKPM 0.59 / 32.8 within 25 %; Table 2 MSPH within 0.03
 expect_range(${MSPH_e1} 1.05 1.75 "001 Table 1, MSPH ||e||_1 = 1.40 (+-25%)")

@@ -70,7 +70,7 @@ program t301_kernels_normalisation_f
   call check_ok(ctx, mfree_kernel_get_normalization(ctx, MFREE_KERNEL_CUBIC_SPLINE, &
                                                     2_c_int32_t, 0.0_c_double, c), 'C 2D')
   call check_close(c, 10 / (7 * pi), 1e-14_c_double, &
-                   'cubic spline 2D: 10/(7 pi) (paper 000 eq 26, spec 000 sect. 3.1)')
+                   'cubic spline 2D: 10/(7 pi) (paper 000 eq 26 in 2D)')
   call check_ok(ctx, mfree_kernel_get_normalization(ctx, MFREE_KERNEL_CUBIC_SPLINE, &
                                                     1_c_int32_t, 0.0_c_double, c), 'C 1D')
   call check_close(c, 2.0_c_double / 3, 1e-14_c_double, 'cubic spline 1D: 2/3 (000 eq 26)')

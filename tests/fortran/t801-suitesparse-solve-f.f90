@@ -2,7 +2,7 @@
 !>  A. strong-form collocation of -Lap u = f with SSPH (order 2) on a jittered 9 x 9
 !>     cloud of the unit square, u quadratic, u = g on the boundary by row replacement,
 !>     solved with UMFPACK and KLU: SSPH reproduces quadratics in the value and Hessian
-!>     tables exactly (paper 001 Sect. 3, spec 001 claim 7), so the exact nodal values
+!>     tables exactly (paper 001 Sect. 3, consistency), so the exact nodal values
 !>     solve the discrete system and the error is round-off (tolerance 1e-9, as t601);
 !>  B. Bubnov-Galerkin Laplace with MLS (order 1), background Gauss cells and Nitsche's
 !>     method for u = g on the whole boundary, u linear, solved with CHOLMOD (Bubnov +

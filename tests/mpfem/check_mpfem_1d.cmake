@@ -1,6 +1,6 @@
 # Paper 004 Example B through examples/mpfem_1d --json (label mpfem):
-#  - with 3 Gauss points, the spec note's reproduction (Sect. 3.4) at h = 0.002 to 1e-3
-#    relative: FEM L2 2.5006e-4, H1 3.9548e-1; MPFEM L2 2.0602e-5, H1(22) 6.1361e-2;
+#  - with 3 Gauss points, the reproduced values (docs/papers.md, paper 004, reproduction)
+#    at h = 0.002 to 1e-3 relative: FEM L2 2.5006e-4, H1 3.9548e-1; MPFEM L2 2.0602e-5, H1(22) 6.1361e-2;
 #  - the paper's rates (Sect. 3.2) on the last pair of spacings: L2 2 +- 0.15 for both,
 #    MPFEM H1 in [1.5, 2], FEM H1 about 1;
 #  - with 6 Gauss points (the coarse meshes' load quadrature resolved), MPFEM L2 below
@@ -17,10 +17,10 @@ string(JSON fl2 GET "${j}" fem L2 5)
 string(JSON fh1 GET "${j}" fem H1 5)
 string(JSON ml2 GET "${j}" mpfem L2 5)
 string(JSON mh1 GET "${j}" mpfem H1 5)
-expect_range(${fl2} 2.4981e-4 2.5031e-4 "spec 004 3.4: FEM L2 at h = 0.002 = 2.5006e-4")
-expect_range(${fh1} 0.39508 0.39588 "spec 004 3.4: FEM H1 at h = 0.002 = 3.9548e-1")
-expect_range(${ml2} 2.0581e-5 2.0623e-5 "spec 004 3.4: MPFEM L2 at h = 0.002 = 2.0602e-5")
-expect_range(${mh1} 0.061300 0.061422 "spec 004 3.4: MPFEM H1(22) at h = 0.002 = 6.1361e-2")
+expect_range(${fl2} 2.4981e-4 2.5031e-4 "004 Example B, reproduced: FEM L2 at h = 0.002 = 2.5006e-4")
+expect_range(${fh1} 0.39508 0.39588 "004 Example B, reproduced: FEM H1 at h = 0.002 = 3.9548e-1")
+expect_range(${ml2} 2.0581e-5 2.0623e-5 "004 Example B, reproduced: MPFEM L2 at h = 0.002 = 2.0602e-5")
+expect_range(${mh1} 0.061300 0.061422 "004 Example B, reproduced: MPFEM H1(22) at h = 0.002 = 6.1361e-2")
 string(JSON rfl GET "${j}" rates fem L2 4)
 string(JSON rfh GET "${j}" rates fem H1 4)
 string(JSON rml GET "${j}" rates mpfem L2 4)

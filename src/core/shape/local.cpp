@@ -151,7 +151,7 @@ bool check_rcond(Site &s, const MatA &A, const Solver &solver) {
 
 // Moving least squares (MLS, weights w) and RKPM (weights w V), order k, with true
 // derivatives: Phi_j = omega_j gamma . p_j, M gamma = p(0), differentiated with the
-// shift point frozen at the site (spec 000 section 4.3).
+// shift point frozen at the site (paper 000 Sect. 4.3; docs/papers.md, paper 000, choices 1).
 //
 // L (basis size) is a template parameter, so that the moment matrices are fixed-size
 // and live in registers and on the stack; M and its first derivatives M_,i (symmetric,
@@ -412,7 +412,8 @@ int msph(Site &s, int order) {
   return 0;
 }
 
-// Derivative corrections with alpha = A^-T (spec 000 sections 4.6, 4.8, 4.9):
+// Derivative corrections with alpha = A^-T (paper 000 Sects. 4.4.3, 4.4.5, 4.4.6; the
+// transpose: docs/papers.md, paper 000, errata 4):
 // A_ab = sum_j p_a(j) q_b(j); the corrected functions are (A^-T q_j)_k. p and q are
 // n x m arrays; writes C = A^-T into coef (m x m, row-major).
 // (m is 1..4: a compile-time size keeps A and its LU in registers.)
