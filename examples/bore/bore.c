@@ -1,5 +1,6 @@
-/* Bore between two water levels (paper 003 Sect. 7.2, Figs. 8-9; spec 003 section 3.2) by
- * the Galerkin-SPH fluid of paper 003, its speed against the shallow-water bore.
+/* Bore between two water levels (paper 003 Sect. 7.2, Figs. 8-9; docs/papers.md, paper
+ * 003, choices 2) by the Galerkin-SPH fluid of paper 003, its speed against the
+ * shallow-water bore.
  *
  * Set-up (the paper gives no dimensions; these are ours). A tank of length --tank L
  * (default 1.5 m) holds water at rest at depth h1 = 0.1 m over x < --deep Ld (default

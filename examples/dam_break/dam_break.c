@@ -4,7 +4,7 @@
  * Set-up. A column of width a and height 2a (Martin & Moyce's n^2 = 2; default
  * a = 0.05715 m = 2.25 in, their column) stands at the left end of a tank of length L =
  * --tank a (default 5a) and is released at t = 0. Everything else is paper 003 Sect. 7.1
- * (spec 003 section 3.1): particles on the cell-centred lattice of spacing d = a / nx,
+ * (docs/papers.md, paper 003, choices 1): particles on the cell-centred lattice of spacing d = a / nx,
  * h = 1.5 d, rho0 = 1000, gamma = 7, kappa = 100 rho0 (2 g H) / gamma with H = 2a (eq 125),
  * mu = 0.5, hydrostatic initial densities (eq 65), masses rho_i d^2, MLS with a linear
  * basis, nodal integration, Galerkin lumped mass (eq 56), leap-frog (eqs 108-110) with
@@ -129,7 +129,7 @@ int main(int argc, char **argv) {
   if (fc_run_prepare(&o.run)) return 1;
   const char *out_dir = o.run.out;
 
-  /* ---- geometry and initial state (spec 003 section 3.1) ---- */
+  /* ---- geometry and initial state (003 Sect. 7.1; docs/papers.md, paper 003, choices 1) */
   const double a = o.a, H = 2.0 * a, L = o.tank * a, d = a / o.nx, h = 1.5 * d;
   const double kappa = 100.0 * kRho0 * 2.0 * kG * H / kGamma; /* 003 eq 125 */
   const double tscale = sqrt(2.0 * kG / a);                   /* T = t sqrt(2 g / a) */

@@ -1,6 +1,6 @@
-/* A circular drop falling onto water at rest (paper 003 Sect. 7.4, Figs. 12-14; spec 003
- * section 3.4 (a)) by the Galerkin-SPH fluid of paper 003: mass, momentum and free fall
- * before the impact.
+/* A circular drop falling onto water at rest (paper 003 Sect. 7.4, Figs. 12-14;
+ * docs/papers.md, paper 003, choices 2) by the Galerkin-SPH fluid of paper 003: mass,
+ * momentum and free fall before the impact.
  *
  * Set-up (the paper gives the drop's speed, 2 m/s, rho0 = 1000, mu = 0.5 and 5,539
  * particles, no dimensions; these are ours). A tank of width --width W (default 0.4 m)

@@ -1,5 +1,5 @@
-/* Gravity current / lock exchange (paper 003 Sect. 7.3, Figs. 10-11; spec 003 section
- * 3.3) by the Galerkin-SPH fluid of paper 003 with two fluids.
+/* Gravity current / lock exchange (paper 003 Sect. 7.3, Figs. 10-11; docs/papers.md,
+ * paper 003, choices 2) by the Galerkin-SPH fluid of paper 003 with two fluids.
  *
  * Set-up. A tank of depth D = 0.06 m holds fluid 1 (rho0 = 1000 kg/m3) on the left over a
  * length --light (default 0.12 m = 2 D) and fluid 2 (rho0 = 1500 kg/m3) on the right over

@@ -1,6 +1,7 @@
 /* Impact of a drop on a rigid structure (paper 003 Sect. 7.4, Figs. 15-17, the
- * fluid-structure example; spec 003 section 3.4 (b)) by the Galerkin-SPH fluid of paper
- * 003: the force history on the structure and its impulse against the fluid's momentum.
+ * fluid-structure example; docs/papers.md, paper 003, choices 2) by the Galerkin-SPH
+ * fluid of paper 003: the force history on the structure and its impulse against the
+ * fluid's momentum.
  *
  * Structure model (the paper does not specify one; this is ours): a rigid, fixed,
  * horizontal plate, infinitely stiff and massive, whose top face is a row of wall

@@ -1,5 +1,5 @@
-/* Breaking dam down a ramp (paper 003 Sect. 7.1, Figs. 5-7; spec 003 section 3.1) by the
- * Galerkin-SPH fluid of paper 003.
+/* Breaking dam down a ramp (paper 003 Sect. 7.1, Figs. 5-7; docs/papers.md, paper 003,
+ * choices 1) by the Galerkin-SPH fluid of paper 003.
  *
  * Set-up. A square water column of side H = 0.1 m (--nx particles across, 50 = the
  * paper's 2500) stands on a short floor against the left wall; at t = 0 the gate on its

@@ -5,8 +5,10 @@
 #    heading ids: lower case, punctuation dropped, spaces to hyphens, -1, -2 for repeats);
 #  - no document, source, script or build file refers to a path outside the repository
 #    (the project's shared folder beside it, or the absolute path of a checkout);
-#  - the public headers name no test ids and cite papers by their docs/references.md key
-#    (t909 is the documents check as a whole: links, paths, headers).
+#  - the public headers name no test ids and cite papers by their docs/references.md key;
+#  - no document, source, script or message cites the team's private notes on the papers
+#    (a "spec 00N section X" citation): a reader has the papers' own numbers and docs/papers.md
+#    (t909 is the documents check as a whole: links, paths, headers, citations).
 # Links inside code blocks and code spans are not links and are skipped, as are URLs.
 cmake_minimum_required(VERSION 3.25)
 if(NOT DEFINED ROOT)
@@ -137,6 +139,14 @@ foreach(f IN LISTS sources)
     file(RELATIVE_PATH rel "${ROOT}" "${f}")
     list(GET hits 0 first)
     string(APPEND errors "  ${rel}: refers to a path outside the repository: ${first}\n")
+  endif()
+  # the notes are not in the repository: cite the paper's section, equation or table, or
+  # docs/papers.md for errata and reproduction choices (written so as not to match here)
+  file(STRINGS "${f}" hits REGEX "[Ss]pe[c] 00[0-9]")
+  if(hits)
+    file(RELATIVE_PATH rel "${ROOT}" "${f}")
+    list(GET hits 0 first)
+    string(APPEND errors "  ${rel}: cites the private spec notes (cite the paper or docs/papers.md): ${first}\n")
   endif()
 endforeach()
 
