@@ -69,38 +69,17 @@ static void run(int dim, double ntarget, int reps) {
   const double radius = bench_radius(dim), h0 = radius / 2.0;
   double *h = malloc(sizeof(double) * n), *mass = malloc(sizeof(double) * n);
   double *rho = malloc(sizeof(double) * n);
-  uint64_t seed = 7;
+  bench_pair_supports(n, h0, h);
   for (int i = 0; i < n; ++i) {
-    h[i] = h0 * (1.0 + 0.02 * bench_rand(&seed));
     rho[i] = 1000.0;
     mass[i] = 1000.0;
   }
   mfree_context_t *ctx = NULL;
   CHECK(mfree_context_create(&ctx));
   bench_page_hints(ctx);
-  /* the host's pair list: mfree's own search once (j > i), as a linked-list search
-   * would give it */
-  mfree_particles_t *search = NULL;
-  CHECK(mfree_particles_create(ctx, dim, n, &search));
-  CHECK(mfree_particles_set_positions(search, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW));
-  CHECK(mfree_particles_set_support(search, h, 1, MFREE_BORROW));
-  CHECK(mfree_particles_set_search(search, MFREE_SEARCH_SYMMETRIC_MEAN, 2.0));
-  CHECK(mfree_particles_setup(search));
-  int64_t nnz = 0;
-  CHECK(mfree_particles_get_neighbor_nnz(search, &nnz));
-  int64_t *rowptr = malloc(sizeof(int64_t) * (n + 1));
-  int32_t *cols = malloc(sizeof(int32_t) * nnz);
-  CHECK(mfree_particles_get_neighbors(search, rowptr, cols));
-  int32_t *pi = malloc(sizeof(int32_t) * nnz / 2 + 8), *pj = malloc(sizeof(int32_t) * nnz / 2 + 8);
-  int64_t np = 0;
-  for (int i = 0; i < n; ++i)
-    for (int64_t q = rowptr[i]; q < rowptr[i + 1]; ++q)
-      if (cols[q] > i) {
-        pi[np] = i;
-        pj[np] = cols[q];
-        ++np;
-      }
-  mfree_particles_destroy(&search);
+  int32_t *pi = NULL, *pj = NULL;
+  const int64_t np = bench_half_pairs(ctx, dim, n, x, h, &pi, &pj);
+  if (np < 0) exit(1);
   double *dwdx = malloc(sizeof(double) * dim * np);
   double *gi = malloc(sizeof(double) * dim * np), *gj = malloc(sizeof(double) * dim * np);
   printf("%dD: %d particles, %lld pairs (%.1f neighbours each)\n", dim, n, (long long)np,
@@ -124,14 +103,7 @@ static void run(int dim, double ntarget, int reps) {
     for (int q = 0; q < 5; ++q) {
       mfree_particles_t *ps = NULL;
       mfree_approximant_t *a = NULL;
-      CHECK(mfree_particles_create(ctx, dim, n, &ps));
-      CHECK(mfree_particles_set_positions(ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW));
-      CHECK(mfree_particles_set_support(ps, h, 1, MFREE_BORROW));
-      CHECK(mfree_particles_set_masses(ps, mass, 1, MFREE_BORROW));
-      CHECK(mfree_particles_set_densities(ps, rho, 1, MFREE_BORROW));
-      CHECK(mfree_particles_set_search(ps, MFREE_SEARCH_SYMMETRIC_MEAN, 2.0));
-      CHECK(mfree_approximant_create(ctx, ps, (mfree_method_t)methods[q], &a));
-      CHECK(mfree_approximant_set_derivatives(a, MFREE_DERIV_GRADIENT));
+      CHECK(bench_pair_set(ctx, dim, n, x, h, mass, rho, (mfree_method_t)methods[q], &ps, &a));
       double best_m = 1e30, best_h = 1e30, part[3] = {0, 0, 0};
       for (int r = 0; r < reps; ++r) {
         double t0 = bench_now();
@@ -171,8 +143,6 @@ static void run(int dim, double ntarget, int reps) {
   free(h);
   free(mass);
   free(rho);
-  free(rowptr);
-  free(cols);
   free(pi);
   free(pj);
   free(dwdx);

@@ -77,6 +77,68 @@ static inline double bench_radius(int dim) {
   return dim == 2 ? sqrt(21.0 / pi) : cbrt(57.0 * 3.0 / (4.0 * pi));
 }
 
+/* The pair-list workload (bench_pairs, scripts/bench-ab): supports h_i = h0 (1 + 0.02 u_i)
+ * with u_i uniform in [-1, 1), and the host's half pair list (i, j > i), each pair once in
+ * particle order, from the library's own search once (symmetric mean h_ij, kappa 2) as a
+ * linked-list search would give it; *pi and *pj malloc'ed. Returns the pair count, or -1
+ * with the context's message on stderr when a call failed. */
+static inline void bench_pair_supports(int n, double h0, double *h) {
+  uint64_t seed = 7;
+  for (int i = 0; i < n; ++i) h[i] = h0 * (1.0 + 0.02 * bench_rand(&seed));
+}
+static inline int64_t bench_half_pairs(mfree_context_t *ctx, int dim, int n, const double *x,
+                                       const double *h, int32_t **pi, int32_t **pj) {
+  mfree_particles_t *search = NULL;
+  int64_t nnz = 0, np = 0;
+  if (mfree_particles_create(ctx, dim, n, &search) != MFREE_SUCCESS ||
+      mfree_particles_set_positions(search, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW) != MFREE_SUCCESS ||
+      mfree_particles_set_support(search, h, 1, MFREE_BORROW) != MFREE_SUCCESS ||
+      mfree_particles_set_search(search, MFREE_SEARCH_SYMMETRIC_MEAN, 2.0) != MFREE_SUCCESS ||
+      mfree_particles_setup(search) != MFREE_SUCCESS ||
+      mfree_particles_get_neighbor_nnz(search, &nnz) != MFREE_SUCCESS) {
+    char msg[512] = "";
+    mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+    fprintf(stderr, "bench_half_pairs: %s\n", msg);
+    mfree_particles_destroy(&search);
+    return -1;
+  }
+  int64_t *rowptr = (int64_t *)malloc(sizeof(int64_t) * (size_t)(n + 1));
+  int32_t *cols = (int32_t *)malloc(sizeof(int32_t) * (size_t)nnz);
+  mfree_particles_get_neighbors(search, rowptr, cols);
+  *pi = (int32_t *)malloc(sizeof(int32_t) * (size_t)(nnz / 2 + 8));
+  *pj = (int32_t *)malloc(sizeof(int32_t) * (size_t)(nnz / 2 + 8));
+  for (int i = 0; i < n; ++i)
+    for (int64_t q = rowptr[i]; q < rowptr[i + 1]; ++q)
+      if (cols[q] > i) {
+        (*pi)[np] = i;
+        (*pj)[np] = cols[q];
+        ++np;
+      }
+  mfree_particles_destroy(&search);
+  free(rowptr);
+  free(cols);
+  return np;
+}
+
+/* The pair-list workload's particle set (positions, supports, masses and densities
+ * borrowed; symmetric-mean search, kappa 2) and its approximant of method m with the
+ * gradient table; the first failing call's status. */
+static inline mfree_status_t bench_pair_set(mfree_context_t *ctx, int dim, int n, const double *x,
+                                            const double *h, const double *mass, const double *rho,
+                                            mfree_method_t m, mfree_particles_t **ps,
+                                            mfree_approximant_t **a) {
+  mfree_status_t st;
+  if ((st = mfree_particles_create(ctx, dim, n, ps)) != MFREE_SUCCESS ||
+      (st = mfree_particles_set_positions(*ps, x, MFREE_LAYOUT_AOS, dim, MFREE_BORROW)) != MFREE_SUCCESS ||
+      (st = mfree_particles_set_support(*ps, h, 1, MFREE_BORROW)) != MFREE_SUCCESS ||
+      (st = mfree_particles_set_masses(*ps, mass, 1, MFREE_BORROW)) != MFREE_SUCCESS ||
+      (st = mfree_particles_set_densities(*ps, rho, 1, MFREE_BORROW)) != MFREE_SUCCESS ||
+      (st = mfree_particles_set_search(*ps, MFREE_SEARCH_SYMMETRIC_MEAN, 2.0)) != MFREE_SUCCESS ||
+      (st = mfree_approximant_create(ctx, *ps, m, a)) != MFREE_SUCCESS)
+    return st;
+  return mfree_approximant_set_derivatives(*a, MFREE_DERIV_GRADIENT);
+}
+
 /* Threads for the "all cores" runs: MFREE_BENCH_THREADS, else 0 (all cores). */
 static inline int bench_threads(void) {
   const char *s = getenv("MFREE_BENCH_THREADS");
