@@ -3,7 +3,9 @@
 # failure, the mass is exact (constant particle masses, none lost through a wall, and the
 # Galerkin lumped masses of 003 eq 57 summing to the total), and the surge front
 # Z = z/a lies within 20 % of Martin & Moyce (1952, Phil. Trans. R. Soc. A 244, Fig. 3,
-# n^2 = 2; data/martin_moyce_1952.csv of the repository) at their points with 1 <= T <= 3.
+# n^2 = 2; data/martin_moyce_1952.csv of the repository) at their points with 1 <= T <= 3;
+# over 0.5 <= T <= 3 the experiment lags the model by less than 0.25 in T (the JSON's
+# time_offset), at nx = 24 by 0.10 to 0.20 at every point (a lag, not a speed difference).
 # Usage: cmake -DEXE=<mfree_dam_break> -DOUT=<dir> -DDATA=<csv> [-DNX=<n>|default] -P check_dam_break.cmake
 cmake_minimum_required(VERSION 3.20)
 include(${CMAKE_CURRENT_LIST_DIR}/../examples/json_checks.cmake)
@@ -50,7 +52,19 @@ expect_equal("${compared}" "3" "Martin & Moyce points with 1 <= T <= 3 (T = 1.21
 # SPH fronts typically run 10-15 % ahead of this experiment; measured 3.97 % at nx = 10,
 # 10.05 % at the default nx = 24
 expect_range(${dev} 0 0.20 "Martin & Moyce (1952) Fig. 3, n^2 = 2: front within 20 % for 1 <= T <= 3")
-if(NOT NX STREQUAL "default")
+# Over the issue's range 0.5 <= T <= 3 (4 points) the deviation is a lag of the experiment,
+# nearly constant in T: the simulated front moves at the experiment's speed (measured at
+# nx = 24: 0.133 to 0.166 in T, mean 0.147; 10.1 % at most, at T = 1.219).
+string(JSON compared_wide GET "${j}" compared_wide)
+string(JSON lag GET "${j}" time_offset 0)
+string(JSON lag_min GET "${j}" time_offset 1)
+string(JSON lag_max GET "${j}" time_offset 2)
+expect_equal("${compared_wide}" "4" "Martin & Moyce points with 0.5 <= T <= 3")
+expect_range(${lag} 0 0.25 "examples/dam_break: the experiment lags the model by less than 0.25 in T")
+if(NX STREQUAL "default")
+  expect_range(${lag_min} 0.10 0.20 "examples/dam_break: the smallest lag at nx = 24")
+  expect_range(${lag_max} 0.10 0.20 "examples/dam_break: the largest lag at nx = 24")
+else()
   expect_plot(${OUT}/front.png)
 endif()
-message(STATUS "dam break front: max relative deviation from Martin & Moyce ${dev} (${compared} points)")
+message(STATUS "dam break front: max relative deviation from Martin & Moyce ${dev} (${compared} points); lag of the experiment ${lag} (${lag_min} to ${lag_max})")
