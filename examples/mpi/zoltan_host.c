@@ -1,7 +1,7 @@
-/* zoltan_host: a C host on MPI ranks with libmfree_mpi for its halo and Zoltan for its
- * partition. Each rank starts with a block of rows of an m x m perturbed lattice on the
- * unit square (global ids = lattice index), Zoltan's recursive coordinate bisection (RCB)
- * repartitions them and the host migrates its particles (one MPI_Alltoallv), then
+/* zoltan_host: a C host on MPI ranks with libmfree_mpi for its halo and its partition.
+ * Each rank starts with a block of rows of an m x m perturbed lattice on the unit square
+ * (global ids = lattice index), Zoltan's recursive coordinate bisection (RCB) repartitions
+ * them and libmfree_mpi's migration moves the particles (mfree_migration_*), then
  * libmfree_mpi builds the ghost layer and every step exchanges positions and the field,
  * and mfree computes the Randles-Libersky gradient of a linear field at the owned
  * particles, exact to round-off, with the bits of a one-rank run.
@@ -17,7 +17,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <zoltan.h>
 
 #include <mfree_mpi.h>
 
@@ -37,105 +36,27 @@ static void die(mfree_context_t *ctx, mfree_status_t st, const char *what) {
   MPI_Abort(MPI_COMM_WORLD, 3);
 }
 
-/* ---- Zoltan's callbacks over the owned particles ---- */
-static int z_num_obj(void *data, int *ierr) {
-  *ierr = ZOLTAN_OK;
-  return (int)((owned_t *)data)->n;
-}
-static void z_obj_list(void *data, int ng, int nl, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int wdim, float *w,
-                       int *ierr) {
-  const owned_t *o = data;
-  (void)ng, (void)nl, (void)wdim, (void)w;
-  for (int64_t k = 0; k < o->n; ++k) {
-    gids[k] = (ZOLTAN_ID_TYPE)o->id[k];
-    lids[k] = (ZOLTAN_ID_TYPE)k;
-  }
-  *ierr = ZOLTAN_OK;
-}
-static int z_num_geom(void *data, int *ierr) {
-  (void)data;
-  *ierr = ZOLTAN_OK;
-  return 2;
-}
-static void z_geom(void *data, int ng, int nl, int nobj, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int ndim,
-                   double *g, int *ierr) {
-  const owned_t *o = data;
-  (void)ng, (void)nl, (void)gids;
-  for (int k = 0; k < nobj; ++k)
-    for (int d = 0; d < ndim; ++d) g[k * ndim + d] = o->x[2 * (size_t)lids[k] + d];
-  *ierr = ZOLTAN_OK;
-}
-
-/* RCB parts from Zoltan, then the particles moved to their parts (MPI_Alltoallv). */
-static void partition(owned_t *o, int rank, int size) {
-  float ver;
-  Zoltan_Initialize(0, NULL, &ver);
-  struct Zoltan_Struct *zz = Zoltan_Create(MPI_COMM_WORLD);
-  Zoltan_Set_Param(zz, "DEBUG_LEVEL", "0");
-  Zoltan_Set_Param(zz, "LB_METHOD", "RCB");
-  Zoltan_Set_Param(zz, "NUM_GID_ENTRIES", "1");
-  Zoltan_Set_Param(zz, "NUM_LID_ENTRIES", "1");
-  Zoltan_Set_Param(zz, "RETURN_LISTS", "EXPORT");
-  Zoltan_Set_Num_Obj_Fn(zz, z_num_obj, o);
-  Zoltan_Set_Obj_List_Fn(zz, z_obj_list, o);
-  Zoltan_Set_Num_Geom_Fn(zz, z_num_geom, o);
-  Zoltan_Set_Geom_Multi_Fn(zz, z_geom, o);
-  int changes, ngid, nlid, nimp, nexp, *iproc, *ipart, *eproc, *epart;
-  ZOLTAN_ID_PTR igid, ilid, egid, elid;
-  if (Zoltan_LB_Partition(zz, &changes, &ngid, &nlid, &nimp, &igid, &ilid, &iproc, &ipart, &nexp, &egid, &elid,
-                          &eproc, &epart) != ZOLTAN_OK) {
-    fprintf(stderr, "zoltan_host: Zoltan_LB_Partition failed\n");
+/* RCB regions from Zoltan through libmfree_mpi's migration, which moves the positions
+ * and ids to their new owners (one MPI_Alltoallv). */
+static void partition(mfree_context_t *ctx, owned_t *o) {
+  mfree_migration_t *mig = NULL;
+  int32_t n_new = 0;
+  die(ctx, mfree_migration_create(ctx, MPI_COMM_WORLD, 2, &mig), "migration create");
+  die(ctx, mfree_migration_set_partitioner(mig, MFREE_PARTITIONER_RCB, 1.05), "partitioner");
+  die(ctx, mfree_migration_partition(mig, (int32_t)o->n, o->x, 2, 1, &n_new), "partition");
+  /* the arrays grow to the larger of the counts before and after */
+  const int64_t cap = n_new > o->n ? n_new : o->n;
+  o->x = realloc(o->x, sizeof(double) * 2 * (size_t)(cap + 1));
+  o->id = realloc(o->id, sizeof(int64_t) * (size_t)(cap + 1));
+  if (!o->x || !o->id) {
+    fprintf(stderr, "zoltan_host: out of memory\n");
     MPI_Abort(MPI_COMM_WORLD, 4);
   }
-  /* the export lists name the particles that change part */
-  int *dest = malloc(sizeof(int) * (size_t)(o->n + 1));
-  for (int64_t k = 0; k < o->n; ++k) dest[k] = rank;
-  for (int k = 0; k < nexp; ++k) dest[elid[k]] = epart[k];
-  Zoltan_LB_Free_Part(&igid, &ilid, &iproc, &ipart);
-  Zoltan_LB_Free_Part(&egid, &elid, &eproc, &epart);
-  Zoltan_Destroy(&zz);
-  int *sc = calloc((size_t)size, sizeof(int)), *rc = calloc((size_t)size, sizeof(int));
-  int *sd = calloc((size_t)size, sizeof(int)), *rd = calloc((size_t)size, sizeof(int));
-  for (int64_t k = 0; k < o->n; ++k) ++sc[dest[k]];
-  MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, MPI_COMM_WORLD);
-  for (int p = 1; p < size; ++p) {
-    sd[p] = sd[p - 1] + sc[p - 1];
-    rd[p] = rd[p - 1] + rc[p - 1];
-  }
-  const int64_t nnew = rd[size - 1] + rc[size - 1];
-  /* records of three doubles: x, y and the id (exact below 2^53) */
-  double *out = malloc(sizeof(double) * 3 * (size_t)(o->n + 1)), *in = malloc(sizeof(double) * 3 * (size_t)(nnew + 1));
-  int *pos = malloc(sizeof(int) * (size_t)size);
-  memcpy(pos, sd, sizeof(int) * (size_t)size);
-  for (int64_t k = 0; k < o->n; ++k) {
-    double *r = out + 3 * (size_t)pos[dest[k]]++;
-    r[0] = o->x[2 * k];
-    r[1] = o->x[2 * k + 1];
-    r[2] = (double)o->id[k];
-  }
-  for (int p = 0; p < size; ++p) {
-    sc[p] *= 3;
-    sd[p] *= 3;
-    rc[p] *= 3;
-    rd[p] *= 3;
-  }
-  MPI_Alltoallv(out, sc, sd, MPI_DOUBLE, in, rc, rd, MPI_DOUBLE, MPI_COMM_WORLD);
-  o->n = nnew;
-  o->x = realloc(o->x, sizeof(double) * 2 * (size_t)(nnew + 1));
-  o->id = realloc(o->id, sizeof(int64_t) * (size_t)(nnew + 1));
-  for (int64_t k = 0; k < nnew; ++k) {
-    o->x[2 * k] = in[3 * k];
-    o->x[2 * k + 1] = in[3 * k + 1];
-    o->id[k] = (int64_t)in[3 * k + 2];
-  }
-  free(out);
-  free(in);
-  free(pos);
-  free(dest);
-  free(sc);
-  free(rc);
-  free(sd);
-  free(rd);
+  die(ctx, mfree_migration_add_field(mig, o->x, 2 * sizeof(double), 2 * sizeof(double)), "field x");
+  die(ctx, mfree_migration_add_field(mig, o->id, sizeof(int64_t), sizeof(int64_t)), "field id");
+  die(ctx, mfree_migration_execute(mig, (int32_t)cap), "migration");
+  o->n = n_new;
+  mfree_migration_destroy(&mig);
 }
 
 static uint64_t mix(uint64_t z) {
@@ -171,12 +92,12 @@ int main(int argc, char **argv) {
     o.x[2 * i + 1] = ((double)(k / m) + 0.5 + 0.2 * ((double)(mix((uint64_t)k + N) >> 11) * 0x1.0p-53 - 0.5)) * dx;
     o.id[i] = k;
   }
-  partition(&o, rank, size);
+  mfree_context_t *ctx = NULL;
+  die(ctx, mfree_context_create(&ctx), "context");
+  partition(ctx, &o);
 
   /* ---- the halo by libmfree_mpi ---- */
-  mfree_context_t *ctx = NULL;
   mfree_halo_t *halo = NULL;
-  die(ctx, mfree_context_create(&ctx), "context");
   die(ctx, mfree_halo_create(ctx, MPI_COMM_WORLD, 2, &halo), "halo create");
   die(ctx, mfree_halo_setup(halo, (int32_t)o.n, o.x, 2, o.id, width), "halo setup");
   int32_t no = 0, ng = 0, nnb = 0;

@@ -5,10 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef MFREE_TEST_ZOLTAN
-#include <zoltan.h>
-#endif
-
 int mpitest_failures = 0;
 
 int mpitest_finish(const char *name) {
@@ -67,43 +63,6 @@ double cloud_max_support(const cloud_t *c) {
   return m;
 }
 
-#ifdef MFREE_TEST_ZOLTAN
-/* Zoltan's view of this rank's starting share: particles i with i % size == rank. */
-typedef struct {
-  const cloud_t *c;
-  int rank, size;
-} zdata_t;
-
-static int z_num_obj(void *data, int *ierr) {
-  const zdata_t *z = data;
-  *ierr = ZOLTAN_OK;
-  return (z->c->n - z->rank + z->size - 1) / z->size;
-}
-static void z_obj_list(void *data, int ng, int nl, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int wdim,
-                       float *w, int *ierr) {
-  const zdata_t *z = data;
-  (void)ng, (void)nl, (void)wdim, (void)w;
-  int k = 0;
-  for (int i = z->rank; i < z->c->n; i += z->size, ++k) {
-    gids[k] = (ZOLTAN_ID_TYPE)i;
-    lids[k] = (ZOLTAN_ID_TYPE)k;
-  }
-  *ierr = ZOLTAN_OK;
-}
-static int z_num_geom(void *data, int *ierr) {
-  *ierr = ZOLTAN_OK;
-  return ((const zdata_t *)data)->c->dim;
-}
-static void z_geom(void *data, int ng, int nl, int nobj, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int ndim,
-                   double *g, int *ierr) {
-  const zdata_t *z = data;
-  (void)ng, (void)nl, (void)lids;
-  for (int k = 0; k < nobj; ++k)
-    for (int d = 0; d < ndim; ++d) g[k * ndim + d] = z->c->x[(size_t)gids[k] * z->c->dim + d];
-  *ierr = ZOLTAN_OK;
-}
-#endif
-
 int decompose(const cloud_t *c, int how, MPI_Comm comm, int *part) {
   int rank, size;
   MPI_Comm_rank(comm, &rank);
@@ -120,34 +79,31 @@ int decompose(const cloud_t *c, int how, MPI_Comm comm, int *part) {
     return 0;
   }
 #ifdef MFREE_TEST_ZOLTAN
-  float ver = 0;
-  if (Zoltan_Initialize(0, NULL, &ver) != ZOLTAN_OK) return -1;
-  struct Zoltan_Struct *zz = Zoltan_Create(comm);
-  zdata_t zd = {c, rank, size};
-  Zoltan_Set_Param(zz, "DEBUG_LEVEL", "0");
-  Zoltan_Set_Param(zz, "LB_METHOD", "RCB");
-  Zoltan_Set_Param(zz, "NUM_GID_ENTRIES", "1");
-  Zoltan_Set_Param(zz, "NUM_LID_ENTRIES", "1");
-  Zoltan_Set_Param(zz, "RETURN_LISTS", "EXPORT");
-  Zoltan_Set_Num_Obj_Fn(zz, z_num_obj, &zd);
-  Zoltan_Set_Obj_List_Fn(zz, z_obj_list, &zd);
-  Zoltan_Set_Num_Geom_Fn(zz, z_num_geom, &zd);
-  Zoltan_Set_Geom_Multi_Fn(zz, z_geom, &zd);
-  int changes, ngid, nlid, nimp, nexp, *iproc, *ipart, *eproc, *epart;
-  ZOLTAN_ID_PTR igid, ilid, egid, elid;
-  const int rc = Zoltan_LB_Partition(zz, &changes, &ngid, &nlid, &nimp, &igid, &ilid, &iproc, &ipart, &nexp,
-                                     &egid, &elid, &eproc, &epart);
-  /* every rank learns every particle's part: the starting share, then the exports */
+  /* Zoltan RCB through libmfree_mpi's migration, from a starting share of particles i with
+   * i % size == rank; every rank learns every particle's part */
+  const int mine_n = (c->n - rank + size - 1) / size;
+  double *xs = malloc(sizeof(double) * (size_t)(mine_n + 1) * (size_t)c->dim);
+  int32_t *dest = malloc(sizeof(int32_t) * (size_t)(mine_n + 1));
   int *mine = malloc(sizeof(int) * (size_t)c->n);
-  for (int i = 0; i < c->n; ++i) mine[i] = i % size == rank ? rank : -1;
-  if (rc == ZOLTAN_OK)
-    for (int k = 0; k < nexp; ++k) mine[egid[k]] = epart[k];
+  for (int i = rank, k = 0; i < c->n; i += size, ++k)
+    memcpy(xs + (size_t)k * c->dim, c->x + (size_t)i * c->dim, sizeof(double) * (size_t)c->dim);
+  mfree_context_t *ctx = NULL;
+  mfree_migration_t *mig = NULL;
+  mfree_context_create(&ctx);
+  int32_t n_new = 0;
+  mfree_status_t st = mfree_migration_create(ctx, comm, c->dim, &mig);
+  if (st == MFREE_SUCCESS) st = mfree_migration_partition(mig, mine_n, xs, c->dim, 1, &n_new);
+  if (st == MFREE_SUCCESS) st = mfree_migration_get_owners(mig, dest, mine_n);
+  for (int i = 0; i < c->n; ++i) mine[i] = -1;
+  if (st == MFREE_SUCCESS)
+    for (int i = rank, k = 0; i < c->n; i += size, ++k) mine[i] = dest[k];
   MPI_Allreduce(mine, part, c->n, MPI_INT, MPI_MAX, comm);
+  mfree_migration_destroy(&mig);
+  mfree_context_destroy(&ctx);
+  free(xs);
+  free(dest);
   free(mine);
-  Zoltan_LB_Free_Part(&igid, &ilid, &iproc, &ipart);
-  Zoltan_LB_Free_Part(&egid, &elid, &eproc, &epart);
-  Zoltan_Destroy(&zz);
-  return rc == ZOLTAN_OK ? 0 : -1;
+  return st == MFREE_SUCCESS ? 0 : -1;
 #else
   (void)part;
   return -1;
