@@ -7,19 +7,19 @@
  *  - independently, by applying VALUE / GRADIENT / DIVERGENCE / HESSIAN / LAPLACIAN to
  *    random polynomial fields written in global coordinates and comparing with their
  *    exact values, derivatives and second derivatives at the sites.
- * Claims (sources): SPH reproduces nothing (000 eq 37, section 4.1); symmetrised SPH
+ * Claims (sources): SPH reproduces nothing (000 eq 37, Sect. 3); symmetrised SPH
  * gives zero gradients of constants but not exact gradients of linear fields (000 eq 47,
- * section 4.4); Shepard reproduces constants with their derivatives, not linear fields
- * (000 eqs 38-42, section 4.2); MLS and RKPM of order k reproduce degree k with true
+ * Sect. 4.4.1); Shepard reproduces constants with their derivatives, not linear fields
+ * (000 eqs 38-42, Sect. 4.2); MLS and RKPM of order k reproduce degree k with true
  * derivatives (000 eqs 43-46; 001 Sect. 4); KB Method 1: Shepard values, linear
  * gradients (000 eqs 55-61); Method 2: linear values and gradients (000 eqs 63-64),
  * order 2 by the same fit; Method 3 linear values and gradients (000 eqs 65-66);
  * Randles-Libersky linear gradients (000 eqs 68-69); Johnson-Beissel exact only for a
  * field linear in one coordinate along that coordinate and fails v = a(x + y)
  * (000 eqs 49-54); MSPH and SSPH of order m: degree m, gradients, Hessians for m >= 2
- * (001 eq 2.15 and Sect. 3, claims 12.A.6-7). Kernels: a method that differentiates the
+ * (001 eq 2.15 and Sect. 3). Kernels: a method that differentiates the
  * kernel rejects the linear kernel, a Hessian that needs W'' rejects the linear and
- * quadratic kernels (001 Sect. 6.2, claim 12.A.9). */
+ * quadratic kernels (001 Sects. 2 and 6.2). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -513,7 +513,7 @@ static void run_case(const mcase_t *mc, const cloud_t *c, mfree_kernel_t kernel,
   assert_ok(ctx, mfree_approximant_set_order(a, mc->order));
   assert_ok(ctx, mfree_approximant_set_derivatives(a, flags));
 
-  /* kernel restrictions (001 Sect. 6.2, claim 12.A.9) */
+  /* kernel restrictions (001 Sects. 2 and 6.2) */
   const int w2_flat = kernel == MFREE_KERNEL_LINEAR || kernel == MFREE_KERNEL_QUADRATIC;
   if (m == MFREE_METHOD_MSPH && (kernel == MFREE_KERNEL_LINEAR || (w2_flat && mc->order >= 2))) {
     /* MSPH moments use W' (and W'' from order 2) even for the values */

@@ -1,16 +1,16 @@
 /* Approximants: integrability and the relations between methods.
- *  - Shepard, MLS and RKPM derivative tables are true derivatives (000 sections 1.4,
- *    4.2, 4.3, claims 8.6, 8.17; 001 claim 12.A.14): at host points, the gradient table
+ *  - Shepard, MLS and RKPM derivative tables are true derivatives (000 Sects. 2.3,
+ *    4.2, 4.3; 001 Sect. 4, eqs 4.12-4.13): at host points, the gradient table
  *    equals central finite differences of the value table, the Hessian table central
  *    differences of the gradient table, and the discrete curl of the gradient table
  *    vanishes (000 eq 18);
- *  - corrected derivatives are not integrable (000 section 4.6 and claim 8.18): KB
+ *  - corrected derivatives are not integrable (000 Sects. 4.4.1, 4.4.3): KB
  *    Methods 1, 2 and 3 have a clearly non-zero curl, and Method 2's G is not the
  *    derivative of its Phi;
- *  - 001 claim 12.A.4: the SSPH value table equals the RKPM value table to round-off
- *    for every kernel, support and order, at particles and at points; claim 12.A.5: the
- *    derivative tables differ; claim 12.A.13: MLS values equal SSPH values when the
- *    volumes are constant;
+ *  - 001 Sect. 4: the SSPH value table equals the RKPM value table to round-off
+ *    for every kernel, support and order, at particles and at points, and the
+ *    derivative tables differ; MLS values equal SSPH values when the volumes are
+ *    constant (docs/papers.md, paper 001, derived results 5);
  *  - KB Method 3's derivative table is Method 1's (derived below). */
 #include <math.h>
 #include <stdio.h>
@@ -260,7 +260,7 @@ static void test_true_derivatives(void **s) {
       {MFREE_METHOD_MLS, 2, MFREE_KERNEL_QUINTIC_SPLINE, 7},
       {MFREE_METHOD_MLS, 3, MFREE_KERNEL_GAUSSIAN, 7},
       {MFREE_METHOD_MLS, 2, MFREE_KERNEL_REVISED_SUPER_GAUSS, 7},
-      /* 001 claim 12.A.14: RKPM derivatives are derivatives of RKPM values */
+      /* 001 eqs 4.12-4.13: RKPM derivatives are derivatives of RKPM values */
       {MFREE_METHOD_RKPM, 1, MFREE_KERNEL_CUBIC_SPLINE, 7},
       {MFREE_METHOD_RKPM, 2, MFREE_KERNEL_CUBIC_SPLINE, 7},
       {MFREE_METHOD_RKPM, 3, MFREE_KERNEL_WENDLAND_C4, 7},
@@ -317,8 +317,8 @@ static void test_true_derivatives(void **s) {
   }
 }
 
-/* Corrected derivatives are not integrable (000 section 4.6: "not integrable"; claim
- * 8.18), and Method 2's G is not the gradient of its Phi. The same discrete checks that
+/* Corrected derivatives are not integrable (000 Sect. 4.4.3: "not integrable"; docs/papers.md,
+ * paper 000, derived results 3), and Method 2's G is not the gradient of its Phi. The same discrete checks that
  * pass to 1e-6 above must fail here by a clear margin, in 2D and 3D. */
 static void test_corrected_not_integrable(void **s) {
   (void)s;
@@ -356,8 +356,8 @@ static void test_corrected_not_integrable(void **s) {
   }
 }
 
-/* 001 claim 12.A.4 (SSPH value = RKPM value, any kernel, h, particle set, at particles and
- * at points) and 12.A.5 (their derivative tables differ). */
+/* 001 Sect. 4 (SSPH value = RKPM value, any kernel, h, particle set, at particles and
+ * at points; their derivative tables differ). */
 static void test_ssph_equals_rkpm_values(void **s) {
   (void)s;
   static cloud_t c;
@@ -417,9 +417,9 @@ static void test_ssph_equals_rkpm_values(void **s) {
       }
 }
 
-/* 001 claim 12.A.13: with constant volumes MLS values equal SSPH values (the basis shift
- * is an invertible change of polynomial basis and a constant V cancels). With varying
- * volumes they differ: SSPH weighs W V, MLS W. */
+/* docs/papers.md, paper 001, derived results 5: with constant volumes MLS values equal
+ * SSPH values (the basis shift is an invertible change of polynomial basis and a
+ * constant V cancels). With varying volumes they differ: SSPH weighs W V, MLS W. */
 static void test_mls_equals_ssph_constant_volumes(void **s) {
   (void)s;
   static cloud_t c;

@@ -3,7 +3,7 @@
  *    the particle tables (same pattern, values to 1e-13) for every method defined away
  *    from the particles; the particles-only methods (symmetrised SPH 000 eq 47,
  *    Johnson-Beissel 000 eq 49, Randles-Libersky 000 eq 68, all "evaluated at nodes
- *    only", 000 section 4.11) refuse points with MFREE_ERR_UNSUPPORTED;
+ *    only", 000 Sects. 4.4.1, 4.4.2, 4.4.6) refuse points with MFREE_ERR_UNSUPPORTED;
  *  - borrowed points (and borrowed particle positions) that moved, followed by
  *    mfree_approximant_update, give the tables of a fresh setup;
  *  - in a periodic box MLS reproduces linear and quadratic fields across the boundary

@@ -335,7 +335,7 @@ static void test_degenerate(void **s) {
   mfree_particles_destroy(&ps);
 }
 
-/* Too few neighbours for the basis: 2D quadratic needs 6 (001 claim 7); with h small
+/* Too few neighbours for the basis: 2D quadratic needs 6 (001 Sect. 2, the necessary condition); with h small
  * enough that sites see 3-5 particles, SSPH reports MFREE_FAIL_NEIGHBORS or
  * MFREE_FAIL_SINGULAR instead of garbage, and neighbour counts are reported. */
 static void test_too_few_neighbors(void **s) {

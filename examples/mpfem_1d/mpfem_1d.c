@@ -10,8 +10,8 @@
  *    u(0) imposed on the nodal value (Kronecker delta), UMFPACK through
  *    libmfree_suitesparse.
  * Errors: eq 34 (L2) and eq 35 (H1 semi-norm; MPFEM derivative by eq 22 as in the
- * paper), 10-point Gauss per half element. The spec note's reproduction (Sect. 3.4)
- * is the reference for --gauss 3.
+ * paper), 10-point Gauss per half element. The reproduced values (docs/papers.md,
+ * paper 004, reproduction) are the reference for --gauss 3.
  *
  * Usage: mfree_mpfem_1d [--json] [--out DIR] [--no-plot] [--gauss N]
  * Output: a table with rates (default) or one JSON object (--json)

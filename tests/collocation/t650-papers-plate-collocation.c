@@ -237,7 +237,7 @@ static void kirsch_solution(void **state) {
 
 /* ---- the discrete problem -------------------------------------------------------------- */
 
-/* 2 N equations for N particles (claim 35), every site set up, a solved system. */
+/* 2 N equations for N particles (001 Sect. 6.3), every site set up, a solved system. */
 static void system_size_and_solve(void **state) {
   fixture_t *f = *state;
   for (int k = 0; k < NRES; ++k)

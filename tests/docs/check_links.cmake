@@ -7,7 +7,8 @@
 #    (the project's shared folder beside it, or the absolute path of a checkout);
 #  - the public headers name no test ids and cite papers by their docs/references.md key;
 #  - no document, source, script or message cites the team's private notes on the papers
-#    (a "spec 00N section X" citation): a reader has the papers' own numbers and docs/papers.md
+#    (a "spec" cited by its seed number, section, note or claim, or the notes' numbered
+#    claims): a reader has the papers' own numbers and docs/papers.md
 #    (t909 is the documents check as a whole: links, paths, headers, citations).
 # Links inside code blocks and code spans are not links and are skipped, as are URLs.
 cmake_minimum_required(VERSION 3.25)
@@ -142,11 +143,11 @@ foreach(f IN LISTS sources)
   endif()
   # the notes are not in the repository: cite the paper's section, equation or table, or
   # docs/papers.md for errata and reproduction choices (written so as not to match here)
-  file(STRINGS "${f}" hits REGEX "[Ss]pe[c] 00[0-9]")
+  file(STRINGS "${f}" hits REGEX "[Ss]pe[c] ([0-9]|note|claim|section)|[Ss]pe[c]'s|00[0-9] section[s]? [0-9]|clai[m]s? ([0-9]+[.][0-9A-Z]|[A-Z][0-9])")
   if(hits)
     file(RELATIVE_PATH rel "${ROOT}" "${f}")
     list(GET hits 0 first)
-    string(APPEND errors "  ${rel}: cites the private spec notes (cite the paper or docs/papers.md): ${first}\n")
+    string(APPEND errors "  ${rel}: cites the team's private notes on the papers (cite the paper or docs/papers.md): ${first}\n")
   endif()
 endforeach()
 

@@ -24,7 +24,7 @@ expect_range(${mass_rel_error} 0 1e-12 "examples/drop: total mass exact (003 eq 
 expect_range(${impact_time} 0.02 ${contact_time_reference} "examples/drop: impact (within 2h) before the free-fall contact")
 expect_range(${last_sample_before_impact} 0.02 1 "examples/drop: a free fall of at least 0.02 s is checked")
 expect_range(${drop_momentum_dev} 0 1e-12 "examples/drop: drop momentum = P(0) + M g t to round-off")
-expect_range(${internal_force_dev} 0 1e-12 "examples/drop: internal forces carry no momentum (003 claim D3)")
+expect_range(${internal_force_dev} 0 1e-12 "examples/drop: internal forces carry no momentum (docs/papers.md, paper 003, derived results 1)")
 expect_range(${free_fall_dev} 0 0.01 "examples/drop: centre of mass on the free-fall curve to 1 %")
 expect_range(${wall_impulse_ratio} 0.97 1.03 "examples/drop: walls' vertical impulse within 3 % of the pool's weight x t")
 expect_range(${wall_impulse_x_rel} 0 1e-6 "examples/drop: no horizontal impulse from the symmetric walls")

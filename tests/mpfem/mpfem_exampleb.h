@@ -5,7 +5,7 @@
  * half width R h_k = h, i.e. d = 2h; trial derivative eq 21; Bubnov-Galerkin; nodal
  * value imposed at x = 0) with UMFPACK. Errors: eq 34 (L2) and eq 35 (H1 semi-norm,
  * MPFEM derivative by eq 22 as in the paper, and by eq 21), with 10-point Gauss per
- * half element as in the spec note 3.4. Header-only so that tests include it. */
+ * half element as in docs/papers.md, paper 004, reproduction. Header-only so that tests include it. */
 #ifndef MPFEM_EXAMPLEB_H
 #define MPFEM_EXAMPLEB_H
 

@@ -1,7 +1,8 @@
-/* MPFEM in 1D against the reference values of the spec note on paper 004 (Sect. 3.5):
+/* MPFEM in 1D against reproduced reference values (docs/papers.md, paper 004, derived
+ * results 10):
  * nodes 0..5, linear elements, cosine kernel (pi/(2d)) cos(pi t/d) with d = 2 and d = 1,
- * Haar kernel with d = 2; shape functions, derivatives by 004 eq 21 and eq 22. The note
- * rounds to 6 decimals, so the tolerance is 1.5e-6. The kernel's support radius is
+ * Haar kernel with d = 2; shape functions, derivatives by 004 eq 21 and eq 22. They are
+ * rounded to 6 decimals, so the tolerance is 1.5e-6. The kernel's support radius is
  * R h = h (R = 1), so the width d is 2h. */
 #include <math.h>
 #include <stdlib.h>
@@ -86,7 +87,7 @@ static void check_rows(mfree_kernel_t kernel, double hp, mfree_mpfem_deriv_t der
   mfree_approximant_destroy(&a);
 }
 
-/* Spec Sect. 3.5, cosine kernel d = 2: N, eq 21 and eq 22 derivatives. */
+/* The reference values, cosine kernel d = 2: N, eq 21 and eq 22 derivatives. */
 static void test_cosine_d2(void **state) {
   (void)state;
   const int np = sizeof kCosD2 / sizeof kCosD2[0];
@@ -108,7 +109,7 @@ static void test_cosine_d2(void **state) {
              (const double(*)[4])N, (const double(*)[4])d22);
 }
 
-/* Spec Sect. 3.5: Haar kernel d = 2 and cosine kernel d = 1 (MPFEM = FEM at the element
+/* The reference values: Haar kernel d = 2 and cosine kernel d = 1 (MPFEM = FEM at the element
  * centre when the support lies inside one element, 004 Sect. 2.2). */
 static void test_haar_and_small_support(void **state) {
   (void)state;

@@ -2,14 +2,14 @@
  *  - Kronecker delta N_J(x_I) = delta_IJ at the nodes when eq 13 holds (Sect. 2.3), in
  *    1D, on TRI3, QUAD4 and HEX8 meshes;
  *  - its reported failure (MFREE_FAIL_SUPPORT) when the support is too large
- *    (Sect. 4.1), with the spec note's errors (Sect. 4.B items 4 and 17);
+ *    (Sect. 4.1), with the errors of docs/papers.md, paper 004, derived results 2;
  *  - partition of unity of the weights (eq 12) and linear reproduction of the values
  *    (eqs 17-20b), of the eq 21 and eq 22 derivatives (eqs 23-24b), bilinear on
- *    rectangles (spec 4.B item 16);
- *  - reduction to FEM where the support lies inside one element (spec 4.B item 23);
- *  - the tensor-product identity on a structured grid (spec 4.B item 24);
- *  - the nodal scheme (eqs 37-38): nodal gradients exact for quadratics in 1D (spec
- *    4.B item 25) and for linear fields on triangles;
+ *    rectangles (derived results 3 there);
+ *  - reduction to FEM where the support lies inside one element (derived results 6);
+ *  - the tensor-product identity on a structured grid (derived results 7);
+ *  - the nodal scheme (eqs 37-38): nodal gradients exact for quadratics in 1D (derived
+ *    results 8) and for linear fields on triangles;
  *  - update after the nodes moved equals a fresh setup. */
 #include <math.h>
 #include <stdlib.h>
@@ -74,7 +74,7 @@ static double kronecker_error(mfree_particles_t *ps, mfree_mesh_t *mesh, mfree_k
 static void test_kronecker(void **state) {
   (void)state;
   mfree_status_t st;
-  /* 1D: d/2 = h <= the shortest element (spec 1.14 step 3) */
+  /* 1D: d/2 = h <= the shortest element (docs/papers.md, paper 004, choices 1) */
   double x[41];
   int32_t conn[80];
   nodes_1d(41, 0.3, 7, x);
@@ -143,9 +143,9 @@ static void test_kronecker(void **state) {
 }
 
 /* 004 Sect. 4.1: too large a support reaches elements not connected to a node; setup
- * reports MFREE_FAIL_SUPPORT and the Kronecker error is that of the spec note (4.B
- * item 4: 1D d = 2.5h, 0.098 cosine, 0.40 Haar; item 17: 2D QUAD4, a = 2.4h, 0.067
- * cosine, 0.31 Haar), given there to two digits. */
+ * reports MFREE_FAIL_SUPPORT and the Kronecker error is the reproduced one
+ * (docs/papers.md, paper 004, derived results 2: 1D d = 2.5h, 0.098 cosine, 0.40 Haar;
+ * 2D QUAD4, a = 2.4h, 0.067 cosine, 0.31 Haar), given there to two digits. */
 static void test_kronecker_failure(void **state) {
   (void)state;
   double x[11];
@@ -164,7 +164,7 @@ static void test_kronecker_failure(void **state) {
     mfree_status_t code;
     assert_ok(ctx, mfree_context_get_last_error(ctx, &code, msg, sizeof msg));
     assert_non_null(strstr(msg, "eq 13"));
-    if (fabs(e - ref1[k]) > 0.006) fail_msg("1D d = 2.5h kernel %d: error %.4f, spec %.3f", ks[k], e, ref1[k]);
+    if (fabs(e - ref1[k]) > 0.006) fail_msg("1D d = 2.5h kernel %d: error %.4f, reproduced %.3f", ks[k], e, ref1[k]);
     mfree_mesh_destroy(&m);
     mfree_particles_destroy(&ps);
   }
@@ -180,7 +180,7 @@ static void test_kronecker_failure(void **state) {
     mfree_status_t st;
     const double e = kronecker_error(ps, m, ks[k], &st);
     assert_int_equal(st, MFREE_FAIL_SUPPORT);
-    if (fabs(e - ref2[k]) > 0.006) fail_msg("2D a = 2.4h kernel %d: error %.4f, spec %.3f", ks[k], e, ref2[k]);
+    if (fabs(e - ref2[k]) > 0.006) fail_msg("2D a = 2.4h kernel %d: error %.4f, reproduced %.3f", ks[k], e, ref2[k]);
     mfree_mesh_destroy(&m);
     mfree_particles_destroy(&ps);
   }
@@ -215,7 +215,7 @@ static void check_reproduction(mfree_particles_t *ps, mfree_mesh_t *m, int dim, 
                             ((ks[k] == MFREE_KERNEL_HAAR && d == 0) ? 0 : MFREE_DERIV_HESSIAN);
       mfree_status_t st;
       mfree_approximant_t *a = mp_approx(ctx, ps, m, ks[k], ds[d], flags, npts, pts, hp, &st);
-      /* reproduction needs no eq 13 (spec 4.B item 15): the cubic spline's support of
+      /* reproduction needs no eq 13 (docs/papers.md, paper 004, derived results 1): the cubic spline's support of
        * radius 2h may violate it, which setup reports */
       assert_true(st == MFREE_SUCCESS || (ks[k] == MFREE_KERNEL_CUBIC_SPLINE && st == MFREE_FAIL_SUPPORT));
       mp_table_t t;
@@ -304,8 +304,8 @@ static void test_reproduction(void **state) {
   mfree_particles_destroy(&ps);
 }
 
-/* Where the kernel support lies inside one element, MPFEM equals FEM (spec 4.B item
- * 23): hat functions in 1D, bilinear functions on rectangles, barycentric coordinates
+/* Where the kernel support lies inside one element, MPFEM equals FEM (004 Sect. 2.2;
+ * docs/papers.md, paper 004, derived results 6): hat functions in 1D, bilinear functions on rectangles, barycentric coordinates
  * on triangles, computed here independently. */
 static void test_fem_reduction(void **state) {
   (void)state;
@@ -408,7 +408,7 @@ static void test_fem_reduction(void **state) {
   mfree_particles_destroy(&ps);
 }
 
-/* Tensor-product identity (spec 4.B item 24): on a structured grid of rectangles with
+/* Tensor-product identity (docs/papers.md, paper 004, derived results 7): on a structured grid of rectangles with
  * the tensor kernel, N_(I,J)(x, y) = N_I(x) N_J(y), gradients by the product rule. */
 static void test_tensor_product(void **state) {
   (void)state;
@@ -467,7 +467,7 @@ static void test_tensor_product(void **state) {
 
 /* Nodal scheme, 004 eqs 37-38: in 1D the inverse-length weights make the nodal
  * gradient the 3-point non-uniform difference, exact for quadratics at interior nodes
- * (spec 1.13); on triangles, exact for linear fields at every node. */
+ * (004 Sect. 4.3); on triangles, exact for linear fields at every node. */
 static void test_nodal_scheme(void **state) {
   (void)state;
   double x[21];

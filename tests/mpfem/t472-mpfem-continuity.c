@@ -1,5 +1,5 @@
-/* MPFEM continuity (paper 004 Sects. 2.6, 2.7, 4.2; spec note 4.A items 7-9 and 4.B
- * items 18-20). A field u^h = sum_J N_J u_J with random nodal values on a non-uniform
+/* MPFEM continuity (paper 004 Sects. 2.6, 2.7, 4.2; docs/papers.md, paper 004, derived
+ * results 4). A field u^h = sum_J N_J u_J with random nodal values on a non-uniform
  * 1D mesh is probed on both sides of the points where smoothness could break: the
  * nodes (element boundaries) and the points where the support edge crosses a node
  * (node +- R h). A quantity f is continuous at p when the one-sided jump
@@ -155,7 +155,7 @@ static void test_haar(void **state) {
   print_message("Haar: relative jumps: value %.2e, eq 21 derivative %.2e, eq 22 derivative %.2e\n", mv,
                 m21, m22);
   assert_true(mv < SMALL);   /* C0 */
-  assert_true(m21 > LARGE);  /* eq 21 derivative discontinuous (spec 4.B item 19) */
+  assert_true(m21 > LARGE);  /* eq 21 derivative discontinuous (docs/papers.md) */
   assert_true(m22 < SMALL);  /* eq 22 continuous for any L2 kernel (004 Sect. 2.7) */
 }
 

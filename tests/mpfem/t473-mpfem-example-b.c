@@ -1,15 +1,15 @@
 /* Paper 004 Example B (Sect. 3.2, Figs. 5-6), see mpfem_exampleb.h, at the spacings
  * h = 0.1, 0.05, 0.02, 0.01, 0.005, 0.002 (the paper: 0.1 down to 0.002).
- *  - The spec note's reproduction (Sect. 3.4, cosine kernel, d = 2h, eq 21 stiffness,
- *    3 Gauss points per element): FEM L2/H1 and MPFEM L2/H1(22)/H1(21) to 1e-3
+ *  - The reproduced values (docs/papers.md, paper 004, reproduction: cosine kernel, d = 2h,
+ *    eq 21 stiffness, 3 Gauss points per element): FEM L2/H1 and MPFEM L2/H1(22)/H1(21) to 1e-3
  *    relative at every spacing.
  *  - The paper's claims (Sect. 3.2): L2 rate 2 +- 0.15 for both methods, MPFEM H1 rate
  *    (eq 22) in [1.5, 2], FEM H1 rate about 1 (0.9..1.1), all on the last pair of
  *    spacings (the coarse meshes do not resolve the bump of width 0.02 and give
  *    pre-asymptotic rates); MPFEM L2 below FEM's at every spacing. With 3 Gauss points
- *    the load quadrature error dominates at h = 0.1 and 0.05 (spec 3.4: the bump is
- *    sampled by 3 points), where the MPFEM error is then above FEM's (26.054 vs 26.031
- *    and 0.373 vs 0.349 in the spec's table too), so the ordering is checked with 6
+ *    the load quadrature error dominates at h = 0.1 and 0.05 (the bump is sampled by 3
+ *    points), where the MPFEM error is then above FEM's (26.054 vs 26.031 and 0.373 vs
+ *    0.349 in the reproduced values too), so the ordering is checked with 6
  *    points per element, within the paper's 1..6.
  * The fine meshes are slow in unoptimised builds only in proportion (a few seconds). */
 #include <mfree_suitesparse.h>
@@ -18,7 +18,7 @@
 
 #define NH 6
 static const double kH[NH] = {0.1, 0.05, 0.02, 0.01, 0.005, 0.002};
-/* spec note Sect. 3.4 */
+/* docs/papers.md, paper 004, reproduction */
 static const double kFemL2[NH] = {2.6031e+01, 3.4942e-01, 1.9598e-02, 6.0914e-03, 1.5540e-03, 2.5006e-04};
 static const double kFemH1[NH] = {4.4307e+01, 4.8816e+00, 3.2336e+00, 1.9387e+00, 9.8441e-01, 3.9548e-01};
 static const double kMpL2[NH] = {2.6054e+01, 3.7278e-01, 8.3050e-03, 1.1168e-03, 1.3590e-04, 2.0602e-05};
@@ -41,9 +41,9 @@ static int teardown(void **state) {
 static int32_t nodes(int i) { return (int32_t)lround(1.0 / kH[i]) + 1; }
 
 static void near(const char *what, int i, double got, double ref, double rel) {
-  print_message("  h = %-6g %-10s %.4e  (spec 3.4: %.4e)\n", kH[i], what, got, ref);
+  print_message("  h = %-6g %-10s %.4e  (reproduced: %.4e)\n", kH[i], what, got, ref);
   if (!(fabs(got - ref) <= rel * ref))
-    fail_msg("h = %g %s: %.5e differs from the spec's %.4e by more than %g relative", kH[i], what, got, ref, rel);
+    fail_msg("h = %g %s: %.5e differs from the reproduced %.4e by more than %g relative", kH[i], what, got, ref, rel);
 }
 
 static void test_reference_table(void **state) {

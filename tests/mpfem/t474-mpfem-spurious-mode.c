@@ -1,14 +1,14 @@
 /* The spurious zero-energy mode of the assumed-strain stiffness (paper 004 eq 22 used
- * in the Galerkin form; spec note 4.B item 27; the paper's remark in Sect. 2.7 that
+ * in the Galerkin form; docs/papers.md, paper 004, derived results 9; the paper's remark in Sect. 2.7 that
  * reproduction "does not suffice to insure" the patch test). With the Haar kernel of
  * width exactly d = 2h on a uniform 1D mesh, the eq 22 derivative of the alternating
  * field u_J = (-1)^J vanishes away from the boundary:
  *  - non-periodic mesh: its energy u^T K u over the interior elements is zero to
  *    round-off (ratio to the FE energy below 1e-14: the assembled K has entries of
- *    order 1/h, so this is its round-off level; the spec's 1e-31 sums squared
- *    derivatives directly), while the cosine kernel (d = 2h) keeps the spec's ratio
+ *    order 1/h, so this is its round-off level; the reproduction's 1e-31 sums squared
+ *    derivatives directly), while the cosine kernel (d = 2h) keeps the reproduced ratio
  *    0.090 (to 0.005) and the Haar kernel with d = h and eq 21 derivatives keep clearly
- *    positive ones (spec: 0.31 and about 1; measured here over the interior elements:
+ *    positive ones (reproduced: 0.31 and about 1; measured here over the interior elements:
  *    0.47 and 1.22, so only "clearly positive" is asserted);
  *  - periodic mesh (a ring, where no boundary stiffens the mode): the stiffness with one
  *    node's value imposed has the null vector 1 - (-1)^J, and the SuiteSparse adapter

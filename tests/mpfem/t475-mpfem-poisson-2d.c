@@ -3,7 +3,7 @@
  * semi-norm. Rates on the last pair of meshes.
  *
  * QUAD4: n = 8, 16, 32 cells per side, support a square of side 2h (the largest eq 13
- * allows, spec 1.14), 3 x 3 Gauss points per element: the kinks of the weights (where
+ * allows, docs/papers.md, paper 004, choices 1), 3 x 3 Gauss points per element: the kinks of the weights (where
  * the support edge passes an element edge) lie on element edges, so the rule sees
  * smooth integrands. Measured: FEM L2 rate 2.000, H1 1.000 | MPFEM L2 1.960, H1(eq 21)
  * 1.004, H1(eq 22) 1.753; MPFEM errors 9x (L2), 6x (H1, eq 21), 12x (H1, eq 22) below

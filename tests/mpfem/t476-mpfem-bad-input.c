@@ -4,7 +4,8 @@
  *    a particle repeated within an element: MFREE_ERR_INPUT;
  *  - inverted or degenerate elements (zero or negative Jacobian): LINE2 with x_2 < x_1,
  *    clockwise or collinear TRI3, non-convex QUAD4, and a QUAD4 whose physical bilinear
- *    interpolant is singular (the diamond of spec 1.2): MFREE_ERR_INPUT, from
+ *    interpolant is singular (the diamond of docs/papers.md, paper 004, choices 2):
+ *    MFREE_ERR_INPUT, from
  *    mfree_mesh_setup and from the approximant's setup;
  *  - a mesh of mixed dimension (TRI3 on a 1D set, LINE2 on a 2D set): MFREE_ERR_MISMATCH;
  *  - a kernel support too small to reach any element (a point outside the mesh, a

@@ -196,7 +196,7 @@ void Kernel::shape(double q, double &f, double &df, double &d2f) const {
       d2f = 0.5;
       return;
     }
-    case MFREE_KERNEL_COSINE: {  // 004 eq 28 with the spec's correction: cos(pi t / d)
+    case MFREE_KERNEL_COSINE: {  // 004 eq 28: cos(pi t / d), docs/papers.md, 004 errata 1
       const double a = 0.5 * kPi;
       f = std::cos(a * q);
       df = -a * std::sin(a * q);

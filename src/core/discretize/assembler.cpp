@@ -57,8 +57,8 @@ double Assembler::mean_h() const {
 
 ApproxConfig Assembler::values_config(const ApproxConfig &c) const {
   // Particles-only methods correct derivatives, not values: loads and boundary values
-  // use the method's own function approximation (paper 000 leaves this open, section
-  // 5.5 of the spec note). Symmetrised SPH and Johnson-Beissel keep SPH's kernel
+  // use the method's own function approximation (paper 000 leaves this open,
+  // docs/papers.md, paper 000, choices 4). Symmetrised SPH and Johnson-Beissel keep SPH's kernel
   // estimate sum_I W(x - x_I) u_I dV_I (000 eq 21; JB corrects the normal strains only),
   // which is not a partition of unity next to the boundary; Randles-Libersky's
   // normalised SPH uses Shepard functions (000 eq 70). With Shepard values for all three
