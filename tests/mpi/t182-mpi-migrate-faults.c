@@ -16,7 +16,9 @@
  *  - get_counts / get_owners without a plan, get_owners with a short array;
  *  - set_pending_error: nothing to hand over, then a failure of one rank handed to the
  *    next collective call, which every rank returns;
- *  - a plan destroyed after MPI_Finalize: only its memory freed (no abort). */
+ *  - a plan destroyed after MPI_Finalize: only its memory freed (no abort).
+ * A last check reads mfree_mpi.h and fails when a mfree_migration_* function has no row
+ * here, so that a new function comes with its bad-input rows. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +27,48 @@
 #include "migstate.h"
 
 static int rank = 0, size = 1;
+
+#if !defined(MFREE_MPI_HEADER) || !defined(MFREE_TEST_SOURCE)
+#error "MFREE_MPI_HEADER and MFREE_TEST_SOURCE (mfree_mpi.h and this file) must be defined by the build"
+#endif
+
+static char *slurp(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  const long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *s = malloc((size_t)n + 1);
+  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
+    free(s);
+    s = NULL;
+  }
+  if (s) s[n] = 0;
+  fclose(f);
+  return s;
+}
+
+/* Every mfree_migration_* function declared in the header is called in this file with a
+ * bad argument (a row above names it followed by "(NULL" or "(m"); returns the missing. */
+static int missing_rows(void) {
+  char *h = slurp(MFREE_MPI_HEADER), *me = slurp(MFREE_TEST_SOURCE);
+  int missing = 0, found = 0;
+  CHECK(h && me, "cannot read %s or %s", MFREE_MPI_HEADER, MFREE_TEST_SOURCE);
+  for (const char *p = h; h && me && (p = strstr(p, "MFREE_MPI_API mfree_status_t mfree_migration_")); ++p) {
+    char name[96] = "", call[112];
+    sscanf(p + strlen("MFREE_MPI_API mfree_status_t "), "%95[a-z_]", name);
+    ++found;
+    snprintf(call, sizeof call, "%s(NULL", name);
+    if (!strstr(me, call)) {
+      CHECK(0, "%s has no bad-input row (no call %s...) in this test", name, call);
+      ++missing;
+    }
+  }
+  CHECK(found >= 13, "only %d mfree_migration_* functions found in %s", found, MFREE_MPI_HEADER);
+  free(h);
+  free(me);
+  return missing;
+}
 
 static void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle,
                    const char *what) {
@@ -240,6 +284,7 @@ int main(int argc, char **argv) {
   (void)xl;
 #endif
   mfree_context_destroy(&ctx); /* the plan keeps the context alive */
+  if (rank == 0) missing_rows();
   int rc = mpitest_finish("t182-mpi-migrate-faults");
   MPI_Finalize();
   if (mfree_migration_destroy(&late) != MFREE_SUCCESS || late) {
