@@ -9,8 +9,8 @@
  *   mpirun -np 4 ./mfree_mpi_zoltan_host [--m=1000] [--steps=3] [--check]
  *
  * --m: particles per side (default 1000: 10^6 particles); --check: exit 1 unless the
- * gradient is exact to 1e-10. Prints, on rank 0, the owned/ghost counts, the time per
- * step and a checksum of the gradient bits keyed by global id (an exclusive or over the
+ * gradient is exact to 1e-10. Prints, on rank 0, the partition's time and the particles it
+ * moved, the owned/ghost counts, the time per step and a checksum of the gradient bits keyed by global id (an exclusive or over the
  * ranks, independent of the decomposition). */
 #include <math.h>
 #include <stdint.h>
@@ -38,12 +38,13 @@ static void die(mfree_context_t *ctx, mfree_status_t st, const char *what) {
 
 /* RCB regions from Zoltan through libmfree_mpi's migration, which moves the positions
  * and ids to their new owners (one MPI_Alltoallv). */
-static void partition(mfree_context_t *ctx, owned_t *o) {
+static void partition(mfree_context_t *ctx, owned_t *o, int64_t *moved) {
   mfree_migration_t *mig = NULL;
   int32_t n_new = 0;
   die(ctx, mfree_migration_create(ctx, MPI_COMM_WORLD, 2, &mig), "migration create");
   die(ctx, mfree_migration_set_partitioner(mig, MFREE_PARTITIONER_RCB, 1.05), "partitioner");
   die(ctx, mfree_migration_partition(mig, (int32_t)o->n, o->x, 2, 1, &n_new), "partition");
+  die(ctx, mfree_migration_get_counts(mig, NULL, NULL, moved, NULL), "counts");
   /* the arrays grow to the larger of the counts before and after */
   const int64_t cap = n_new > o->n ? n_new : o->n;
   o->x = realloc(o->x, sizeof(double) * 2 * (size_t)(cap + 1));
@@ -94,7 +95,11 @@ int main(int argc, char **argv) {
   }
   mfree_context_t *ctx = NULL;
   die(ctx, mfree_context_create(&ctx), "context");
-  partition(ctx, &o);
+  int64_t moved = 0;
+  MPI_Barrier(MPI_COMM_WORLD);
+  const double p0 = MPI_Wtime();
+  partition(ctx, &o, &moved);
+  double t_part = MPI_Wtime() - p0;
 
   /* ---- the halo by libmfree_mpi ---- */
   mfree_halo_t *halo = NULL;
@@ -168,7 +173,12 @@ int main(int argc, char **argv) {
   MPI_Reduce(&t_comm, &tcomm, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
   MPI_Reduce(&g64, &gmax, 1, MPI_INT64_T, MPI_MAX, 0, MPI_COMM_WORLD);
   MPI_Reduce(&g64, &gsum, 1, MPI_INT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
+  int64_t moved_all = 0;
+  MPI_Reduce(&moved, &moved_all, 1, MPI_INT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &t_part, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   if (rank == 0) {
+    printf("partition and migration %.4f s: %lld particles moved (%.1f MB of 24-byte records)\n", t_part,
+           (long long)moved_all, 24e-6 * (double)moved_all);
     printf("zoltan_host: %lld particles on %d ranks (Zoltan RCB), ghosts per rank %.0f avg / %lld max\n",
            (long long)N, size, (double)gsum / size, (long long)gmax);
     if (steps > 0)
