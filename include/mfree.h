@@ -1378,7 +1378,7 @@ MFREE_API mfree_status_t mfree_matrix_apply(const mfree_matrix_t *A, const doubl
  * An assembler of the given form with trial functions from trial and test functions
  * from test (NULL: Bubnov-Galerkin, test = trial; Shepard test functions with
  * corrected-derivative trial functions give the Petrov-Galerkin scheme of
- * [Belytschko1998] Sect. 5.3.1). The approximants' configuration (method, kernel,
+ * [Belytschko1998] Sect. 5.2.1). The approximants' configuration (method, kernel,
  * order) is copied. Unknowns are node-major, dof = particle * ncomp + component
  * (ncomp = dim for elasticity, else 1), followed by Lagrange multipliers.
  * @param[in]  ctx    context (kept alive)

@@ -87,19 +87,19 @@ typedef struct {
 /* Paper 000 Sect. 4 (docs/papers.md, paper 000, derived results 2) and paper 001 for
  * MSPH/SSPH. 3 means ">= 3" (check_reproduction covers degrees up to 3). */
 static const row_t kRows[] = {
-    {MFREE_METHOD_SPH, 0, -1, -1, "000 Sect. 4.1 (eqs 21, 29; eq 37): SPH reproduces nothing, not even constants"},
-    {MFREE_METHOD_SPH_SYMMETRIC, 0, -1, 0, "000 Sect. 4.4 (eq 47): symmetrised SPH, derivatives of constants only; function not corrected"},
+    {MFREE_METHOD_SPH, 0, -1, -1, "000 Sect. 3 (eqs 21, 29; eq 37): SPH reproduces nothing, not even constants"},
+    {MFREE_METHOD_SPH_SYMMETRIC, 0, -1, 0, "000 Sect. 4.4.1 (eq 47): symmetrised SPH, derivatives of constants only; function not corrected"},
     {MFREE_METHOD_SHEPARD, 0, 0, 0, "000 Sect. 4.2 (eqs 38-42): Shepard constant / constant"},
     {MFREE_METHOD_MLS, 1, 1, 1, "000 Sect. 4.3 (eqs 43-46): MLS linear / linear"},
     {MFREE_METHOD_MLS, 2, 2, 2, "000 Sect. 2 (eqs 3-4): MLS of order k is complete to k (k = 2)"},
     {MFREE_METHOD_MLS, 3, 3, 3, "000 Sect. 2 (eqs 3-4): MLS of order k is complete to k (k = 3)"},
     {MFREE_METHOD_RKPM, 1, 1, 1, "000 Sect. 4.3 / 001 eqs 4.5-4.13: RKPM = MLS by kernel correction, linear"},
     {MFREE_METHOD_RKPM, 2, 2, 2, "001 Sect. 4 (eq 4.5): RKPM reproducing conditions to order n = 2"},
-    {MFREE_METHOD_JOHNSON_BEISSEL, 1, -1, 0, "000 Sect. 4.5 (eqs 49-54): JB derivatives of constants only (fails v = a(x+y)); function not corrected"},
-    {MFREE_METHOD_RANDLES_LIBERSKY, 1, -1, 1, "000 Sect. 4.9 (eqs 68-69): RL linear derivatives; function not corrected"},
-    {MFREE_METHOD_KB_METHOD1, 1, 0, 1, "000 Sect. 4.6 (eqs 55-61): KB Method 1 constant (Shepard) / linear"},
-    {MFREE_METHOD_KB_METHOD2, 1, 1, 1, "000 Sect. 4.7 (eqs 63-64): KB Method 2 linear / linear"},
-    {MFREE_METHOD_KB_METHOD3, 1, 1, 1, "000 Sect. 4.8 (eqs 65-66): KB Method 3 linear / linear"},
+    {MFREE_METHOD_JOHNSON_BEISSEL, 1, -1, 0, "000 Sect. 4.4.2 (eqs 49-54): JB derivatives of constants only (fails v = a(x+y)); function not corrected"},
+    {MFREE_METHOD_RANDLES_LIBERSKY, 1, -1, 1, "000 Sect. 4.4.6 (eqs 68-69): RL linear derivatives; function not corrected"},
+    {MFREE_METHOD_KB_METHOD1, 1, 0, 1, "000 Sect. 4.4.3 (eqs 55-61): KB Method 1 constant (Shepard) / linear"},
+    {MFREE_METHOD_KB_METHOD2, 1, 1, 1, "000 Sect. 4.4.4 (eqs 63-64): KB Method 2 linear / linear"},
+    {MFREE_METHOD_KB_METHOD3, 1, 1, 1, "000 Sect. 4.4.5 (eqs 65-66): KB Method 3 linear / linear"},
     /* 001 states consistency m, m-1 (m-2 for second derivatives); at the particles both
      * fits reproduce degree m exactly in the value and gradient tables (K Q = T is solved
      * exactly when f is a polynomial of degree <= m), which implies the paper's orders. */
@@ -208,7 +208,7 @@ static void test_johnson_beissel_counterexample(void **state) {
     if (fabs(rho) > max_rho) max_rho = fabs(rho);
   }
   if (!(max_rho > 1e-3))
-    fail_msg("000 Sect. 4.5: JB fails v = a(x+y) on irregular particles (max |rho_J| = %.3g)", max_rho);
+    fail_msg("000 Sect. 4.4.2: JB fails v = a(x+y) on irregular particles (max |rho_J| = %.3g)", max_rho);
   free(rowptr);
   free(cols);
   mfree_approximant_destroy(&a);
@@ -295,9 +295,9 @@ static void test_integrability(void **state) {
   } rows[] = {
       {MFREE_METHOD_SHEPARD, 0, 1, "000 Sect. 4.2: Shepard derivatives are integrable"},
       {MFREE_METHOD_MLS, 1, 1, "000 Sect. 4.3: MLS derivatives are integrable"},
-      {MFREE_METHOD_KB_METHOD1, 1, 0, "000 Sect. 4.6: KB Method 1 derivatives are not integrable"},
-      {MFREE_METHOD_KB_METHOD2, 1, 0, "000 Sect. 4.7: Method 2 derivatives are not integrable"},
-      {MFREE_METHOD_KB_METHOD3, 1, 0, "000 Sect. 4.8: Method 3 derivatives are not integrable"},
+      {MFREE_METHOD_KB_METHOD1, 1, 0, "000 Sect. 4.4.3: KB Method 1 derivatives are not integrable"},
+      {MFREE_METHOD_KB_METHOD2, 1, 0, "000 Sect. 4.4.4: Method 2 derivatives are not integrable"},
+      {MFREE_METHOD_KB_METHOD3, 1, 0, "000 Sect. 4.4.5: Method 3 derivatives are not integrable"},
   };
   for (size_t r = 0; r < sizeof rows / sizeof rows[0]; ++r) {
     double worst = 0.0;

@@ -4,7 +4,7 @@
  * its constant stress on the whole boundary satisfies the assembled equations,
  * K u_lin = f, to round-off once the test gradients are corrected, for the Bubnov MLS
  * scheme and the Petrov-Galerkin corrected-derivative schemes of paper 000 (KB Method 1
- * and 2 trial, Shepard test), also with the finite-element layer of 000 Sect. 5.6 (whose
+ * and 2 trial, Shepard test), also with the finite-element layer of 000 Sect. 5.2.4 (whose
  * strip nodal quadrature samples only at its two edges). Without the correction the same
  * residual is O(1) relative (nodal quadrature fails the patch test); switching the
  * correction off again (npts = 0) restores that matrix exactly. The second-order part:

@@ -22,7 +22,7 @@
  * functions (Petrov-Galerkin), nodal quadrature; MLS: Bubnov MLS (order 1), nodal
  * quadrature; EFG: the same with 5 x 5 Gauss points per background cell.
  *
- * Essential conditions: the paper's finite-element blending layer (000 Sect. 5.6), by
+ * Essential conditions: the paper's finite-element blending layer (000 Sect. 5.2.4), by
  * mfree_assembler_set_fe_layer, one call (component mask) per essential line (--bc selects
  * the others mfree offers). JB keeps the symmetrised SPH shear strain as 000 eqs 48-52
  * say (mfree's assembler does that for JB under elasticity forms).
@@ -108,7 +108,7 @@ static const char kUsage[] =
     "             (the ruled map from the arc to the outer edges: non-uniform, dense at the hole)\n"
     "             or graded (the same map, rings graded to square cells, per-node s)\n"
     "  --bc       essential conditions for every scheme; default auto = fe-layer (mfree's\n"
-    "             finite-element blending layer, 000 Sect. 5.6, a mask per line); fe-nodal =\n"
+    "             finite-element blending layer, 000 Sect. 5.2.4, a mask per line); fe-nodal =\n"
     "             the example's nodal-quadrature build of the same layer; fe-gauss = the layer's\n"
     "             elements by 2x2 Gauss points, the rest nodal (not the paper's; CD1, CD2, MLS).\n"
     "             Others: direct = rows u_J = g(x_J) on the parameters; rows =\n"
@@ -308,7 +308,7 @@ static int run_patch(mfree_context_t *ctx, const options_t *o, patch_t *P) {
 /* Output                                                                                 */
 /* ------------------------------------------------------------------------------------ */
 
-/* The paper's scheme (000 Sect. 5.3, 5.6, 6.2): the FE layer (or its nodal emulation,
+/* The paper's scheme (000 Sects. 5.2, 5.2.4, 6.2): the FE layer (or its nodal emulation,
  * equal to round-off), no consistent integration, nodal boundary quadrature of the
  * tractions (eq 95) for the nodal-quadrature schemes and Gauss points for EFG. */
 static int paper_scheme(const es_scheme_t *s, const es_result_t *r) {
@@ -539,7 +539,7 @@ int main(int argc, char **argv) {
          "nodes), the L2 error near 1 %% (Shepard test functions leave a 1.4 %% end shear).\n"
          "--vci (not the paper's) corrects the test gradients: 1.36/1.68, 1.22/1.58 (33x5..257x33).\n"
          "Essential conditions (BC column): fe-layer = mfree_assembler_set_fe_layer, the paper's\n"
-         "finite-element blending layer (000 Sect. 5.6) along Gamma_u, one component mask per\n"
+         "finite-element blending layer (000 Sect. 5.2.4) along Gamma_u, one component mask per\n"
          "line (beam: u at x = 0; hole: u_y = 0 on y = 0, u_x = 0 on x = 0).\n"
          "Errors: l2 (000 eq 115) from u^h at the nodes = trial approximant values (SPH, JB, RL:\n"
          "the particle values); L2 and energy (eqs 116-119) by 5x5 Gauss per background cell with\n"

@@ -114,7 +114,7 @@ typedef enum {
   ES_BC_PENALTY = 4,  /* MFREE_BC_PENALTY on boundary Gauss points */
   ES_BC_LAGRANGE = 5, /* MFREE_BC_LAGRANGE, one point multiplier per boundary node */
   ES_BC_FE_LAYER = 6, /* mfree_assembler_set_fe_layer: the finite-element blending layer
-                         of 000 Sect. 5.6, one call (component mask) per boundary line */
+                         of 000 Sect. 5.2.4, one call (component mask) per boundary line */
   ES_BC_FE_GAUSS = 8, /* the same layer, its elements integrated by 2 x 2 Gauss points with
                          the blended functions and the other nodes by nodal quadrature (the
                          interface nodes' volumes less their share of the layer): not the

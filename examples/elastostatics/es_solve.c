@@ -15,7 +15,7 @@
 #include "es.h"
 
 /* 000 Sect. 6.2, cases 1-7. Cases 1-3, 6, 7 are Bubnov-Galerkin; 4 and 5 Petrov-Galerkin
- * with Shepard test functions (000 Sect. 5.3.1); nodal quadrature except EFG. */
+ * with Shepard test functions (000 Sect. 5.2.1); nodal quadrature except EFG. */
 const es_scheme_t es_schemes[ES_NSCHEMES] = {
     {"SPH", MFREE_METHOD_SPH_SYMMETRIC, 0, (mfree_method_t)0, 0, 1},
     {"JB", MFREE_METHOD_JOHNSON_BEISSEL, 0, (mfree_method_t)0, 0, 1},
@@ -43,7 +43,7 @@ int es_bc_parse(const char *s, es_bc_t *bc) {
 }
 
 /* Essential conditions. The paper imposed u = g through a row of linear finite elements
- * blended into the meshfree functions (000 Sect. 5.6): mfree_assembler_set_fe_layer
+ * blended into the meshfree functions (000 Sect. 5.2.4): mfree_assembler_set_fe_layer
  * (ES_BC_FE_LAYER), used for every scheme where it applies. It takes one component mask
  * for the whole layer, so the plate with a hole (u_y = 0 on y = 0, u_x = 0 on x = 0)
  * cannot use it; there the nodal-quadrature schemes get the example's own build of the
@@ -224,7 +224,7 @@ static void plane_stress_D(const es_problem_t *p, double *D) {
   memcpy(D, d, sizeof d);
 }
 
-/* The layer of the finite-element blending (000 Sect. 5.6): one quadrilateral between
+/* The layer of the finite-element blending (000 Sect. 5.2.4): one quadrilateral between
  * each pair of consecutive boundary nodes P_k, P_k+1 of an essential boundary line and
  * their inner partners Q_k+1, Q_k (the nodes nearest to P - dx n), counter-clockwise.
  * conn: 4 per element; returns the element count, or -1 (message in err). */
@@ -269,7 +269,7 @@ static int32_t layer_elements(const es_level_t *lv, int chain, int32_t *conn, ch
   return ne;
 }
 
-/* ES_BC_FE_NODAL: the finite-element layer of 000 Sect. 5.6 as nodal quadrature sees it.
+/* ES_BC_FE_NODAL: the finite-element layer of 000 Sect. 5.2.4 as nodal quadrature sees it.
  * The blended functions are only evaluated at the edges of the layer (000 eq 105): at a
  * node on Gamma_u they are the element functions, at the inner row the meshfree ones,
  * whose contributions the assembler already made. So at each Gamma_u node the meshfree

@@ -6,7 +6,7 @@
 #         -P check_table3.cmake
 #
 # What the example measures with the paper's scheme (its default): the finite-element
-# blending layer of 000 Sect. 5.6 (mfree_assembler_set_fe_layer, one call and component
+# blending layer of 000 Sect. 5.2.4 (mfree_assembler_set_fe_layer, one call and component
 # mask per essential line), nodal quadrature (EFG: 5 x 5 Gauss per cell) and, since issue
 # 4's third session, the tractions by nodal boundary quadrature Psi_J(x_I) dGamma_I as 000
 # eq 95 writes them (EFG: 4 Gauss points per segment):
@@ -82,7 +82,7 @@
 #
 # Checked on the beam (17x3 .. 257x33):
 # (a) u^h and grad u^h at the 5 x 5 Gauss points of the error norms are the trial
-# approximant's: CD1 = Shepard values (000 Sect. 4.6: Method 1's function is the Shepard
+# approximant's: CD1 = Shepard values (000 Sect. 4.4.3: Method 1's function is the Shepard
 # function) with Method 1's corrected derivatives, CD2 = Method 2's Phi (eq 63a, linear
 # MLS) with its G (eq 63b, c). The interpolants of the exact solution (u_I = u(x_I)) have
 # relative errors L2 / energy: CD1 2.95e-2, 1.05e-2, 3.70e-3, 1.31e-3, 4.62e-4 (rate 1.50)
@@ -128,7 +128,7 @@
 # density grows like 1/dx: 15, 29, 58; MLS likewise 27, 58, 121). This acts like a
 # spurious moment at the clamp. The Bubnov MLS scheme still converges in L2 (1.87);
 # the Shepard test functions, which are not linearly complete, do not balance moments
-# (000 Sect. 5.7: no angular-momentum conservation), and with them the error becomes a
+# (000 Sect. 5.3: no angular-momentum conservation), and with them the error becomes a
 # global error that grows with refinement (the fifth session: an oscillation between the
 # nodes, see above, plus the end's 1.4 % shear for the L2 error): on a fifth level (257x33) the CD1 and
 # CD2 L2 errors rise from 5.3e-3 and 6.8e-3 to 9.8e-3 and 1.0e-2, while MLS's falls to
