@@ -145,7 +145,7 @@ foreach(f IN LISTS sources)
   # docs/papers.md for errata and reproduction choices (written so as not to match here)
   # Paper 000 has no sections numbered 4.5 to 4.11 or 5.4 to 5.7: those are the notes'
   # numbers for its 4.4.x, 5.2.x and 5.3.
-  file(STRINGS "${f}" hits REGEX "[Ss]pe[c] ([0-9]|note|claim|section)|[Ss]pe[c]'s|00[0-9] section[s]? [0-9]|clai[m]s? ([0-9]+[.][0-9A-Z]|[A-Z][0-9])|(000|Belytschko1998])[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?Sects?[.] (4[.]([5-9]|1[01])|5[.][4-7])")
+  file(STRINGS "${f}" hits REGEX "[Ss]pe[c] ([0-9]|note|claim|section)|[Ss]pe[c]'s|00[0-9] section[s]? [0-9]|clai[m]s? ([0-9]+[.][0-9A-Z]|[A-Z][0-9])|(^|[^0-9])00[0-9] [A-Z][0-9]([^0-9]|$)|(000|Belytschko1998])[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?[^;]?Sects?[.] (4[.]([5-9]|1[01])|5[.][4-7])")
   if(hits)
     file(RELATIVE_PATH rel "${ROOT}" "${f}")
     list(GET hits 0 first)

@@ -1,6 +1,7 @@
 !> t701 (Fortran twin of t701-system-fluid): the Galerkin-SPH fluid system of paper 003
 !> driven from Fortran. On a free jittered patch with random velocities and densities the
-!> lumped-mass weighted accelerations sum to zero (linear momentum, 003 D3) to round-off;
+!> lumped-mass weighted accelerations sum to zero (linear momentum; docs/papers.md,
+!> paper 003, derived results 1) to round-off;
 !> a native integration with a progress callback written in Fortran stops when the
 !> callback asks it to, and reports the steps taken. Without walls or gravity the walls' force
 !> (mfree_system_get_wall_force) vanishes.
@@ -87,7 +88,7 @@ program t701_system_fluid_f
     scale = scale + abs(fx) + abs(fz)
   end do
   call check(all(abs(mom) <= 1e-12_c_double * scale), &
-             'lumped-mass accelerations conserve linear momentum (003 D3)')
+             'lumped-mass accelerations conserve linear momentum (003 eq 43)')
 
   ! no walls and no gravity: the walls' force (the lumped-mass weighted accelerations' sum)
   ! vanishes to round-off; per_wall must hold dim values per wall particle

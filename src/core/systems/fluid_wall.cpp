@@ -1,7 +1,8 @@
 // Dummy wall particles, density diffusion and consistent nodal integration for the
 // Galerkin-SPH fluid (see fluid_wall.hpp). None is in paper 003; all are off by default.
 //
-// Why (t702, 003 B5): the paper's wall force (eqs 122-124) acts only on approaching
+// Why (t702, still water: docs/papers.md, paper 003, choices 3): the paper's wall
+// force (eqs 122-124) acts only on approaching
 // particles, so it cannot carry the bottom pressure of a still column, and the dropped
 // traction term of eq 87 leaves the near-wall rows of the nodal-integration force
 // unbalanced; a hydrostatic column then never settles. Dummy particles that extend the
