@@ -31,8 +31,9 @@
  * half-depth current of Benjamin (1968), 0.5 (g D drho / rho0)^(1/2) = 0.271 m/s, the
  * limit of a flow over free-slip walls such as the paper's. Measured (this window, CFL
  * 0.25): 0.229 m/s at nz = 12, 0.224 (16), 0.234 (20), 0.272 (26), 0.278 (34), 0.279
- * (41, 5,043 particles): the speed converges from nz = 26 on, to the inviscid value,
- * 29 % above Rottman & Simpson's experiment (no-slip floor; the paper's walls slip); the
+ * (41, 5,043 particles), 0.290 (58): from nz = 26 on the speed settles near the inviscid
+ * value (the unsteady nose leaves about +-0.01 m/s in the slope), 29 % above Rottman &
+ * Simpson's experiment at nz = 41 (no-slip floor; the paper's walls slip); the
  * viscosity does not matter (mu = 0.001 to 0.05 change it by less than 1 %). The run
  * stops at the window's end (or at --tend).
  *

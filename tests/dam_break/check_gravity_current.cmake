@@ -3,7 +3,7 @@
 # is exact, and the head speed over the example's fit window (0.1 <= t <= 0.3 s) lies
 # within TOL of REF: "rs", Rottman & Simpson's 0.4 (g D drho / rho0)^(1/2) = 0.217 m/s (003
 # eq 126; the paper reports about 0.2 m/s), or "inviscid", Benjamin's half-depth current
-# 0.5 (g D drho / rho0)^(1/2) = 0.271 m/s, the limit the example converges to over its
+# 0.5 (g D drho / rho0)^(1/2) = 0.271 m/s, the value the example settles near over its
 # free-slip walls; the plot of the head's travel is written when gnuplot is installed.
 # Usage: cmake -DEXE=<mfree_gravity_current> -DOUT=<dir> -DNZ=<n> -DREF=rs|inviscid -DTOL=<rel>
 #              -P check_gravity_current.cmake
