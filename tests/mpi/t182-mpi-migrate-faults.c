@@ -242,6 +242,19 @@ int main(int argc, char **argv) {
     free(extra);
     mig_state_check(&s, &c, 0.0, "after the refused layouts (nothing moved)");
   }
+  /* a capacity below the owned particles the arrays hold (but not below n_new) */
+  {
+    int32_t n_owned_plan = 0;
+    mfree_migration_get_counts(m, &n_owned_plan, NULL, NULL, NULL);
+    int gives = n_owned_plan > n_new, any = 0;
+    MPI_Allreduce(&gives, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (any) {
+      expect(ctx, mfree_migration_execute(m, gives ? n_new : s.cap), MFREE_ERR_ARG, "owned particles the plan moves",
+             "capacity below n_owned on the ranks that lose particles");
+      mig_state_check(&s, &c, 0.0, "after the refused execute (nothing moved)");
+    }
+    CHECK(any || size == 1, "no rank loses particles: the row above did not run");
+  }
   /* a field without data */
   mfree_migration_clear_fields(m);
   mfree_migration_add_field(m, rank == 0 ? NULL : s.rho, 8, 8);

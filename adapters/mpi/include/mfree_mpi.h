@@ -372,10 +372,11 @@ MFREE_MPI_API mfree_status_t mfree_migration_set_owners(mfree_migration_t *migra
  * register them again, call again). Then one MPI_Alltoallv of packed records.
  * @param[in] migration  a plan from mfree_migration_partition or _set_owners, not yet executed
  * @param[in] capacity   particles each registered array holds (>= n_new, the size needed,
- *                       from the plan call or mfree_migration_get_counts)
+ *                       from the plan call or mfree_migration_get_counts; and >= the
+ *                       plan's n_owned, which the arrays hold)
  * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_STATE (no plan, or executed
  *         already), MFREE_ERR_ARG (a capacity below n_new: "capacity C is below the N
- *         particles this rank owns after the migration"; ranks whose registered fields
+ *         particles this rank owns after the migration", or below n_owned; ranks whose registered fields
  *         differ in number or item sizes: "ranks disagree on the registered fields"),
  *         MFREE_ERR_NULL (a field without data and capacity > 0), MFREE_ERR_ALLOC,
  *         MFREE_ERR_INTERNAL; the message starts with the failing rank

@@ -420,6 +420,11 @@ mfree_status_t mfree_migration_execute(mfree_migration_t *m, int32_t capacity) {
     if (capacity < m->n_new)
       return r.fail(MFREE_ERR_ARG, "capacity " + std::to_string(capacity) + " is below the " +
                                        std::to_string(m->n_new) + " particles this rank owns after the migration");
+    // (the arrays hold the owned particles the plan moves: a capacity below their count
+    // would be read past)
+    if (capacity < m->n_owned)
+      return r.fail(MFREE_ERR_ARG, "capacity " + std::to_string(capacity) + " is below the " +
+                                       std::to_string(m->n_owned) + " owned particles the plan moves");
     for (size_t f = 0; f < m->fields.size(); ++f)
       if (!m->fields[f].data && capacity > 0)
         return r.fail(MFREE_ERR_NULL, "field " + std::to_string(f) + " has no data");
