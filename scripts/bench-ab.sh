@@ -68,8 +68,8 @@ for side in old new; do
   def=()
   grep -q mfree_context_set_page_hints "$wt/include/mfree.h" && def=(-DMFREE_BENCH_HAVE_PAGE_HINTS)
   ver="$(dirname "$(find "$bd" -name mfree_version.h -print -quit)")"
-  # bench/ of the new side on both (bench-compare copied it into both worktrees)
-  cc -O2 -fPIC -shared -Wall -Wextra "${def[@]}" -I"$scratch/new/bench" -I"$wt/include" -I"$ver" \
+  # bench/bench_util.h of this checkout on both sides, like case.c
+  cc -O2 -fPIC -shared -Wall -Wextra -Werror=implicit-function-declaration "${def[@]}" -I"$repo/bench" -I"$wt/include" -I"$ver" \
      -o "$ab/case-$side.so" "$here/bench-ab/case.c" -L"$bd/src" -lmfree -lm -Wl,-rpath,"$bd/src"
 done
 cc -O2 -Wall -Wextra -o "$ab/driver" "$here/bench-ab/driver.c" -ldl
@@ -102,7 +102,7 @@ else
   echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
   for c in "${args[@]:2}"; do
     read -r -a cw <<<"$c"
-    "$ab/driver" "$ab/case-old.so" "$ab/case-new.so" "$rounds" "${cw[@]}"
+    "$ab/driver" "$ab/case-old.so" "$ab/case-new.so" "$rounds" "${cw[@]}" || die "the case '$c' failed"
   done
 fi
 exit 0
