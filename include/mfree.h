@@ -1919,6 +1919,64 @@ MFREE_API mfree_status_t mfree_system_set_load_history(mfree_system_t *sys,
 MFREE_API mfree_status_t mfree_system_get_stress(mfree_system_t *sys, double t,
                                                  const double *y, double *sigma);
 
+/**
+ * Forward halo exchange for a system on ranks (mfree_system_create_elastodynamic_ranks):
+ * the owners' values of a per-particle field written into this rank's ghost items.
+ * Collective over the system's ranks; the core never calls MPI, the host (or
+ * libmfree_mpi's mfree_halo_exchange_callback) does.
+ * @param[in]     user   the pointer given at the system's creation
+ * @param[in]     ncomp  components per particle (>= 1), the same on every rank
+ * @param[in,out] field  AoS items of ld doubles, the particle set's order (owned, then
+ *                       ghosts): owned items read, components [0, ncomp) of ghosts written
+ * @param[in]     ld     leading dimension (>= ncomp)
+ * @return MFREE_SUCCESS, or a failure status that every rank returns alike
+ */
+typedef mfree_status_t (*mfree_exchange_fn)(void *user, int32_t ncomp, double *field,
+                                            int64_t ld);
+/**
+ * All-gather for a system on ranks: every rank's n doubles concatenated in rank order.
+ * Collective. The values travel as bits (integers are packed into doubles by memcpy).
+ * @param[in]  user   the pointer given at the system's creation
+ * @param[in]  in     this rank's n values (may be NULL when n is 0)
+ * @param[in]  n      this rank's count (>= 0; may differ between ranks)
+ * @param[out] out    cap doubles; written only when cap >= *total on every rank
+ * @param[in]  cap    capacity of out (0: ask for the total only)
+ * @param[out] total  the sum of the ranks' n
+ * @return MFREE_SUCCESS, or a failure status that every rank returns alike
+ */
+typedef mfree_status_t (*mfree_allgather_fn)(void *user, const double *in, int64_t n,
+                                             double *out, int64_t cap, int64_t *total);
+
+/**
+ * Linear elastodynamics by collocation, as mfree_system_create_elastodynamic, on one rank
+ * of several: the assembler is set up over this rank's owned particles plus ghosts (a
+ * particle set with mfree_particles_set_num_ghost and global ids, ghosts at least one
+ * support deep), and the state y of this rank holds its owned particles only
+ * (displacements of the owned particles, then their velocities: neq = 2 ncomp n_owned).
+ * Every right-hand side, native step and stress evaluation is collective: it exchanges
+ * the ghosts' displacements through exchange, and gathers the boundary rows' data through
+ * allgather (the boundary unknowns are solved in global-id order on every rank, so that
+ * the owned particles' results are bitwise those of one rank, whatever the partition).
+ * A failure on one rank (a non-finite state: MFREE_FAIL_NONFINITE) is returned by every
+ * rank with that rank's message ("rank R: ..."). Creation is collective too: a NULL
+ * assembler or a bad density on one rank, or ranks that disagree on the density, the
+ * form or its coefficients, make every rank fail alike (MFREE_ERR_NULL, MFREE_ERR_ARG).
+ * Collocation forms only (MFREE_ERR_UNSUPPORTED for Galerkin assemblers).
+ * libmfree_mpi's mfree_halo_create_elastodynamic supplies the callbacks from a halo plan.
+ * @param[in]  ctx        context (kept alive); NULL: MFREE_ERR_NULL on this rank alone
+ * @param[in]  as         a set-up collocation assembler over owned particles and ghosts
+ *                        (kept alive), or NULL (every rank then fails)
+ * @param[in]  density    rho > 0, the same on every rank
+ * @param[in]  exchange   the forward halo exchange (NULL: MFREE_ERR_NULL, local)
+ * @param[in]  allgather  the all-gather (NULL: MFREE_ERR_NULL, local)
+ * @param[in]  user       passed to both callbacks; kept
+ * @param[out] sys        the new system (NULL: MFREE_ERR_NULL, local)
+ * @return MFREE_SUCCESS, or a failure named with the parameters, alike on every rank
+ */
+MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
+    mfree_context_t *ctx, mfree_assembler_t *as, double density, mfree_exchange_fn exchange,
+    mfree_allgather_fn allgather, void *user, mfree_system_t **sys);
+
 #ifdef __cplusplus
 }
 #endif

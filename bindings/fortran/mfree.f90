@@ -1439,6 +1439,20 @@ module mfree
       type(c_ptr), value :: user
     end function mfree_system_set_load_history_c
 
+    ! (exchange, allgather: bind(C) functions of the interfaces mfree_exchange_fn and
+    ! mfree_allgather_fn of mfree.h, passed with c_funloc; libmfree_mpi supplies both)
+    integer(c_int) function mfree_system_create_elastodynamic_ranks_c(ctx, as, density, exchange, &
+        allgather, user, sys) bind(C, name="mfree_system_create_elastodynamic_ranks")
+      import :: c_int, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: ctx
+      type(c_ptr), value :: as
+      real(c_double), value :: density
+      type(c_funptr), value :: exchange
+      type(c_funptr), value :: allgather
+      type(c_ptr), value :: user
+      type(c_ptr), intent(out) :: sys
+    end function mfree_system_create_elastodynamic_ranks_c
+
     integer(c_int) function mfree_system_get_stress_c(sys, t, y, sigma) &
         bind(C, name="mfree_system_get_stress")
       import :: c_int, c_double, c_ptr
@@ -1526,6 +1540,7 @@ module mfree
   public :: mfree_system_get_wall_force_c
   public :: mfree_system_create_elastodynamic_c, mfree_system_set_load_history_c
   public :: mfree_system_create_elastodynamic_galerkin_c
+  public :: mfree_system_create_elastodynamic_ranks_c
   public :: mfree_system_set_shepard_condition_c
   public :: mfree_system_get_stress_c
 

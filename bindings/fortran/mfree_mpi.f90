@@ -19,7 +19,7 @@ module mfree_mpi
   use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double, c_ptr, &
     c_null_ptr, c_loc, c_f_pointer
   use mfree, only: mfree_context, mfree_approximant, MFREE_SUCCESS, mfree_wrapper_check_out, &
-    mfree_wrapper_view_dbl
+    mfree_wrapper_view_dbl, mfree_assembler, mfree_system
   implicit none
   private
 
@@ -38,7 +38,8 @@ module mfree_mpi
   integer(c_int), parameter, public :: MFREE_PARTITIONER_HSFC = 2
 
   ! ---- raw bind(C) interfaces: one per public function of mfree_mpi.h (but the C-only
-  ! mfree_halo_create) ----
+  ! mfree_halo_create and mfree_halo_get_communicator, whose MPI_Comm has no portable
+  ! Fortran interface) ----
   interface
     integer(c_int) function mfree_halo_create_f_c(ctx, fcomm, dim, halo) &
         bind(C, name="mfree_halo_create_f")
@@ -220,6 +221,35 @@ module mfree_mpi
       import :: c_int, c_ptr
       type(c_ptr), value :: migration
     end function mfree_migration_set_pending_error_c
+
+    integer(c_int) function mfree_halo_exchange_callback_c(halo, ncomp, field, ld) &
+        bind(C, name="mfree_halo_exchange_callback")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int32_t), value :: ncomp
+      real(c_double), intent(inout) :: field(*)
+      integer(c_int64_t), value :: ld
+    end function mfree_halo_exchange_callback_c
+
+    integer(c_int) function mfree_halo_allgather_c(halo, in, n, out, cap, total) &
+        bind(C, name="mfree_halo_allgather")
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: halo
+      real(c_double), intent(in) :: in(*)
+      integer(c_int64_t), value :: n
+      real(c_double), intent(out) :: out(*)
+      integer(c_int64_t), value :: cap
+      integer(c_int64_t), intent(out) :: total
+    end function mfree_halo_allgather_c
+
+    integer(c_int) function mfree_halo_create_elastodynamic_c(halo, as, density, sys) &
+        bind(C, name="mfree_halo_create_elastodynamic")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: halo
+      type(c_ptr), value :: as
+      real(c_double), value :: density
+      type(c_ptr), intent(out) :: sys
+    end function mfree_halo_create_elastodynamic_c
   end interface
 
   public :: mfree_halo_create_f_c, mfree_halo_destroy_c, mfree_halo_setup_c
@@ -241,6 +271,8 @@ module mfree_mpi
   public :: mfree_migration_partition, mfree_migration_set_owners, mfree_migration_execute
   public :: mfree_migration_get_counts, mfree_migration_get_owners, mfree_migration_get_context
   public :: mfree_migration_set_pending_error
+  public :: mfree_halo_exchange_callback_c, mfree_halo_allgather_c, mfree_halo_create_elastodynamic_c
+  public :: mfree_halo_create_elastodynamic
 
   real(c_double), target, save :: empty_dbl(0)
   integer(c_int32_t), target, save :: empty_i32(0)
@@ -255,6 +287,17 @@ contains
     type(mfree_halo), intent(out) :: halo
     st = mfree_halo_create_f_c(ctx%ptr, int(comm, c_int32_t), dim, halo%ptr)
   end function mfree_halo_create
+
+  !> The elastodynamic system of a collocation assembler over the plan's particles, on
+  !> ranks (mfree_system_create_elastodynamic_ranks through the plan). Collective; the plan
+  !> must outlive the system.
+  integer(c_int) function mfree_halo_create_elastodynamic(halo, as, density, sys) result(st)
+    type(mfree_halo), intent(in) :: halo
+    type(mfree_assembler), intent(in) :: as
+    real(c_double), intent(in) :: density
+    type(mfree_system), intent(out) :: sys
+    st = mfree_halo_create_elastodynamic_c(halo%ptr, as%ptr, density, sys%ptr)
+  end function mfree_halo_create_elastodynamic
 
   !> The same with the communicator already as integer(c_int32_t).
   integer(c_int) function mfree_halo_create_f(ctx, fcomm, dim, halo) result(st)

@@ -57,6 +57,18 @@ mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, mfree_matrix_t **M
   });
 }
 
+// The handle of a new elastodynamic system: it keeps its context and assembler alive.
+mfree_system_t *elastic_handle(mfree_context_t *ctx, std::unique_ptr<mfree::ElasticSystem> impl,
+                               mfree_assembler_t *as) {
+  auto *s = new mfree_system_t();
+  s->ctx = ctx;
+  s->as = as;
+  s->sys = std::move(impl);
+  mfree::retain(ctx);
+  as->refs.fetch_add(1, std::memory_order_relaxed);
+  return s;
+}
+
 }  // namespace
 
 extern "C" {
@@ -222,14 +234,7 @@ mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx, mfree_ass
     MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
     *sys = nullptr;
     MFREE_REQUIRE(as, MFREE_ERR_NULL, "assembler is NULL");
-    auto impl = std::make_unique<mfree::ElasticSystem>(&as->as, density);
-    auto *s = new mfree_system_t();
-    s->ctx = ctx;
-    s->as = as;
-    s->sys = std::move(impl);
-    mfree::retain(ctx);
-    as->refs.fetch_add(1, std::memory_order_relaxed);
-    *sys = s;
+    *sys = elastic_handle(ctx, std::make_unique<mfree::ElasticSystem>(&as->as, density), as);
     return MFREE_SUCCESS;
   });
 }
@@ -251,6 +256,22 @@ mfree_status_t mfree_system_create_elastodynamic_galerkin(mfree_context_t *ctx, 
     stiffness->refs.fetch_add(1, std::memory_order_relaxed);
     mass->refs.fetch_add(1, std::memory_order_relaxed);
     *sys = s;
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_create_elastodynamic_ranks(mfree_context_t *ctx, mfree_assembler_t *as, double density,
+                                                      mfree_exchange_fn exchange, mfree_allgather_fn allgather,
+                                                      void *user, mfree_system_t **sys) {
+  if (!ctx) return MFREE_ERR_NULL;
+  return mfree::guard(ctx, "mfree_system_create_elastodynamic_ranks", [&]() {
+    // (local failures: without the callbacks or the output no rank can be told)
+    MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
+    *sys = nullptr;
+    MFREE_REQUIRE(exchange && allgather, MFREE_ERR_NULL, "exchange or allgather callback is NULL");
+    auto impl = mfree::ElasticSystem::on_ranks(as ? &as->as : nullptr, density,
+                                               mfree::Collective(exchange, allgather, user));
+    *sys = elastic_handle(ctx, std::move(impl), as);
     return MFREE_SUCCESS;
   });
 }

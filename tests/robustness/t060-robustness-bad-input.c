@@ -303,6 +303,18 @@ static void row(const char *call, mfree_status_t got, mfree_status_t want, mfree
 static void host_field(void *user, const double *x, double *v) { (void)user; v[0] = x[0]; }
 static double history(void *user, double t) { (void)user; return t; }
 static int32_t inside(void *user, const double *x) { (void)user; return x[0] >= 0.0; }
+/* the collective callbacks of one rank: no ghosts to fill; the gather copies */
+static mfree_status_t one_exchange(void *user, int32_t ncomp, double *field, int64_t ld) {
+  (void)user, (void)ncomp, (void)field, (void)ld;
+  return MFREE_SUCCESS;
+}
+static mfree_status_t one_allgather(void *user, const double *in, int64_t n, double *out, int64_t cap,
+                                    int64_t *total) {
+  (void)user;
+  *total = n;
+  if (cap >= n && n > 0) memcpy(out, in, sizeof(double) * (size_t)n);
+  return MFREE_SUCCESS;
+}
 static void handler(void *user, mfree_status_t code, const char *message) {
   (void)code, (void)message;
   ++*(int *)user;
@@ -1133,6 +1145,13 @@ static void rows_system(void) {
   ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic(F.ctx, NULL, 1.0, &s));
   ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic(F.ctx, F.as, 1.0, NULL));
   ROW(MFREE_ERR_UNSUPPORTED, mfree_system_create_elastodynamic(F.ctx, F.as, 1.0, &s));
+  ROW0(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(NULL, F.as, 1.0, one_exchange, one_allgather, NULL, &s));
+  ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(F.ctx, NULL, 1.0, one_exchange, one_allgather, NULL, &s));
+  ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, one_exchange, one_allgather, NULL, NULL));
+  ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, NULL, one_allgather, NULL, &s));
+  ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, one_exchange, NULL, NULL, &s));
+  /* a Galerkin assembler */
+  ROW(MFREE_ERR_UNSUPPORTED, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, one_exchange, one_allgather, NULL, &s));
 #if MFREE_T060_GALERKIN_ELASTODYNAMICS
   {
     mfree_assembler_t *mass = NULL;

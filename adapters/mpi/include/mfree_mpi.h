@@ -428,6 +428,68 @@ MFREE_MPI_API mfree_status_t mfree_migration_get_context(const mfree_migration_t
  */
 MFREE_MPI_API mfree_status_t mfree_migration_set_pending_error(mfree_migration_t *migration);
 
+/* ------------------------------------------------------------------------------------ */
+/* Systems on ranks: the collective callbacks of mfree_system_create_elastodynamic_ranks  */
+/* over a halo plan. docs/mpi.md, "Systems on ranks".                                      */
+/* ------------------------------------------------------------------------------------ */
+
+/**
+ * The plan's communicator (a duplicate of the one given at creation), for collective
+ * calls of the host that must meet the plan's ranks.
+ * @param[in]  halo  the plan
+ * @param[out] comm  its communicator, borrowed: the plan frees it
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL handle or output
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_get_communicator(const mfree_halo_t *halo, MPI_Comm *comm);
+
+/**
+ * mfree_halo_exchange as an mfree_exchange_fn, for systems on ranks
+ * (mfree_system_create_elastodynamic_ranks with user = the plan). Collective.
+ * @param[in]     halo   the plan (an mfree_halo_t *)
+ * @param[in]     ncomp  components per particle, the same on every rank
+ * @param[in,out] field  owned then ghost items of ld doubles
+ * @param[in]     ld     leading dimension (>= ncomp)
+ * @return as mfree_halo_exchange: the same status on every rank
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_exchange_callback(void *halo, int32_t ncomp, double *field,
+                                                          int64_t ld);
+
+/**
+ * An all-gather over the plan's communicator as an mfree_allgather_fn: every rank's n
+ * doubles concatenated in rank order (MPI_Allgather of the counts and capacities, then
+ * MPI_Allgatherv; the values' bits are moved, never combined). Collective.
+ * @param[in]  halo   the plan (an mfree_halo_t *)
+ * @param[in]  in     this rank's n values (may be NULL when n is 0)
+ * @param[in]  n      this rank's count (>= 0)
+ * @param[out] out    cap doubles, written when every rank's cap is at least *total
+ * @param[in]  cap    capacity of out (0: ask for the total only)
+ * @param[out] total  the sum of the ranks' n
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_NULL (a NULL plan: locally; a
+ *         NULL total or NULL in with n > 0), MFREE_ERR_ARG (a negative n, more than
+ *         2^31 - 1 values), MFREE_ERR_INTERNAL (an MPI failure); the message starts with
+ *         the failing rank
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_allgather(void *halo, const double *in, int64_t n,
+                                                  double *out, int64_t cap, int64_t *total);
+
+/**
+ * mfree_system_create_elastodynamic_ranks through this plan: the ghosts' displacements
+ * by mfree_halo_exchange, the boundary rows' data by mfree_halo_allgather; the system is
+ * created on the plan's context and keeps a pointer to the plan, which must outlive it
+ * (destroy the system first). Collective; the assembler's particle set holds the plan's
+ * particles in its order (n_owned owned, then the n_ghost ghosts, with the plan's global
+ * ids: mfree_halo_get_global_ids).
+ * @param[in]  halo     a set-up plan
+ * @param[in]  as       a set-up collocation assembler over the plan's particles (kept
+ *                      alive), or NULL (every rank then fails)
+ * @param[in]  density  rho > 0, the same on every rank
+ * @param[out] sys      the new system
+ * @return as mfree_system_create_elastodynamic_ranks; MFREE_ERR_NULL (local) for a NULL
+ *         plan or output
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_create_elastodynamic(mfree_halo_t *halo, mfree_assembler_t *as,
+                                                             double density, mfree_system_t **sys);
+
 #ifdef __cplusplus
 }
 #endif

@@ -458,3 +458,9 @@ mfree_status_t mfree_halo_exchange_correction(mfree_halo_t *h, mfree_approximant
 }
 
 }  // extern "C"
+
+extern "C" mfree_status_t mfree_halo_get_communicator(const mfree_halo_t *h, MPI_Comm *comm) {
+  if (!h || !comm) return MFREE_ERR_NULL;
+  *comm = h->comm;
+  return MFREE_SUCCESS;
+}

@@ -260,6 +260,22 @@ MFREE_SUNDIALS_API int mfree_sundials_mass(sunrealtype t, SUNMatrix M, void *use
 MFREE_SUNDIALS_API int mfree_sundials_residual(sunrealtype t, N_Vector y, N_Vector yp,
                                                N_Vector r, void *user_data);
 
+/**
+ * ARKLsMassTimesFn: Mv = M v with M the mass of mfree_sundials_mass (at the same state,
+ * predicted to time t), for matrix-free mass solvers such as SUNLinSol_PCG
+ * (ARKStepSetMassLinearSolver(mem, LS, NULL, ...), ARKStepSetMassTimes(mem, NULL,
+ * mfree_sundials_mass_times, ad)), and for vectors over ranks (NVECTOR_PARALLEL: the
+ * mass of a system on ranks is block-diagonal by rank; collocation: the identity).
+ * @param[in]  v            the vector to multiply (the system's length on this rank)
+ * @param[out] Mv           M v
+ * @param[in]  t            time
+ * @param[in]  mtimes_data  the adapter (ARKStepSetMassTimes' data)
+ * @return 0; -1 (reason on the context) for a NULL adapter, no state yet, or vectors of
+ *         another length or without data; the system's positive status as it is
+ */
+MFREE_SUNDIALS_API int mfree_sundials_mass_times(N_Vector v, N_Vector Mv, sunrealtype t,
+                                                 void *mtimes_data);
+
 #ifdef __cplusplus
 }
 #endif

@@ -102,7 +102,11 @@ mfree_status_t vector_data(mfree_sundials_t *ad, const char *fn, const char *nam
                   std::string(name) +
                       " has no length operation (nvgetlength): the adapter needs vectors "
                       "with one contiguous host array (NVECTOR_SERIAL, OPENMP, PTHREADS)");
-  const sunindextype len = N_VGetLength(v);
+  // Vectors over ranks (NVECTOR_PARALLEL, MPIPLUSX) hold this rank's part of the state:
+  // their local length is the system's size on this rank.
+  const N_Vector_ID id = v->ops->nvgetvectorid ? N_VGetVectorID(v) : SUNDIALS_NVEC_CUSTOM;
+  const bool ranks = (id == SUNDIALS_NVEC_PARALLEL || id == SUNDIALS_NVEC_MPIPLUSX) && v->ops->nvgetlocallength;
+  const sunindextype len = ranks ? v->ops->nvgetlocallength(v) : N_VGetLength(v);
   if (len != static_cast<sunindextype>(ad->neq))
     return record(ad->ctx, MFREE_ERR_MISMATCH, fn,
                   std::string(name) + " has length " + std::to_string(static_cast<int64_t>(len)) +
@@ -135,6 +139,25 @@ mfree_status_t mass_form(mfree_sundials_t *ad, double t, const double *y, double
   st = mfree_system_assemble_mass(ad->sys, y, 0, &ad->lumped);
   if (st != MFREE_SUCCESS) return st;
   return mfree_matrix_apply(ad->lumped, ad->work.data(), out);
+}
+
+// ad->mass = the mass at time t. M depends on positions and densities, whose rows of
+// M y' = F are y' = f: they are predicted to time t from the last right-hand side (first
+// order in t - state_t).
+mfree_status_t mass_at(mfree_sundials_t *ad, const char *fn, double t) {
+  if (!ad->has_state)
+    return record(ad->ctx, MFREE_ERR_STATE, fn,
+                  "no state to assemble the mass at: evaluate a right-hand side of the "
+                  "adapter or call mfree_sundials_set_state first");
+  const double *at = ad->state.data();
+  if (ad->state_timed && t != ad->state_t) {
+    ++ad->nmass_predicted;
+    ad->predicted.resize(static_cast<size_t>(ad->neq));
+    const double dt = t - ad->state_t;
+    for (int32_t q = 0; q < ad->neq; ++q) ad->predicted[q] = ad->state[q] + dt * ad->rate[q];
+    at = ad->predicted.data();
+  }
+  return mfree_system_assemble_mass(ad->sys, at, ad->consistent ? 1 : 0, &ad->mass);
 }
 
 // Copy an mfree matrix (CSR view or its CSC view) into the host's SUNSparseMatrix.
@@ -362,23 +385,23 @@ int mfree_sundials_mass(sunrealtype t, SUNMatrix M, void *user_data, N_Vector tm
   mfree_sundials_t *ad = static_cast<mfree_sundials_t *>(user_data);
   return callback(ad, fn, [&]() {
     ++ad->nmass;
-    if (!ad->has_state)
-      return record(ad->ctx, MFREE_ERR_STATE, fn,
-                    "no state to assemble the mass at: evaluate a right-hand side of the "
-                    "adapter or call mfree_sundials_set_state first");
-    // M depends on positions and densities, whose rows of M y' = F are y' = f: predict
-    // them to time t from the last right-hand side (first order in t - state_t)
-    const double *at = ad->state.data();
-    if (ad->state_timed && t != ad->state_t) {
-      ++ad->nmass_predicted;
-      ad->predicted.resize(static_cast<size_t>(ad->neq));
-      const double dt = t - ad->state_t;
-      for (int32_t q = 0; q < ad->neq; ++q) ad->predicted[q] = ad->state[q] + dt * ad->rate[q];
-      at = ad->predicted.data();
-    }
-    mfree_status_t st = mfree_system_assemble_mass(ad->sys, at, ad->consistent ? 1 : 0, &ad->mass);
+    mfree_status_t st = mass_at(ad, fn, t);
     if (st != MFREE_SUCCESS) return st;
     return fill_sparse(ad, fn, ad->mass, M);
+  });
+}
+
+int mfree_sundials_mass_times(N_Vector v, N_Vector Mv, sunrealtype t, void *mtimes_data) {
+  static const char *fn = "mfree_sundials_mass_times";
+  mfree_sundials_t *ad = static_cast<mfree_sundials_t *>(mtimes_data);
+  return callback(ad, fn, [&]() {
+    ++ad->nmass;
+    double *pv = nullptr, *pm = nullptr;
+    mfree_status_t st = vector_data(ad, fn, "v", v, &pv);
+    if (st == MFREE_SUCCESS) st = vector_data(ad, fn, "Mv", Mv, &pm);
+    if (st == MFREE_SUCCESS) st = mass_at(ad, fn, t);
+    if (st != MFREE_SUCCESS) return st;
+    return mfree_matrix_apply(ad->mass, pv, pm);
   });
 }
 

@@ -18,20 +18,26 @@ ElasticSystem::ElasticSystem(const Assembler *as, double density) : as_(as), rho
                                        "mfree_system_create_elastodynamic_galerkin");
   if (!(std::isfinite(density) && density > 0.0)) throw Error(MFREE_ERR_ARG, "density must be finite and > 0");
   init_common();
-  // the smallest particle spacing for the CFL limit
-  const ParticleSet &ps = as->particles();
-  dx_min_ = INFINITY;
-  const Approximant *tab = as->collocation_tables();
-  for (int32_t i = 0; i < ps.size(); ++i)
+  dx_min_ = local_spacing(as->particles().size());
+  limit_ = dx_min_ / c_;
+}
+
+// The smallest distance between a particle of the first nrows and a neighbour of its
+// collocation row: the CFL limit's spacing.
+double ElasticSystem::local_spacing(int32_t nrows) const {
+  const ParticleSet &ps = as_->particles();
+  double dx = INFINITY;
+  const Approximant *tab = as_->collocation_tables();
+  for (int32_t i = 0; i < nrows; ++i)
     for (int64_t k = tab->rowptr()[i]; k < tab->rowptr()[i + 1]; ++k) {
       const int32_t j = tab->cols()[k];
       if (j == i) continue;
       double d[3] = {0, 0, 0}, r2 = 0.0;
       ps.displacement(i, j, d);
       for (int c = 0; c < dim_; ++c) r2 += d[c] * d[c];
-      if (r2 > 0.0) dx_min_ = std::min(dx_min_, std::sqrt(r2));
+      if (r2 > 0.0) dx = std::min(dx, std::sqrt(r2));
     }
-  limit_ = dx_min_ / c_;
+  return dx;
 }
 
 ElasticSystem::ElasticSystem(const Assembler *stiffness, const Assembler *mass) : as_(stiffness), rho_(0.0) {
@@ -56,16 +62,42 @@ ElasticSystem::ElasticSystem(const Assembler *stiffness, const Assembler *mass) 
 }
 
 void ElasticSystem::init_common() {
+  if (as_->particles().num_ghost() != 0)
+    throw Error(MFREE_ERR_UNSUPPORTED, "elastodynamics runs on particle sets without ghosts (on ranks: "
+                                       "mfree_system_create_elastodynamic_ranks)");
+  init_operator();
+  init_boundary();
+}
+
+// The operator's rows, its load and the wave speed; nd_ counts the owned unknowns, nl_
+// the local ones (owned and ghost particles).
+void ElasticSystem::init_operator() {
   const Assembler *as = as_;
   const ParticleSet &ps = as->particles();
   dim_ = ps.dim();
   nc_ = as->ncomp();
-  nd_ = ps.size() * nc_;
-  if (ps.num_ghost() != 0) throw Error(MFREE_ERR_UNSUPPORTED, "elastodynamics runs on particle sets without ghosts");
+  nd_ = ps.num_owned() * nc_;
+  nl_ = ps.size() * nc_;
   as->assemble_matrix(K_);
-  f0_.assign(static_cast<size_t>(nd_), 0.0);
+  f0_.assign(static_cast<size_t>(nl_), 0.0);
   as->assemble_rhs(f0_.data());
-  const auto &kinds = as->row_kinds();
+  // wave speed: bar (Laplace, c = coefficient = E) or P wave
+  const int form = as->form();
+  if (form == MFREE_FORM_COLLOCATION_LAPLACE || form == MFREE_FORM_LAPLACE) {
+    c_ = std::sqrt(as->coefficient() / rho_);
+  } else {
+    const double E = as->young(), nu = as->poisson();
+    const double lam = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+    const bool pstress = form == MFREE_FORM_COLLOCATION_PLANE_STRESS || form == MFREE_FORM_ELASTICITY_PLANE_STRESS;
+    const double lam_eff = pstress ? 2 * lam * mu / (lam + 2 * mu) : lam;
+    c_ = std::sqrt((lam_eff + 2 * mu) / rho_);
+  }
+  work_.resize(nl_);
+}
+
+// The boundary unknowns of one process and the factorised block that determines them.
+void ElasticSystem::init_boundary() {
+  const auto &kinds = as_->row_kinds();
   bpos_.assign(nd_, -1);
   for (int32_t d = 0; d < nd_; ++d)
     if (kinds[d] != 0) {
@@ -83,26 +115,18 @@ void ElasticSystem::init_common() {
         if (bpos_[c] >= 0 && K_.values()[k] != 0.0) trip.emplace_back(q, bpos_[c], K_.values()[k]);
       }
     }
-    Eigen::SparseMatrix<double> Kbb(nb, nb);
-    Kbb.setFromTriplets(trip.begin(), trip.end());
-    lu_ = std::make_unique<Eigen::SparseLU<Eigen::SparseMatrix<double>>>();
-    lu_->compute(Kbb);
-    if (lu_->info() != Eigen::Success)
-      throw Error(MFREE_ERR_INPUT, "the boundary rows do not determine the boundary unknowns (singular block)");
-  }
-  // wave speed: bar (Laplace, c = coefficient = E) or P wave
-  const int form = as->form();
-  if (form == MFREE_FORM_COLLOCATION_LAPLACE || form == MFREE_FORM_LAPLACE) {
-    c_ = std::sqrt(as->coefficient() / rho_);
-  } else {
-    const double E = as->young(), nu = as->poisson();
-    const double lam = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
-    const bool pstress = form == MFREE_FORM_COLLOCATION_PLANE_STRESS || form == MFREE_FORM_ELASTICITY_PLANE_STRESS;
-    const double lam_eff = pstress ? 2 * lam * mu / (lam + 2 * mu) : lam;
-    c_ = std::sqrt((lam_eff + 2 * mu) / rho_);
+    factor_boundary(nb, trip);
   }
   rb_.resize(nb);
-  work_.resize(nd_);
+}
+
+void ElasticSystem::factor_boundary(int32_t nb, const std::vector<Eigen::Triplet<double>> &trip) {
+  Eigen::SparseMatrix<double> Kbb(nb, nb);
+  Kbb.setFromTriplets(trip.begin(), trip.end());
+  lu_ = std::make_unique<Eigen::SparseLU<Eigen::SparseMatrix<double>>>();
+  lu_->compute(Kbb);
+  if (lu_->info() != Eigen::Success)
+    throw Error(MFREE_ERR_INPUT, "the boundary rows do not determine the boundary unknowns (singular block)");
 }
 
 void ElasticSystem::init_galerkin_mass(const Assembler *mass) {
@@ -246,7 +270,10 @@ Report ElasticSystem::check(const double *y, const std::string &when) const {
   for (int32_t q = 0; q < 2 * nd_; ++q)
     if (!std::isfinite(y[q])) {
       std::ostringstream s;
-      s << when << "particle " << (q % nd_) / nc_ << " has a non-finite " << (q < nd_ ? "displacement" : "velocity");
+      const int32_t i = (q % nd_) / nc_;
+      s << when << "particle " << i;
+      if (ranks_) s << " (global id " << as_->particles().global_ids()[i] << ")";
+      s << " has a non-finite " << (q < nd_ ? "displacement" : "velocity");
       rep.fail(MFREE_FAIL_NONFINITE, s.str());
       break;
     }
@@ -255,9 +282,14 @@ Report ElasticSystem::check(const double *y, const std::string &when) const {
 
 Report ElasticSystem::rhs(double t, const double *y, double *ydot) {
   Report rep = check(y, "");
-  if (!rep.ok()) return rep;
-  std::copy(y, y + nd_, work_.begin());
-  enforce_boundary(t, work_.data());
+  if (ranks_) {
+    rep = fill_state(t, y, rep);  // every rank takes part, a failing one too
+    if (!rep.ok()) return settle(rep);
+  } else {
+    if (!rep.ok()) return rep;
+    std::copy(y, y + nd_, work_.begin());
+    enforce_boundary(t, work_.data());
+  }
   // boundary unknowns follow the constraints: their entries of y are not used
   for (int32_t d = 0; d < nd_; ++d) ydot[d] = bpos_[d] >= 0 ? 0.0 : y[nd_ + d];
   accel(t, work_.data(), ydot + nd_);
@@ -297,11 +329,15 @@ Report ElasticSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
 }
 
 void ElasticSystem::stress(double t, const double *y, double *sigma) const {
-  std::copy(y, y + nd_, work_.begin());
-  enforce_boundary(t, work_.data());
+  if (ranks_) {
+    settle(fill_state(t, y, Report()));
+  } else {
+    std::copy(y, y + nd_, work_.begin());
+    enforce_boundary(t, work_.data());
+  }
   const Approximant *tab = as_->collocation_tables();
   const auto &G = tab->gradients();
-  const int32_t n = as_->particles().size();
+  const int32_t n = num_particles();
   const int sc = stress_components();
   const double E = as_->young(), nu = as_->poisson();
   double lam = E * nu / ((1 + nu) * (1 - 2 * nu));
@@ -327,28 +363,64 @@ void ElasticSystem::stress(double t, const double *y, double *sigma) const {
 
 Report ElasticSystem::integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                                 mfree_progress_fn progress, void *user, int64_t &nsteps) {
-  if (scheme != MFREE_INTEGRATOR_LEAPFROG)
-    throw Error(MFREE_ERR_UNSUPPORTED, "elastodynamics integrates with the central-difference (leap-frog) scheme");
-  if (!(std::isfinite(t_end) && std::isfinite(t))) throw Error(MFREE_ERR_ARG, "times must be finite");
-  if (!(std::isfinite(cfl) && cfl <= 1.0)) throw Error(MFREE_ERR_ARG, "cfl must be finite and <= 1");
-  if (!(std::isfinite(dt_max) && dt_max >= 0.0)) throw Error(MFREE_ERR_ARG, "dt_max must be finite and >= 0");
-  if (cfl <= 0.0 && dt_max <= 0.0) throw Error(MFREE_ERR_ARG, "give a CFL number or a fixed step dt_max");
   nsteps = 0;
-  Report rep = check(y, "initial state: ");
-  if (!rep.ok()) return rep;
-  const double limit = limit_;
-  double dt = cfl > 0.0 ? cfl * limit : dt_max;
-  if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
-  if (dt > limit * (1.0 + 1e-12)) {
-    std::ostringstream s;
-    s << "dt = " << dt << " exceeds the CFL limit " << (galerkin_ ? "2/omega_max = " : "dx/c = ") << limit;
-    rep.fail(MFREE_FAIL_CFL, s.str());
-    return rep;
+  // The argument checks and the first state's: on ranks one outcome for all (and the
+  // same arguments everywhere), so that no rank steps on alone.
+  Report rep;
+  double dt = 0.0;
+  try {
+    if (scheme != MFREE_INTEGRATOR_LEAPFROG)
+      throw Error(MFREE_ERR_UNSUPPORTED, "elastodynamics integrates with the central-difference (leap-frog) scheme");
+    if (!(std::isfinite(t_end) && std::isfinite(t))) throw Error(MFREE_ERR_ARG, "times must be finite");
+    if (!(std::isfinite(cfl) && cfl <= 1.0)) throw Error(MFREE_ERR_ARG, "cfl must be finite and <= 1");
+    if (!(std::isfinite(dt_max) && dt_max >= 0.0)) throw Error(MFREE_ERR_ARG, "dt_max must be finite and >= 0");
+    if (cfl <= 0.0 && dt_max <= 0.0) throw Error(MFREE_ERR_ARG, "give a CFL number or a fixed step dt_max");
+    rep = check(y, "initial state: ");
+    dt = cfl > 0.0 ? cfl * limit_ : dt_max;
+    if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
+    if (rep.ok() && dt > limit_ * (1.0 + 1e-12)) {
+      std::ostringstream s;
+      s << "dt = " << dt << " exceeds the CFL limit " << (galerkin_ ? "2/omega_max = " : "dx/c = ") << limit_;
+      rep.fail(MFREE_FAIL_CFL, s.str());
+    }
+  } catch (const Error &e) {
+    if (!ranks_) throw;
+    rep.status = e.status();
+    rep.message = e.what();
   }
+  if (ranks_) {
+    const double mine[5] = {static_cast<double>(rep.status), t, t_end, cfl, dt_max};
+    const std::vector<double> all = coll_.allgather(mine, 5);
+    std::vector<double> st(all.size() / 5);
+    for (size_t p = 0; p < st.size(); ++p) st[p] = all[5 * p];
+    rep = settle(coll_.agree_from(st, rep));
+    static const char *names[5] = {"", "t", "t_end", "cfl", "dt_max"};
+    for (size_t p = 1; rep.ok() && p < st.size(); ++p)
+      for (int k = 1; k < 5; ++k)
+        if (all[5 * p + k] != all[k]) {
+          std::ostringstream s;
+          s << "ranks disagree on " << names[k] << ": rank 0 passes " << all[k] << ", rank " << p << " passes "
+            << all[5 * p + k] << " (every rank must pass the same)";
+          throw Error(MFREE_ERR_ARG, s.str());
+        }
+  }
+  if (!rep.ok()) return rep;
   std::vector<double> yn(y, y + 2 * static_cast<size_t>(nd_)), a(nd_), u(nd_);
   double *un = yn.data(), *vn = yn.data() + nd_;
-  enforce_boundary(t, un);
-  accel(t, un, a.data());
+  // a = the acceleration at displacements un (boundary unknowns enforced in un)
+  auto eval = [&](double tt) {
+    if (!ranks_) {
+      enforce_boundary(tt, un);
+      accel(tt, un, a.data());
+      return Report();
+    }
+    Report r = settle(fill_state(tt, un, Report()));
+    for (int32_t d = 0; d < nd_; ++d)
+      if (bpos_[d] >= 0) un[d] = work_[d];
+    accel(tt, work_.data(), a.data());
+    return r;
+  };
+  eval(t);
   while (t < t_end) {
     const double h = std::min(dt, t_end - t);
     // velocity Verlet = central difference for the displacements
@@ -357,10 +429,10 @@ Report ElasticSystem::integrate(int scheme, double *y, double &t, double t_end, 
       un[d] += h * vn[d];
     }
     const double tn = (t_end - t <= h) ? t_end : t + h;
-    enforce_boundary(tn, un);
-    accel(tn, un, a.data());
+    eval(tn);
     for (int32_t d = 0; d < nd_; ++d) vn[d] += 0.5 * h * a[d];
     Report bad = check(yn.data(), "step " + std::to_string(nsteps + 1) + ": ");
+    if (ranks_) bad = settle(coll_.agree(bad));
     if (!bad.ok()) return bad;
     std::copy(yn.begin(), yn.end(), y);
     t = tn;

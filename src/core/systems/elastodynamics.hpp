@@ -2,6 +2,9 @@
 // Navier(u) + b at interior particles, boundary rows (tractions, displacements) kept as
 // algebraic constraints, solved for the boundary unknowns at every evaluation; or by
 // Galerkin: M u'' = g(t) f - K u with K and M from two assemblers (any approximant).
+// Collocation also on ranks (elastodynamics_ranks.cpp): owned particles plus ghosts, the
+// ghosts' displacements exchanged and the boundary unknowns solved in global-id order on
+// every rank at each evaluation.
 #pragma once
 
 #include <Eigen/SparseCholesky>
@@ -11,6 +14,7 @@
 #include <vector>
 
 #include "core/discretize/assembler.hpp"
+#include "core/systems/collective.hpp"
 #include "core/systems/system.hpp"
 
 namespace mfree {
@@ -25,6 +29,12 @@ class ElasticSystem : public System {
   // MFREE_FORM_MASS_LUMPED, coefficient = density) on the same particles.
   ElasticSystem(const Assembler *stiffness, const Assembler *mass);
 
+  // On ranks: a set-up collocation assembler over this rank's owned particles and ghosts
+  // (global ids required). Collective: every rank throws the same Error when one rank
+  // fails (as may be NULL: that rank fails) or the ranks disagree on the density, the
+  // form or its coefficients.
+  static std::unique_ptr<ElasticSystem> on_ranks(const Assembler *as, double density, const Collective &coll);
+
   void set_load_history(double (*fn)(void *, double), void *user);
 
   int32_t neq() const override { return 2 * nd_; }
@@ -35,9 +45,12 @@ class ElasticSystem : public System {
 
   int stress_components() const { return dim_ == 1 ? 1 : (dim_ == 2 ? 3 : 6); }
   int dim() const { return dim_; }
+  // the owned particles (all of them off ranks)
   int32_t num_particles() const { return nc_ > 0 ? nd_ / nc_ : 0; }
+  bool ranks() const { return ranks_; }
   // Stress at the particles from the displacements of y (boundary unknowns enforced);
-  // collocation systems only (the Galerkin trial tables live in the assembler).
+  // collocation systems only (the Galerkin trial tables live in the assembler). On ranks
+  // collective (the ghosts' displacements), the owned particles' stresses.
   void stress(double t, const double *y, double *sigma) const;
   bool galerkin() const { return galerkin_; }
   double wave_speed() const { return c_; }
@@ -47,8 +60,21 @@ class ElasticSystem : public System {
   double step_limit() const { return limit_; }
 
  private:
+  ElasticSystem(const Assembler *as, double density, const Collective &coll);  // on_ranks' local part
   double history(double t) const { return hist_ ? hist_(hist_user_, t) : 1.0; }
   void init_common();
+  void init_operator();
+  void init_boundary();
+  void init_ranks();
+  // lu_ = the factorised block K_bb of nb boundary unknowns (its entries as triplets)
+  void factor_boundary(int32_t nb, const std::vector<Eigen::Triplet<double>> &trip);
+  double local_spacing(int32_t nrows) const;
+  // On ranks: work_ = the owned displacements u, the ghosts' from their owners and the
+  // boundary unknowns of both solved; mine (this rank's outcome so far) agreed with the
+  // other ranks' in the same gather. Returns the agreed outcome (work_ unfinished if bad).
+  Report fill_state(double t, const double *u, const Report &mine) const;
+  // An agreed outcome: thrown when it is an error (alike on every rank), else returned.
+  static Report settle(const Report &agreed);
   void init_galerkin_mass(const Assembler *mass);
   void enforce_boundary(double t, double *u) const;
   void accel(double t, const double *u, double *a) const;
@@ -76,6 +102,19 @@ class ElasticSystem : public System {
   std::vector<int32_t> mci_;
   std::vector<double> mval_;
   mutable std::vector<double> rb_, work_;
+  // On ranks: nl_ local unknowns (owned and ghost particles); bpos_ (nl_ entries) is then
+  // each unknown's position among all ranks' boundary unknowns sorted by (global id,
+  // component), gb_local_ the local unknown of each of them (-1: not here); own_b_ the
+  // owned boundary unknowns in the order this rank sends their rows' data, cnt_ each
+  // rank's count of them, perm_ each gathered row's sorted position, seg_ where each
+  // rank's part (its status, then its rows' data) starts in the gather.
+  bool ranks_ = false;
+  Collective coll_;
+  int32_t nl_ = 0;
+  std::vector<int32_t> gb_local_, own_b_, perm_;
+  std::vector<int64_t> cnt_, seg_;
+  mutable std::vector<double> send_, gathered_;
+  mutable Eigen::VectorXd rbe_;
 };
 
 }  // namespace mfree

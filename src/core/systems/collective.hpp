@@ -1,0 +1,49 @@
+// The collective operations of a system spread over ranks, through the host's two
+// callbacks (a forward halo exchange and an all-gather): the core never calls MPI. The
+// agreement on an outcome (every rank returns the same status and the failing rank's
+// message, so that no rank goes on alone into a collective call) is built on the
+// all-gather.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/base/error.hpp"
+#include "mfree.h"
+
+namespace mfree {
+
+class Collective {
+ public:
+  Collective() = default;
+  Collective(mfree_exchange_fn ex, mfree_allgather_fn ag, void *user) : ex_(ex), ag_(ag), user_(user) {}
+
+  // Owners' values into the ghost items. A failing callback throws, alike on every rank
+  // (the callbacks' contract).
+  void exchange(int32_t ncomp, double *field, int64_t ld) const;
+  // Every rank's n values in rank order, when the total is not known (two calls).
+  std::vector<double> allgather(const double *in, int64_t n) const;
+  // The same into out, whose size (the total) the caller knows to be total.
+  void allgather(const double *in, int64_t n, double *out, int64_t total) const;
+  // The number of ranks (one gather, the first time).
+  int size() const;
+  // The agreed outcome: the lowest rank holding an error (negative status) or, without
+  // one, the lowest rank holding a failure (positive status); its status and "rank R:
+  // <its message>". statuses: every rank's status, in rank order; mine: this rank's.
+  Report agree_from(const std::vector<double> &statuses, const Report &mine) const;
+  // agree_from after one gather of the statuses.
+  Report agree(const Report &mine) const;
+
+  // Integers travel through the all-gather as the bits of a double.
+  static double pack(int64_t v);
+  static int64_t unpack(double d);
+
+ private:
+  mfree_exchange_fn ex_ = nullptr;
+  mfree_allgather_fn ag_ = nullptr;
+  void *user_ = nullptr;
+  mutable int size_ = 0;
+};
+
+}  // namespace mfree

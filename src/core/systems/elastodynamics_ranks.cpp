@@ -1,0 +1,215 @@
+// Collocation elastodynamics on ranks: each rank holds its owned particles and their
+// ghosts; the interior rows of its owned particles need the ghosts' displacements (one
+// halo exchange per evaluation), and the boundary rows determine the boundary unknowns
+// through a block that may couple particles of several ranks. That block is gathered
+// once, in (global id, component) order, and solved on every rank at each evaluation
+// from all ranks' boundary data (one all-gather, which also carries each rank's status):
+// every rank then holds every boundary unknown, computed by the same operations in the
+// same order whatever the partition, so the owned particles' results are bitwise those
+// of one rank. The boundary is a lower-dimensional set: the gather and the solve grow
+// with it, not with the particles.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/systems/elastodynamics.hpp"
+
+namespace mfree {
+
+Report ElasticSystem::settle(const Report &agreed) {
+  if (agreed.status < 0) throw Error(agreed.status, agreed.message);
+  return agreed;
+}
+
+ElasticSystem::ElasticSystem(const Assembler *as, double density, const Collective &coll)
+    : as_(as), rho_(density), coll_(coll) {
+  if (!as->is_setup()) throw Error(MFREE_ERR_STATE, "the assembler is not set up");
+  const int form = as->form();
+  if (form != MFREE_FORM_COLLOCATION_LAPLACE && form != MFREE_FORM_COLLOCATION_PLANE_STRESS &&
+      form != MFREE_FORM_COLLOCATION_PLANE_STRAIN)
+    throw Error(MFREE_ERR_UNSUPPORTED, "elastodynamics on ranks needs a collocation assembler (Laplace form for the "
+                                       "1D bar, or a plane collocation form); Galerkin systems run on one process");
+  if (!(std::isfinite(density) && density > 0.0)) throw Error(MFREE_ERR_ARG, "density must be finite and > 0");
+  if (!as->particles().has_global_ids())
+    throw Error(MFREE_ERR_STATE, "on ranks the particle set needs global ids (mfree_particles_set_global_ids): "
+                                 "they order the boundary unknowns");
+  ranks_ = true;
+  init_operator();
+  dx_min_ = local_spacing(as->particles().num_owned());
+}
+
+std::unique_ptr<ElasticSystem> ElasticSystem::on_ranks(const Assembler *as, double density, const Collective &coll) {
+  // 1. the local part, its outcome and the values every rank must share, agreed
+  std::unique_ptr<ElasticSystem> sys;
+  Report mine;
+  try {
+    if (!as) throw Error(MFREE_ERR_NULL, "assembler is NULL");
+    sys.reset(new ElasticSystem(as, density, coll));
+  } catch (const Error &e) {
+    mine.status = e.status();
+    mine.message = e.what();
+  } catch (const std::bad_alloc &) {
+    mine.status = MFREE_ERR_ALLOC;
+    mine.message = "out of memory";
+  }
+  enum { kStatus, kDensity, kForm, kCoef, kYoung, kPoisson, kComp, kDim, kSpacing, kN };
+  double v[kN] = {static_cast<double>(mine.status), density, 0, 0, 0, 0, 0, 0, INFINITY};
+  if (sys) {
+    v[kForm] = as->form();
+    v[kCoef] = as->coefficient();
+    v[kYoung] = as->young();
+    v[kPoisson] = as->poisson();
+    v[kComp] = as->ncomp();
+    v[kDim] = as->particles().dim();
+    v[kSpacing] = sys->dx_min_;
+  }
+  const std::vector<double> all = coll.allgather(v, kN);
+  const size_t np = all.size() / kN;
+  std::vector<double> st(np);
+  for (size_t p = 0; p < np; ++p) st[p] = all[kN * p];
+  settle(coll.agree_from(st, mine));
+  static const char *names[kN] = {"", "the density", "the assembler's form", "the form's coefficient",
+                                  "Young's modulus", "Poisson's ratio", "the components", "the dimension", ""};
+  double spacing = INFINITY;
+  for (size_t p = 0; p < np; ++p) {
+    for (int k = kDensity; k < kSpacing; ++k)
+      if (!(all[kN * p + k] == all[k]) && !(std::isnan(all[kN * p + k]) && std::isnan(all[k]))) {
+        std::ostringstream s;
+        s.precision(17);
+        s << "ranks disagree on " << names[k] << ": rank 0 passes " << all[k] << ", rank " << p << " passes "
+          << all[kN * p + k] << " (every rank must pass the same)";
+        throw Error(MFREE_ERR_ARG, s.str());
+      }
+    spacing = std::min(spacing, all[kN * p + kSpacing]);  // a minimum: exact in any order
+  }
+  // 2. the boundary block of all ranks (identical data on every rank: a failure here is
+  // every rank's)
+  sys->dx_min_ = spacing;
+  sys->limit_ = spacing / sys->c_;
+  sys->init_ranks();
+  return sys;
+}
+
+void ElasticSystem::init_ranks() {
+  const ParticleSet &ps = as_->particles();
+  const int64_t *gid = ps.global_ids();
+  const auto &kinds = as_->row_kinds();
+  auto key = [&](int32_t d) { return gid[d / nc_] * nc_ + d % nc_; };
+  // Each row's entries in global-id order of their columns (the assembler's are in local
+  // order, which depends on the partition): every sum over a row then runs in one order.
+  // (K_ is used through its arrays only; its rows are not sorted by local column.)
+  {
+    std::vector<int64_t> rp(K_.rowptr());
+    std::vector<int32_t> ci(K_.colidx());
+    std::vector<double> va(K_.values());
+    std::vector<std::pair<int64_t, int64_t>> row;
+    for (int32_t d = 0; d < K_.rows(); ++d) {
+      row.clear();
+      for (int64_t k = rp[d]; k < rp[d + 1]; ++k) row.emplace_back(key(K_.colidx()[k]), k);
+      std::sort(row.begin(), row.end());
+      for (size_t q = 0; q < row.size(); ++q) {
+        ci[rp[d] + q] = K_.colidx()[row[q].second];
+        va[rp[d] + q] = K_.values()[row[q].second];
+      }
+    }
+    K_.set_pattern(K_.rows(), K_.cols(), std::move(rp), std::move(ci));
+    K_.values_mut() = std::move(va);
+  }
+  own_b_.clear();
+  for (int32_t d = 0; d < nd_; ++d)
+    if (kinds[d] != 0) own_b_.push_back(d);
+  // every rank's count and keys (global id, component) of its owned boundary unknowns
+  const double nb_own = static_cast<double>(own_b_.size());
+  const std::vector<double> counts = coll_.allgather(&nb_own, 1);
+  const int np = static_cast<int>(counts.size());
+  cnt_.assign(np, 0);
+  seg_.assign(np + 1, 0);
+  int64_t nb = 0;
+  for (int p = 0; p < np; ++p) {
+    cnt_[p] = static_cast<int64_t>(counts[p]);
+    seg_[p] = p + nb;
+    nb += cnt_[p];
+  }
+  seg_[np] = np + nb;
+  std::vector<double> mine(own_b_.size());
+  for (size_t k = 0; k < own_b_.size(); ++k) mine[k] = Collective::pack(key(own_b_[k]));
+  std::vector<double> keys_in(static_cast<size_t>(nb));
+  coll_.allgather(mine.data(), static_cast<int64_t>(mine.size()), keys_in.data(), nb);
+  std::vector<int64_t> keys(static_cast<size_t>(nb));
+  for (int64_t k = 0; k < nb; ++k) keys[k] = Collective::unpack(keys_in[k]);
+  std::vector<int64_t> sorted(keys);
+  std::sort(sorted.begin(), sorted.end());
+  for (int64_t k = 1; k < nb; ++k)
+    if (sorted[k] == sorted[k - 1])
+      throw Error(MFREE_ERR_INPUT, "global id " + std::to_string(sorted[k] / nc_) +
+                                       " is the id of boundary particles of two ranks (ids must be unique)");
+  auto pos = [&](int64_t k) -> int32_t {
+    auto it = std::lower_bound(sorted.begin(), sorted.end(), k);
+    return it != sorted.end() && *it == k ? static_cast<int32_t>(it - sorted.begin()) : -1;
+  };
+  perm_.resize(static_cast<size_t>(nb));
+  for (int64_t k = 0; k < nb; ++k) perm_[k] = pos(keys[k]);
+  // where the boundary unknowns are here (owned or ghost)
+  bpos_.assign(nl_, -1);
+  gb_local_.assign(static_cast<size_t>(nb), -1);
+  for (int32_t d = 0; d < nl_; ++d) {
+    bpos_[d] = pos(key(d));
+    if (bpos_[d] >= 0) gb_local_[bpos_[d]] = d;
+  }
+  // the block K_bb: each rank's owned boundary rows, as (row, column, value)
+  std::vector<double> trip_in;
+  for (int32_t d : own_b_)
+    for (int64_t k = K_.rowptr()[d]; k < K_.rowptr()[d + 1]; ++k) {
+      const int32_t c = K_.colidx()[k];
+      if (bpos_[c] >= 0 && K_.values()[k] != 0.0) {
+        trip_in.push_back(bpos_[d]);
+        trip_in.push_back(bpos_[c]);
+        trip_in.push_back(K_.values()[k]);
+      }
+    }
+  const std::vector<double> trip_all = coll_.allgather(trip_in.data(), static_cast<int64_t>(trip_in.size()));
+  std::vector<Eigen::Triplet<double>> trip;
+  for (size_t k = 0; k + 2 < trip_all.size(); k += 3)
+    trip.emplace_back(static_cast<int>(trip_all[k]), static_cast<int>(trip_all[k + 1]), trip_all[k + 2]);
+  // (sorted: the matrix must not depend on the ranks' order of sending)
+  std::sort(trip.begin(), trip.end(), [](const Eigen::Triplet<double> &x, const Eigen::Triplet<double> &y) {
+    return x.col() != y.col() ? x.col() < y.col() : x.row() < y.row();
+  });
+  if (nb > 0) factor_boundary(static_cast<int32_t>(nb), trip);
+  rbe_.resize(nb);
+  send_.resize(own_b_.size() + 1);
+  gathered_.resize(static_cast<size_t>(seg_[np]));
+}
+
+Report ElasticSystem::fill_state(double t, const double *u, const Report &mine) const {
+  std::copy(u, u + nd_, work_.begin());
+  coll_.exchange(nc_, work_.data(), nc_);
+  // this rank's boundary rows' data (g f0 - K_bI u_I), with its status, to every rank
+  const double g = history(t);
+  send_[0] = static_cast<double>(mine.status);
+  for (size_t q = 0; q < own_b_.size(); ++q) {
+    const int32_t d = own_b_[q];
+    double s = g * f0_[d];
+    for (int64_t k = K_.rowptr()[d]; k < K_.rowptr()[d + 1]; ++k) {
+      const int32_t c = K_.colidx()[k];
+      if (bpos_[c] < 0) s -= K_.values()[k] * work_[c];
+    }
+    send_[q + 1] = s;
+  }
+  const int np = static_cast<int>(cnt_.size());
+  coll_.allgather(send_.data(), static_cast<int64_t>(send_.size()), gathered_.data(), seg_[np]);
+  std::vector<double> st(np);
+  for (int p = 0; p < np; ++p) st[p] = gathered_[seg_[p]];
+  Report agreed = coll_.agree_from(st, mine);
+  if (!agreed.ok()) return agreed;
+  if (rbe_.size() == 0) return agreed;
+  int64_t k = 0;
+  for (int p = 0; p < np; ++p)
+    for (int64_t j = 0; j < cnt_[p]; ++j) rbe_(perm_[k++]) = gathered_[seg_[p] + 1 + j];
+  const Eigen::VectorXd ub = lu_->solve(rbe_);
+  for (Eigen::Index q = 0; q < ub.size(); ++q)
+    if (gb_local_[q] >= 0) work_[gb_local_[q]] = ub(q);
+  return agreed;
+}
+
+}  // namespace mfree

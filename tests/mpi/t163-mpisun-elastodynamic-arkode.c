@@ -1,0 +1,160 @@
+/* The elastodynamic bar of paper 001 Sect. 6.4 on 1-4 ranks (label mpi) with ARKODE on
+ * NVECTOR_PARALLEL vectors whose reductions are reproducible
+ * (mfree_sundials_mpi_create_vector): ERKStep (explicit, adaptive steps) and ARKStep with
+ * the mass through a matrix-free PCG mass solver (mfree_sundials_mass_times) give, for
+ * every particle matched by global id, bitwise the displacements and velocities of the
+ * one-rank run (the same code on MPI_COMM_SELF), with the same numbers of steps, for
+ * contiguous slabs, scattered owners and everything on one rank. The adaptive steps
+ * depend on every rank's error through the WRMS norm: any rounding difference of a
+ * reduction would change them. Also: the exact sum (mfree_sundials_mpi_sum) of values
+ * whose floating-point sum depends on the order is the same on every partition. */
+#include <arkode/arkode_arkstep.h>
+#include <arkode/arkode_erkstep.h>
+#include <math.h>
+#include <nvector/nvector_serial.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sunlinsol/sunlinsol_pcg.h>
+
+#include "mfree_sundials.h"
+#include "mfree_sundials_mpi.h"
+#include "mpibar.h"
+#include "mpitest.h"
+
+enum { N = 160 };
+static const double T_END = 5e-6, RTOL = 1e-6;
+
+static void flag(int f, const char *what) { CHECK(f >= 0, "%s returned %d", what, f); }
+
+/* u, v by global id after T_END; the step count. mass: ARKStep with PCG, else ERKStep */
+static long run(mfree_context_t *ctx, SUNContext sunctx, MPI_Comm comm, int how, int mass, double *u, double *v) {
+  mpibar_t b;
+  CHECK(mpibar_make(&b, ctx, comm, N, how) == MFREE_SUCCESS, "bar, decomposition %d", how);
+  mfree_sundials_t *ad = NULL;
+  CHECK(mfree_sundials_create(ctx, b.sys, &ad) == MFREE_SUCCESS, "adapter");
+  N_Vector y = NULL;
+  CHECK(mfree_sundials_mpi_create_vector(ctx, b.sys, comm, sunctx, &y) == MFREE_SUCCESS, "vector");
+  CHECK(N_VGetLength(y) == 2 * N, "global length %ld", (long)N_VGetLength(y));
+  N_Vector atol = N_VClone(y);
+  N_VConst(1e-12, atol);
+  double *pa = N_VGetArrayPointer(atol);
+  for (int i = 0; i < b.n_owned; ++i) pa[b.n_owned + i] = 1e-5; /* velocities */
+  void *mem = NULL;
+  SUNLinearSolver LS = NULL;
+  double t = 0.0;
+  long steps = -1;
+  if (mass) {
+    mem = ARKStepCreate(mfree_sundials_rhs_mass_form, NULL, 0.0, y, sunctx);
+    LS = SUNLinSol_PCG(y, SUN_PREC_NONE, 10, sunctx);
+    flag(ARKStepSetMassLinearSolver(mem, LS, NULL, SUNFALSE), "ARKStepSetMassLinearSolver");
+    flag(ARKStepSetMassTimes(mem, NULL, mfree_sundials_mass_times, ad), "ARKStepSetMassTimes");
+    CHECK(mfree_sundials_set_state(ad, y) == MFREE_SUCCESS, "state");
+    flag(ARKStepSVtolerances(mem, RTOL, atol), "tolerances");
+    flag(ARKStepSetUserData(mem, ad), "user data");
+    flag(ARKStepSetMaxNumSteps(mem, 100000), "max steps");
+    flag(ARKStepSetStopTime(mem, T_END), "stop time");
+    flag(ARKStepEvolve(mem, T_END, y, &t, ARK_NORMAL), "ARKStepEvolve");
+    ARKStepGetNumSteps(mem, &steps);
+    ARKStepFree(&mem);
+  } else {
+    mem = ERKStepCreate(mfree_sundials_rhs, 0.0, y, sunctx);
+    flag(ERKStepSVtolerances(mem, RTOL, atol), "tolerances");
+    flag(ERKStepSetUserData(mem, ad), "user data");
+    flag(ERKStepSetMaxNumSteps(mem, 100000), "max steps");
+    flag(ERKStepSetStopTime(mem, T_END), "stop time");
+    flag(ERKStepEvolve(mem, T_END, y, &t, ARK_NORMAL), "ERKStepEvolve");
+    ERKStepGetNumSteps(mem, &steps);
+    ERKStepFree(&mem);
+  }
+  CHECK(t == T_END, "t %.17g", t);
+  const double *py = N_VGetArrayPointer(y);
+  mpibar_collect(&b, py, 1, u);
+  mpibar_collect(&b, py + b.n_owned, 1, v);
+  if (LS) SUNLinSolFree(LS);
+  N_VDestroy(atol);
+  N_VDestroy(y);
+  mfree_sundials_destroy(&ad);
+  mpibar_free(&b);
+  return steps;
+}
+
+static void same_bits(const double *a, const double *b, const char *what, int how, int mass) {
+  for (int i = 0; i < N; ++i)
+    if (memcmp(&a[i], &b[i], sizeof(double)) != 0) {
+      CHECK(0, "%s, decomposition %d: %s of particle %d: %.17g, one rank %.17g", mass ? "ARKStep" : "ERKStep", how,
+            what, i, a[i], b[i]);
+      return;
+    }
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  mfree_context_t *ctx = NULL;
+  mfree_context_create(&ctx);
+  SUNContext sunctx = NULL;
+  MPI_Comm world = MPI_COMM_WORLD, self = MPI_COMM_SELF;
+  SUNContext self_ctx = NULL;
+  SUNContext_Create(&world, &sunctx);
+  SUNContext_Create(&self, &self_ctx);
+  static double u1[N], v1[N], u[N], v[N];
+
+  for (int mass = 0; mass <= 1; ++mass) {
+    const long s1 = run(ctx, self_ctx, MPI_COMM_SELF, BAR_SLAB, mass, u1, v1);
+    /* (the ends are boundary unknowns: their entries of y stay 0) */
+    CHECK(u1[N - 3] < -1e-7, "the pulse moved the particles near the loaded end: %g", u1[N - 3]);
+    const int hows[3] = {BAR_SLAB, BAR_HASHED, BAR_LAST};
+    for (int k = 0; k < 3; ++k) {
+      const long s = run(ctx, sunctx, MPI_COMM_WORLD, hows[k], mass, u, v);
+      CHECK(s == s1, "%s, decomposition %d: %ld steps, one rank %ld", mass ? "ARKStep" : "ERKStep", hows[k], s, s1);
+      same_bits(u, u1, "displacement", hows[k], mass);
+      same_bits(v, v1, "velocity", hows[k], mass);
+    }
+    if (rank == 0)
+      printf("t163: %s %ld steps, displacement near the loaded end %.6e m, %d ranks bitwise\n", mass ? "ARKStep + PCG mass" : "ERKStep",
+             s1, u1[N - 3], size);
+  }
+
+  /* the exact sum: 1e16 + 1 - 1e16 and friends, spread over the ranks in two ways */
+  enum { M = 1000 };
+  static double vals[M];
+  for (int i = 0; i < M; ++i) vals[i] = (i % 3 == 0 ? 1e16 : 1.0) * (i % 2 ? -1.0 : 1.0) * (1.0 + i * 1e-3);
+  double exact = 0.0, s0 = 0.0, s1 = 0.0;
+  CHECK(mfree_sundials_mpi_sum(ctx, MPI_COMM_SELF, vals, M, &exact) == MFREE_SUCCESS, "sum on one rank");
+  const int lo = M * rank / size, hi = M * (rank + 1) / size;
+  CHECK(mfree_sundials_mpi_sum(ctx, MPI_COMM_WORLD, vals + lo, hi - lo, &s0) == MFREE_SUCCESS, "sum, slabs");
+  double mine[M];
+  int nm = 0;
+  for (int i = M - 1; i >= 0; --i)
+    if (i % size == (size - 1 - rank)) mine[nm++] = vals[i];
+  CHECK(mfree_sundials_mpi_sum(ctx, MPI_COMM_WORLD, mine, nm, &s1) == MFREE_SUCCESS, "sum, scattered");
+  CHECK(memcmp(&exact, &s0, sizeof exact) == 0 && memcmp(&exact, &s1, sizeof exact) == 0,
+        "exact sums %.17g %.17g %.17g", exact, s0, s1);
+  /* the exact value: the pairs cancel but for the 1 + i 1e-3 scale factors */
+  long double ref = 0.0L;
+  for (int i = 0; i < M; ++i) ref += (long double)vals[i];
+  CHECK(fabs(exact - (double)ref) <= 1e-3 * fabs((double)ref) + 1.0, "sum %.17g, long double %.17Lg", exact, ref);
+  /* bad input, on every rank alike */
+  CHECK(mfree_sundials_mpi_sum(ctx, MPI_COMM_WORLD, vals, rank == size - 1 ? -1 : 1, &s0) == MFREE_ERR_ARG,
+        "negative count on one rank");
+  CHECK(mfree_sundials_mpi_sum(ctx, MPI_COMM_WORLD, rank == 0 ? NULL : vals, 1, &s0) == MFREE_ERR_NULL,
+        "NULL values on rank 0");
+  CHECK(mfree_sundials_mpi_sum(NULL, MPI_COMM_WORLD, vals, 1, &s0) == MFREE_ERR_NULL, "NULL context (local)");
+  N_Vector ser = N_VNew_Serial(4, sunctx);
+  CHECK(mfree_sundials_mpi_set_reproducible(ctx, ser) == MFREE_ERR_UNSUPPORTED, "a serial vector");
+  CHECK(mfree_sundials_mpi_set_reproducible(ctx, NULL) == MFREE_ERR_NULL, "NULL vector");
+  N_VDestroy(ser);
+  N_Vector y = NULL;
+  CHECK(mfree_sundials_mpi_create_vector(ctx, NULL, MPI_COMM_WORLD, sunctx, &y) == MFREE_ERR_NULL && !y,
+        "NULL system");
+
+  SUNContext_Free(&self_ctx);
+  SUNContext_Free(&sunctx);
+  mfree_context_destroy(&ctx);
+  const int rc = mpitest_finish("t163-mpisun-elastodynamic-arkode");
+  MPI_Finalize();
+  return rc;
+}
