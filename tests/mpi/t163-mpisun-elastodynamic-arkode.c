@@ -114,7 +114,7 @@ int main(int argc, char **argv) {
       same_bits(v, v1, "velocity", hows[k], mass);
     }
     if (rank == 0)
-      printf("t163: %s %ld steps, displacement near the loaded end %.6e m, %d ranks bitwise\n", mass ? "ARKStep + PCG mass" : "ERKStep",
+      printf("t163: %s %ld steps, displacement near the loaded end %.6e m, compared on %d ranks\n", mass ? "ARKStep + PCG mass" : "ERKStep",
              s1, u1[N - 3], size);
   }
 
