@@ -1729,6 +1729,28 @@ MFREE_API mfree_status_t mfree_system_set_shepard_condition(mfree_system_t *sys,
                                                             double max_cond);
 
 /**
+ * The fluid's shape functions: the method, order and kernel of an approximant
+ * (mfree_approximant_create, _set_order, _set_kernel), built at the particles (and dummy
+ * particles) on their neighbours within the kernel's support, with the fallback
+ * MFREE_FALLBACK_LOWER_ORDER and the Shepard condition of
+ * mfree_system_set_shepard_condition. Default: MFREE_METHOD_MLS, order 1,
+ * MFREE_KERNEL_CUBIC_SPLINE ([CuetoFelgueroso2004]).
+ * @param[in] sys     a fluid system (else MFREE_ERR_UNSUPPORTED)
+ * @param[in] method  an mfree_method_t (else MFREE_ERR_ARG); MFREE_METHOD_MPFEM, which needs a
+ *                    mesh: MFREE_ERR_UNSUPPORTED
+ * @param[in] order   the order, as mfree_approximant_set_order accepts it for the method
+ *                    (else MFREE_ERR_UNSUPPORTED)
+ * @param[in] kernel  an mfree_kernel_t (else MFREE_ERR_ARG); one whose derivative the method
+ *                    needs and does not have: MFREE_ERR_UNSUPPORTED
+ * @param[in] param   the kernel's shape parameter, as mfree_approximant_set_kernel takes it
+ *                    (0 for the default)
+ * @return MFREE_SUCCESS, or a failure named with the parameters (the previous choice stays)
+ */
+MFREE_API mfree_status_t mfree_system_set_approximation(mfree_system_t *sys,
+                                                        mfree_method_t method, int32_t order,
+                                                        mfree_kernel_t kernel, double param);
+
+/**
  * Dummy wall particles ([Adami2012]; not in [CuetoFelgueroso2004]): fixed particles
  * filling the solid past the walls, at least 4h - d deep, with the pressure
  * extrapolated from the fluid; they give fluid nodes near a wall full supports and the

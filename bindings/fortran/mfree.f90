@@ -1413,6 +1413,16 @@ module mfree
       real(c_double), value :: max_cond
     end function mfree_system_set_shepard_condition_c
 
+    integer(c_int) function mfree_system_set_approximation_c(sys, method, order, kernel, param) &
+        bind(C, name="mfree_system_set_approximation")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int), value :: method
+      integer(c_int32_t), value :: order
+      integer(c_int), value :: kernel
+      real(c_double), value :: param
+    end function mfree_system_set_approximation_c
+
     integer(c_int) function mfree_system_create_elastodynamic_c(ctx, as, density, sys) &
         bind(C, name="mfree_system_create_elastodynamic")
       import :: c_int, c_double, c_ptr
@@ -1542,6 +1552,7 @@ module mfree
   public :: mfree_system_create_elastodynamic_galerkin_c
   public :: mfree_system_create_elastodynamic_ranks_c
   public :: mfree_system_set_shepard_condition_c
+  public :: mfree_system_set_approximation_c
   public :: mfree_system_get_stress_c
 
   ! ---- generic wrappers: strides, leading dimensions and counts of either integer kind
@@ -1659,6 +1670,7 @@ module mfree
   public :: mfree_system_create_elastodynamic, mfree_system_set_load_history
   public :: mfree_system_create_elastodynamic_galerkin
   public :: mfree_system_set_shepard_condition
+  public :: mfree_system_set_approximation
   public :: mfree_system_get_stress
 
   ! Targets of zero-length matrix views (a C view of an empty array may be NULL).
@@ -3879,6 +3891,16 @@ contains
     real(c_double), intent(in) :: max_cond
     st = mfree_system_set_shepard_condition_c(sys%ptr, max_cond)
   end function mfree_system_set_shepard_condition
+
+  !> The fluid's shape functions: an approximant's method, order, kernel and shape parameter.
+  integer(c_int) function mfree_system_set_approximation(sys, method, order, kernel, param) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int), intent(in) :: method
+    integer(c_int32_t), intent(in) :: order
+    integer(c_int), intent(in) :: kernel
+    real(c_double), intent(in) :: param
+    st = mfree_system_set_approximation_c(sys%ptr, method, order, kernel, param)
+  end function mfree_system_set_approximation
 
   !> Galerkin elastodynamics M u'' = g(t) f - K u from a stiffness and a mass assembler.
   integer(c_int) function mfree_system_create_elastodynamic_galerkin(ctx, stiffness, mass, sys) result(st)

@@ -139,6 +139,11 @@ mfree_status_t mfree_system_set_shepard_condition(mfree_system_t *sys, double ma
   MFREE_SYS_SETTER("mfree_system_set_shepard_condition", f.set_shepard_condition(max_cond));
 }
 
+mfree_status_t mfree_system_set_approximation(mfree_system_t *sys, mfree_method_t method, int32_t order,
+                                              mfree_kernel_t kernel, double param) {
+  MFREE_SYS_SETTER("mfree_system_set_approximation", f.set_approximation(method, order, kernel, param));
+}
+
 mfree_status_t mfree_system_set_dummy_particles(mfree_system_t *sys, int32_t n, const double *x,
                                                const double *volumes, int64_t stride) {
   MFREE_SYS_SETTER("mfree_system_set_dummy_particles", f.set_dummy_particles(n, x, volumes, stride));

@@ -72,6 +72,11 @@ program t701_system_fluid_f
                                             0.5_c_double), 'set_fluid (one rho0)')
   call check_ok(ctx, mfree_system_set_masses(sys, m, 1_c_int64_t), 'set_masses')
   call check_ok(ctx, mfree_system_set_smoothing(sys, 1.5_c_double * d), 'set_smoothing')
+  ! the approximation setter: a bad order refused, the default chosen again
+  call check(mfree_system_set_approximation(sys, MFREE_METHOD_MLS, 9_c_int32_t, MFREE_KERNEL_CUBIC_SPLINE, &
+                                            0.0_c_double) == MFREE_ERR_UNSUPPORTED, 'set_approximation: order 9')
+  call check_ok(ctx, mfree_system_set_approximation(sys, MFREE_METHOD_MLS, 1_c_int32_t, MFREE_KERNEL_CUBIC_SPLINE, &
+                                                    0.0_c_double), 'set_approximation')
   call check_ok(ctx, mfree_system_get_size(sys, neq), 'get_size')
   call check(neq == 5 * n, 'state length (2 dim + 1) n')
   call check_ok(ctx, mfree_system_rhs(sys, 0.0_c_double, y, yd), 'rhs')

@@ -60,10 +60,6 @@ set(re_threshold
   "[Mm][Ii][Nn][A-Za-z0-9_]*[Cc][Oo][Nn][Dd][A-Za-z0-9_]*${S}=${S}[0-9]")
 
 set(exceptions
-  # the fluid's own rows (linear MLS, its SPD inverse and threshold) stay until the fluid
-  # takes every row from the approximants with the same Shepard rule (src/core/README.md)
-  "spd|core/systems/fluid_tables.cpp"
-  "threshold|core/systems/fluid_tables.cpp"
 )
 
 file(GLOB_RECURSE files RELATIVE "${SRC}" LIST_DIRECTORIES false

@@ -1084,6 +1084,16 @@ static void rows_system(void) {
   ROW(MFREE_ERR_ARG, mfree_system_set_shepard_condition(F.sys, 0.5));
   ROW(MFREE_ERR_ARG, mfree_system_set_shepard_condition(F.sys, NAN));
 #endif
+  ROW0(MFREE_ERR_NULL, mfree_system_set_approximation(NULL, MFREE_METHOD_MLS, 1, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
+  ROW(MFREE_ERR_ARG, mfree_system_set_approximation(F.sys, (mfree_method_t)0, 1, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
+  ROW(MFREE_ERR_ARG, mfree_system_set_approximation(F.sys, (mfree_method_t)99, 1, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
+  ROW(MFREE_ERR_ARG, mfree_system_set_approximation(F.sys, MFREE_METHOD_MLS, 1, (mfree_kernel_t)0, 0.0));
+  ROW(MFREE_ERR_ARG, mfree_system_set_approximation(F.sys, MFREE_METHOD_MLS, 1, (mfree_kernel_t)99, 0.0));
+  ROW(MFREE_ERR_UNSUPPORTED, mfree_system_set_approximation(F.sys, MFREE_METHOD_MLS, 4, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
+  ROW(MFREE_ERR_UNSUPPORTED, mfree_system_set_approximation(F.sys, MFREE_METHOD_MLS, -1, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
+  ROW(MFREE_ERR_UNSUPPORTED, mfree_system_set_approximation(F.sys, MFREE_METHOD_RANDLES_LIBERSKY, 2, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
+  ROW(MFREE_ERR_UNSUPPORTED, mfree_system_set_approximation(F.sys, MFREE_METHOD_MPFEM, 1, MFREE_KERNEL_COSINE, 0.0));
+  ROW(MFREE_ERR_UNSUPPORTED, mfree_system_set_approximation(F.sys, MFREE_METHOD_MLS, 1, MFREE_KERNEL_LINEAR, 0.0));
   /* dummy wall particles and density diffusion (failures change nothing) */
   ROW0(MFREE_ERR_NULL, mfree_system_set_dummy_particles(NULL, 2, wx, &one, 0));
   ROW(MFREE_ERR_ARG, mfree_system_set_dummy_particles(F.sys, -1, wx, &one, 0));

@@ -212,7 +212,12 @@ void Approximant::validate_config() const {
   }
   if (points_ && particles_only(m))
     throw Error(MFREE_ERR_UNSUPPORTED, mn() + " is defined at the particles only");
-  const bool grad = flags_ & MFREE_DERIV_GRADIENT, hess = flags_ & MFREE_DERIV_HESSIAN;
+  check_kernel_use(m, k, order_, flags_);
+}
+
+void Approximant::check_kernel_use(int m, int k, int order, int flags) {
+  auto mn = [m] { return std::string(method_name(m)); };
+  const bool grad = flags & MFREE_DERIV_GRADIENT, hess = flags & MFREE_DERIV_HESSIAN;
   const bool uses_dw = (grad && gradient_needs_dw(m)) || m == MFREE_METHOD_MSPH ||
                        m == MFREE_METHOD_JOHNSON_BEISSEL || m == MFREE_METHOD_RANDLES_LIBERSKY ||
                        m == MFREE_METHOD_KB_METHOD1 || m == MFREE_METHOD_KB_METHOD3;
@@ -220,13 +225,13 @@ void Approximant::validate_config() const {
     throw Error(MFREE_ERR_UNSUPPORTED,
                 mn() + " differentiates the kernel; the linear kernel's derivative is constant "
                      "(paper 001 Sect. 6.2): use SSPH or another kernel");
-  const bool uses_d2w = (hess && hessian_needs_d2w(m)) || (m == MFREE_METHOD_MSPH && order_ >= 2);
+  const bool uses_d2w = (hess && hessian_needs_d2w(m)) || (m == MFREE_METHOD_MSPH && order >= 2);
   if ((k == MFREE_KERNEL_LINEAR || k == MFREE_KERNEL_QUADRATIC) && uses_d2w)
     throw Error(MFREE_ERR_UNSUPPORTED,
                 mn() + " needs the kernel's second derivative, constant for the linear and "
                      "quadratic kernels (paper 001 Sect. 6.2)");
-  if (hess && !provides_hessian(m, order_))
-    throw Error(MFREE_ERR_UNSUPPORTED, mn() + " of order " + std::to_string(order_) +
+  if (hess && !provides_hessian(m, order))
+    throw Error(MFREE_ERR_UNSUPPORTED, mn() + " of order " + std::to_string(order) +
                                            " provides no second derivatives");
 }
 

@@ -78,6 +78,10 @@ class Approximant {
   // True after an MPFEM setup whose supports satisfy 004 eq 13 (Kronecker delta).
   bool interpolating() const { return method_ == MFREE_METHOD_MPFEM && interpolating_; }
 
+  // Throws MFREE_ERR_UNSUPPORTED when the tables of flags (MFREE_DERIV_*) of the method
+  // and order need a derivative of the kernel that it does not have (linear, quadratic).
+  static void check_kernel_use(int method, int kernel, int order, int flags);
+
   // Build pattern and tables (positive failures reported, negative ones thrown).
   Report setup();
   // Recompute tables on the existing pattern.

@@ -201,42 +201,8 @@ void Approximant::general_site(int32_t s, const LocalConfig &base, bool fast_don
   if (fast_done) {  // the fast path's result stands but for the rows
     out.status = 0;
     out.cond = cond_[s];
-  } else {
-    compute_site(cfg, in, w.work, out);
   }
-  if (out.status && fallback_ == MFREE_FALLBACK_LOWER_ORDER) {
-    const int first_status = out.status;
-    const double first_cond = out.cond;
-    // A site that falls back gets a record of zeros (mfree.h): a lower order's or
-    // Shepard's record has another layout, and Shepard's (1 + dim values) is longer
-    // than Johnson-Beissel's or Randles-Libersky's, so it would run into the next one.
-    if (out.coef) std::fill_n(out.coef, ncoef, 0.0);
-    out.coef = nullptr;
-    if (has_order(method_))
-      for (int o = order_ - 1; o >= min_order(method_) && out.status; --o) {
-        cfg.order = o;
-        if (fh && !provides_hessian(method_, o)) break;
-        compute_site(cfg, in, w.work, out);
-      }
-    if (out.status) {  // last resort: Shepard functions (constant complete)
-      cfg.method = MFREE_METHOD_SHEPARD;
-      cfg.order = 0;
-      compute_site(cfg, in, w.work, out);
-    }
-    if (out.status) {
-      out.status = first_status;
-      out.cond = first_cond;
-    }
-  }
-  if (!out.status && out.cond > shepard_cond_) {
-    const double cond = out.cond;
-    if (out.coef) std::fill_n(out.coef, ncoef, 0.0);  // as a fallback's (above)
-    out.coef = nullptr;
-    cfg.method = MFREE_METHOD_SHEPARD;
-    cfg.order = 0;
-    compute_site(cfg, in, w.work, out);
-    out.cond = cond;
-  }
+  compute_site_rules(cfg, in, w.work, out, fallback_, shepard_cond_, fast_done, ncoef);
   status_[s] = out.status;
   support_[s] = out.support;
   cond_[s] = out.cond;

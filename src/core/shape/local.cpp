@@ -660,6 +660,46 @@ void compute_site(const LocalConfig &cfg, const LocalInput &in, LocalWork &work,
   if (out.status) zero_rows(s);
 }
 
+void compute_site_rules(LocalConfig cfg, const LocalInput &in, LocalWork &work, LocalOutput &out,
+                        int fallback, double shepard_cond, bool done, int ncoef) {
+  const int method = cfg.method, order = cfg.order;
+  if (!done) compute_site(cfg, in, work, out);
+  if (out.status && fallback == MFREE_FALLBACK_LOWER_ORDER) {
+    const int first_status = out.status;
+    const double first_cond = out.cond;
+    // A site that falls back gets a record of zeros (mfree.h): a lower order's or
+    // Shepard's record has another layout, and Shepard's (1 + dim values) is longer
+    // than Johnson-Beissel's or Randles-Libersky's, so it would run into the next one.
+    if (out.coef) std::fill_n(out.coef, ncoef, 0.0);
+    out.coef = nullptr;
+    if (has_order(method))
+      for (int o = order - 1; o >= min_order(method) && out.status; --o) {
+        cfg.order = o;
+        if (cfg.want_hess && !provides_hessian(method, o)) break;
+        compute_site(cfg, in, work, out);
+      }
+    if (out.status) {  // last resort: Shepard functions (constant complete)
+      cfg.method = MFREE_METHOD_SHEPARD;
+      cfg.order = 0;
+      compute_site(cfg, in, work, out);
+    }
+    if (out.status) {
+      out.status = first_status;
+      out.cond = first_cond;
+    }
+  }
+  if (!out.status && out.cond > shepard_cond) {
+    const double cond = out.cond;
+    if (out.coef) std::fill_n(out.coef, ncoef, 0.0);  // as a fallback's (above)
+    out.coef = nullptr;
+    // Shepard functions of w V, RKPM of order 0 (MFREE_METHOD_SHEPARD's are of w)
+    cfg.method = MFREE_METHOD_RKPM;
+    cfg.order = 0;
+    compute_site(cfg, in, work, out);
+    out.cond = cond;
+  }
+}
+
 bool has_order(int m) {
   return m == MFREE_METHOD_MLS || m == MFREE_METHOD_RKPM || m == MFREE_METHOD_SSPH ||
          m == MFREE_METHOD_MSPH || m == MFREE_METHOD_KB_METHOD2;

@@ -55,6 +55,16 @@ struct LocalWork {
 void compute_site(const LocalConfig &cfg, const LocalInput &in, LocalWork &work,
                   LocalOutput &out);
 
+// One site with the approximants' rules (Approximant::set_fallback, set_shepard_condition):
+// compute_site unless done (a fast path's result stands but for the rows: out.status 0 and
+// out.cond set by the caller); with fallback MFREE_FALLBACK_LOWER_ORDER, where that failed,
+// the lower orders down to the method's least, then Shepard functions (the first failure
+// kept when all fail); where the site succeeded with a condition estimate above
+// shepard_cond, Shepard functions of the volume-weighted kernel with that estimate kept.
+// A site that falls back or goes to Shepard gets a record (out.coef, ncoef doubles) of zeros.
+void compute_site_rules(LocalConfig cfg, const LocalInput &in, LocalWork &work, LocalOutput &out,
+                        int fallback, double shepard_cond, bool done, int ncoef);
+
 // The kernel at d = x_j - x (dim values) with support h: r = |d|, the value w and its
 // gradient with respect to x, gw = -W'(r) d / r (0 at r = 0), as every table computes
 // them; dw = W'(r), d2w = W''(r).

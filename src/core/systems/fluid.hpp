@@ -32,6 +32,9 @@ class FluidSystem : public System {
   void set_box(const double *lo, const double *hi);
   // Sites whose moment-matrix condition estimate exceeds max_cond use Shepard functions.
   void set_shepard_condition(double max_cond);
+  // The shape functions (fluid_tables.cpp): an approximant's method, order, kernel and
+  // its shape parameter (paper 003: MLS, order 1, the cubic spline, the default).
+  void set_approximation(int method, int order, int kernel, double param);
   // Options beyond paper 003 (fluid_wall.cpp): dummy wall particles (n = 0 removes them),
   // density diffusion coefficient delta (0 = off, the default).
   void set_dummy_particles(int32_t n, const double *x, const double *vol, int64_t stride);
@@ -67,29 +70,27 @@ class FluidSystem : public System {
   // Candidate neighbour lists (Verlet lists with a skin, see tables_) for the node
   // positions xn, rebuilt when a node moved more than half the skin since the last build.
   Report candidates(const double *xn);
-  // Tables rows [k0, k1): linear MLS at the nodes, Shepard rows where ill-conditioned;
-  // with transpose, also NT_ (true if a pair is in one node's row only, which the search
-  // rules out). k0 starts a chunk of kChunk rows (see rb_).
-  // table_rows_avx2 is the same code compiled for AVX2 + FMA (simd.hpp), chosen per step.
-  template <int D>
-  bool table_rows(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
-  template <int D>
-  bool table_rows_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose);
-  // The 2D rows for AVX2 + FMA without the transpose (the dam break's configuration):
-  // the approximants' fused linear-MLS rows (shape_fast_mls1.hpp) on the filtered
-  // candidates; fast and rp are the thread's scratch (rp: nq() + 1 row offsets).
-  void table_rows2_avx2(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch,
-                        FastScratch &fast, int64_t *rp);
-  template <int D>
-  bool table_rows_body(int32_t k0, int32_t k1, const double *xn, double *scratch, int64_t *iscratch, bool transpose,
-                       bool wide);  // wide: the AVX2 copy (gathers, 256-bit sqrt)
+  // Tables rows [k0, k1) on thread t: the kept candidates, then the approximants' rows
+  // (the fast path, the general path with its fallbacks and Shepard rule where it does
+  // not finish a row or a row is worse conditioned than shepard_cond_); with transpose,
+  // also NT_ (true if a pair is in one node's row only, which the search rules out).
+  // k0 starts a chunk of kChunk rows (see rb_).
+  bool table_rows(int t, int32_t k0, int32_t k1, const double *xn, const double *pack, bool transpose);
+  // Per-thread scratch of the rows: the fast path's, the general path's input (offsets,
+  // volumes, supports) and work, and the row offsets of a chunk (nq() + 1).
+  struct RowsScratch {
+    FastScratch fast;
+    HVec<double> d, v, h;
+    LocalWork work;
+    std::vector<int64_t> rp;
+  };
+  // Row k by the general path (local.hpp, compute_site_rules); fast_done: the fast path's
+  // rows stand, only the Shepard rule applies.
+  void general_row(int32_t k, const double *xn, RowsScratch &w, bool fast_done);
   // Chunks of kChunk rows coloured so that no two chunks of a colour touch a common
   // node (on the candidate pattern), for the scatter of accel (rebuilt with the lists).
   void color_chunks();
   void transposed_candidates();  // ctrans_, only for NT_ (consistent integration)
-  template <int D>
-  void shepard_row(int n, const double *w, const double *gf, double *const *s, double ih, bool volumes,
-                   const int32_t *js, double *Nk, double *Gk) const;
   // Acceleration parameters a (dim per particle) from the prepared tables and v, rho:
   // accel_args (node arrays, zeroed sums), accel_point for every row in colour order
   // (chunk_order_), accel_end (the nodes' accelerations).
@@ -147,6 +148,11 @@ class FluidSystem : public System {
   HVec<double> wall_n_;
   double r0_ = 0.0, strength_ = 0.0;
   double shepard_cond_ = 100.0;
+  // The shape functions (set_approximation) and the fast path for them (made at prepare)
+  int method_ = MFREE_METHOD_MLS, order_ = 1, kernel_id_ = MFREE_KERNEL_CUBIC_SPLINE;
+  double kernel_param_ = 0.0;
+  std::unique_ptr<Kernel> kernel_;
+  std::unique_ptr<FastPath> fast_;
   mutable DummyWall dummy_;  // scratch node arrays are refilled by const evaluations
   double delta_ = 0.0;
   bool vci_ = false;
@@ -191,13 +197,11 @@ class FluidSystem : public System {
   const double *xbound_ = nullptr;  // node positions ps_ borrows
   int64_t rebuilds_ = 0;
   int64_t maxrow_ = 0;               // longest candidate row
-  std::vector<double> rows_scratch_;  // (dim + 2) (maxrow_ + 8) per thread
-  std::vector<int64_t> rows_iscratch_;  // maxrow_ per thread (transposed candidates)
-  // table_rows2_avx2: per thread, the fast path's scratch and row offsets; per node, the
-  // fast path's status, support and order
-  std::vector<FastScratch> fast_scratch_;
-  std::vector<int64_t> rows_ptr_;
-  std::vector<int32_t> site_status_, site_support_, site_order_;
+  std::vector<RowsScratch> rows_scratch_;
+  // per node: the rows' status, support and order, the node's place in its row; the
+  // nodes' positions and volumes in records for the methods that weight by volume
+  std::vector<int32_t> site_status_, site_support_, site_order_, self_;
+  std::vector<double> node_pack_;
   Csr wall_nbr_;
   // per node (reused): packed quadrature-point data of accel; integrate's states and rates
   std::vector<double> pack_, work_state_, stage_, rate_, vh_, dr_, vh_start_;
