@@ -1551,6 +1551,7 @@ module mfree
   public :: mfree_system_create_elastodynamic_c, mfree_system_set_load_history_c
   public :: mfree_system_create_elastodynamic_galerkin_c
   public :: mfree_system_create_elastodynamic_ranks_c
+  public :: mfree_system_create_elastodynamic_ranks
   public :: mfree_system_set_shepard_condition_c
   public :: mfree_system_set_approximation_c
   public :: mfree_system_get_stress_c
@@ -3884,6 +3885,22 @@ contains
     type(mfree_system), intent(out) :: sys
     st = mfree_system_create_elastodynamic_c(ctx%ptr, as%ptr, density, sys%ptr)
   end function mfree_system_create_elastodynamic
+
+  !> Typed wrapper of mfree_system_create_elastodynamic_ranks (mfree.h). exchange and
+  !> allgather are C function pointers (c_funloc of bind(C) procedures with the
+  !> interfaces of mfree_exchange_fn and mfree_allgather_fn); module mfree_mpi's
+  !> mfree_halo_create_elastodynamic passes libmfree_mpi's own.
+  integer(c_int) function mfree_system_create_elastodynamic_ranks(ctx, as, density, exchange, &
+                                                                  allgather, user, sys) result(st)
+    type(mfree_context), intent(in) :: ctx
+    type(mfree_assembler), intent(in) :: as
+    real(c_double), intent(in) :: density
+    type(c_funptr), intent(in) :: exchange, allgather
+    type(c_ptr), intent(in) :: user
+    type(mfree_system), intent(out) :: sys
+    st = mfree_system_create_elastodynamic_ranks_c(ctx%ptr, as%ptr, density, exchange, allgather, &
+                                                   user, sys%ptr)
+  end function mfree_system_create_elastodynamic_ranks
 
   !> Condition threshold of the fluid's Shepard fallback (default 100).
   integer(c_int) function mfree_system_set_shepard_condition(sys, max_cond) result(st)

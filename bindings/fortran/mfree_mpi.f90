@@ -273,6 +273,7 @@ module mfree_mpi
   public :: mfree_migration_set_pending_error
   public :: mfree_halo_exchange_callback_c, mfree_halo_allgather_c, mfree_halo_create_elastodynamic_c
   public :: mfree_halo_create_elastodynamic
+  public :: mfree_halo_exchange_callback, mfree_halo_allgather
 
   real(c_double), target, save :: empty_dbl(0)
   integer(c_int32_t), target, save :: empty_i32(0)
@@ -402,6 +403,57 @@ contains
     end if
     st = mfree_halo_exchange_c(halo%ptr, ncomp, pf, ld)
   end function mfree_halo_exchange
+
+  !> Typed wrapper of mfree_halo_exchange_callback (mfree_mpi.h): the exchange a system on
+  !> ranks calls, with mfree_halo_exchange's checks of field. Collective.
+  integer(c_int) function mfree_halo_exchange_callback(halo, ncomp, field, ld) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(inout), target :: field(..)
+    integer(c_int64_t), intent(in) :: ld
+    real(c_double), pointer :: pf(:)
+    integer(c_int32_t) :: no, ng
+    integer(c_int64_t) :: need
+    st = MFREE_SUCCESS
+    if (mfree_halo_get_size_c(halo%ptr, no, ng) == MFREE_SUCCESS .and. ncomp >= 1 .and. ld >= ncomp) then
+      need = 0
+      if (no + ng > 0) need = (int(no, c_int64_t) + ng - 1) * ld + ncomp
+      st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_exchange_callback', 'field', &
+                                   is_contiguous(field), size(field, kind=c_int64_t), need)
+    end if
+    pf => empty_dbl
+    if (st /= MFREE_SUCCESS) then
+      if (mfree_halo_set_pending_error_c(halo%ptr) /= MFREE_SUCCESS) return
+    else if (size(field) > 0) then
+      call c_f_pointer(c_loc(field), pf, [size(field)])
+    end if
+    st = mfree_halo_exchange_callback_c(halo%ptr, ncomp, pf, ld)
+  end function mfree_halo_exchange_callback
+
+  !> Typed wrapper of mfree_halo_allgather (mfree_mpi.h): every rank's n values of in
+  !> concatenated in rank order into out (cap values; cap = 0 asks for the total only).
+  !> in must hold n values and out cap values (else MFREE_ERR_ARG on every rank).
+  !> Collective.
+  integer(c_int) function mfree_halo_allgather(halo, in, n, out, cap, total) result(st)
+    type(mfree_halo), intent(in) :: halo
+    real(c_double), intent(in) :: in(:)
+    integer(c_int64_t), intent(in) :: n, cap
+    real(c_double), intent(out) :: out(:)
+    integer(c_int64_t), intent(out) :: total
+    real(c_double) :: none(0)
+    total = 0
+    st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_allgather', 'in', .true., &
+                                 size(in, kind=c_int64_t), n)
+    if (st == MFREE_SUCCESS) &
+      st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_allgather', 'out', .true., &
+                                   size(out, kind=c_int64_t), cap)
+    if (st /= MFREE_SUCCESS) then
+      if (mfree_halo_set_pending_error_c(halo%ptr) /= MFREE_SUCCESS) return
+      st = mfree_halo_allgather_c(halo%ptr, none, 0_c_int64_t, empty_dbl, 0_c_int64_t, total)
+      return
+    end if
+    st = mfree_halo_allgather_c(halo%ptr, in, n, out, cap, total)
+  end function mfree_halo_allgather
 
   !> The ghosts' correction records of approximant a from their owners (mfree_mpi.h).
   !> Collective; after every setup or update of a.

@@ -7,7 +7,10 @@
 !> on one rank is MFREE_ERR_ARG on every rank, naming that rank, with no ghost written and
 !> no rank left waiting; a scalar field h(n) is exchanged as it is. The ghosts' correction
 !> records of an RL approximant on the plan's particles come from their owners
-!> (mfree_halo_exchange_correction), and SPH, which has none, fails on every rank.
+!> (mfree_halo_exchange_correction), and SPH, which has none, fails on every rank. The
+!> callbacks of systems on ranks: the all-gather in rank order (a capacity beyond out on
+!> one rank fails on every rank, one below the total writes nothing) and the exchange
+!> callback.
 program t167_mpi_halo_f
   use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double
   use mpi
@@ -147,6 +150,41 @@ program t167_mpi_halo_f
   call check(mfree_approximant_destroy(rl) == MFREE_SUCCESS .and. mfree_approximant_destroy(sph) == MFREE_SUCCESS, &
              'approximants destroy')
   call check(mfree_particles_destroy(ps) == MFREE_SUCCESS, 'set destroy')
+
+  ! ---- the callbacks of systems on ranks, called from Fortran ----
+  ! the all-gather: rank r gives r + 1 values r; the total and the concatenation in rank
+  ! order; an out one short on the last rank fails on every rank, nothing written
+  deallocate (hs, vs)
+  allocate (hs(rank + 1), vs(nprocs * (nprocs + 1) / 2))
+  hs = real(rank, c_double)
+  vs = -1
+  call check(mfree_halo_allgather(halo, hs, int(rank + 1, c_int64_t), vs, size(vs, kind=c_int64_t), total) &
+             == MFREE_SUCCESS, 'allgather')
+  call check(total == nprocs * (nprocs + 1) / 2, 'allgather total')
+  do k = 0, nprocs - 1
+    call check(all(vs(k * (k + 1) / 2 + 1:k * (k + 1) / 2 + k + 1) == real(k, c_double)), &
+               'allgather: rank order')
+  end do
+  vs = -1
+  st_ = mfree_halo_allgather(halo, hs, int(rank + 1, c_int64_t), vs, &
+                             size(vs, kind=c_int64_t) + merge(1, 0, rank == last), total)
+  call check(st_ == MFREE_ERR_ARG .and. index(mfree_last_error(hctx), trim(who)) > 0, &
+             'allgather, a capacity beyond out on the last rank: '//mfree_last_error(hctx))
+  call check(all(vs == -1), 'nothing written by a failed allgather')
+  ! a capacity below the total on one rank: no rank writes, the total is given
+  total = -1
+  call check(mfree_halo_allgather(halo, hs, int(rank + 1, c_int64_t), vs, &
+                                  size(vs, kind=c_int64_t) - merge(1, 0, rank == last), total) &
+             == MFREE_SUCCESS .and. total == nprocs * (nprocs + 1) / 2, 'allgather, total only')
+  call check(all(vs == -1), 'nothing written below the total')
+  ! the exchange callback: the ghosts' positions again
+  x(1, no + 1:no + ng) = -1
+  call check(mfree_halo_exchange_callback(halo, 1_c_int32_t, x, 1_c_int64_t) == MFREE_SUCCESS, &
+             'exchange callback')
+  do k = no + 1, no + ng
+    call check(x(1, k) == real(ids(k), c_double) / n, 'exchange callback: ghost position is its owner''s')
+  end do
+  deallocate (hs, vs)
 
   call check(mfree_halo_destroy(halo) == MFREE_SUCCESS, 'destroy')
   call check(mfree_context_destroy(ctx) == MFREE_SUCCESS, 'context destroy')

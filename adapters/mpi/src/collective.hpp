@@ -152,6 +152,10 @@ struct Pending {
   }
 };
 
+// halo.cpp: a plan's pending failure, taken (MFREE_SUCCESS when none), for the
+// collective calls outside halo.cpp (the all-gather of systems on ranks).
+mfree_status_t take_pending(mfree_halo_t *h, std::string &msg) noexcept;
+
 }  // namespace mfree_mpi_detail
 
 #endif  // MFREE_MPI_COLLECTIVE_HPP

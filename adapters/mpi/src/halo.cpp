@@ -459,6 +459,17 @@ mfree_status_t mfree_halo_exchange_correction(mfree_halo_t *h, mfree_approximant
 
 }  // extern "C"
 
+// The failure a binding handed over with mfree_halo_set_pending_error, taken (reported
+// once), for the collective calls of halo_system.cpp.
+mfree_status_t mfree_mpi_detail::take_pending(mfree_halo_t *h, std::string &msg) noexcept {
+  const Local l = h->pending.first_step([](Local &) {});
+  try {
+    msg = l.msg;
+  } catch (...) {
+  }
+  return l.st;
+}
+
 extern "C" mfree_status_t mfree_halo_get_communicator(const mfree_halo_t *h, MPI_Comm *comm) {
   if (!h || !comm) return MFREE_ERR_NULL;
   *comm = h->comm;

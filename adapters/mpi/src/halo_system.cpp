@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "collective.hpp"
 #include "mfree_mpi.h"
 
 namespace {
@@ -33,34 +34,45 @@ mfree_status_t mfree_halo_allgather(void *halo, const double *in, int64_t n, dou
   int size = 1, rank = 0;
   MPI_Comm_size(comm, &size);
   MPI_Comm_rank(comm, &rank);
-  // this rank's count, capacity and argument fault, seen by every rank: one outcome
-  const int64_t bad = !total ? MFREE_ERR_NULL : n < 0 ? MFREE_ERR_ARG : (n > 0 && !in) ? MFREE_ERR_NULL : 0;
-  int64_t mine[3] = {n, cap, bad};
+  // this rank's count, capacity and argument fault (or the failure a binding handed
+  // over, flagged), seen by every rank: one outcome
+  std::string pending;
+  const mfree_status_t handed = mfree_mpi_detail::take_pending(static_cast<mfree_halo_t *>(halo), pending);
+  const int64_t bad = handed != MFREE_SUCCESS ? handed
+                      : !total                ? MFREE_ERR_NULL
+                      : n < 0                 ? MFREE_ERR_ARG
+                      : (n > 0 && !in)        ? MFREE_ERR_NULL
+                                              : 0;
+  int64_t mine[4] = {n, cap, bad, handed != MFREE_SUCCESS};
   std::vector<int64_t> all;
   try {
-    all.resize(3 * static_cast<size_t>(size));
+    all.resize(4 * static_cast<size_t>(size));
   } catch (...) {
     return fail(ctx, MFREE_ERR_ALLOC, "out of memory");  // (before any rank waits: none can go on)
   }
-  if (MPI_Allgather(mine, 3, MPI_INT64_T, all.data(), 3, MPI_INT64_T, comm) != MPI_SUCCESS)
+  if (MPI_Allgather(mine, 4, MPI_INT64_T, all.data(), 4, MPI_INT64_T, comm) != MPI_SUCCESS)
     return fail(ctx, MFREE_ERR_INTERNAL, "MPI_Allgather failed");
   for (int p = 0; p < size; ++p)
-    if (all[3 * p + 2] != 0) {
-      char msg[160];
-      std::snprintf(msg, sizeof msg, "rank %d: %s", p,
-                    all[3 * p + 2] == MFREE_ERR_ARG ? "a negative count" : "a NULL total, or NULL values with n > 0");
-      return fail(ctx, static_cast<mfree_status_t>(all[3 * p + 2]), msg);
+    if (all[4 * p + 2] != 0) {
+      char msg[360];
+      if (all[4 * p + 3])
+        std::snprintf(msg, sizeof msg, "rank %d: %s", p,
+                      p == rank ? pending.c_str() : "a binding's check of its arrays failed there");
+      else
+        std::snprintf(msg, sizeof msg, "rank %d: %s", p,
+                      all[4 * p + 2] == MFREE_ERR_ARG ? "a negative count" : "a NULL total, or NULL values with n > 0");
+      return fail(ctx, static_cast<mfree_status_t>(all[4 * p + 2]), msg);
     }
   int64_t sum = 0;
   bool room = true;
-  for (int p = 0; p < size; ++p) sum += all[3 * p];
-  for (int p = 0; p < size; ++p) room = room && all[3 * p + 1] >= sum;
+  for (int p = 0; p < size; ++p) sum += all[4 * p];
+  for (int p = 0; p < size; ++p) room = room && all[4 * p + 1] >= sum;
   *total = sum;
   if (!room) return MFREE_SUCCESS;  // the total only
   if (sum > std::numeric_limits<int>::max()) return fail(ctx, MFREE_ERR_ARG, "more than 2^31 - 1 values");
   std::vector<int> counts(size), displs(size);
   for (int p = 0, off = 0; p < size; ++p) {
-    counts[p] = static_cast<int>(all[3 * p]);
+    counts[p] = static_cast<int>(all[4 * p]);
     displs[p] = off;
     off += counts[p];
   }
