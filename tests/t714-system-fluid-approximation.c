@@ -93,6 +93,7 @@ static void test_choices_run_the_dam_break(void **state) {
     print_message("choice %d: front %.4f a, default %.4f a\n", c, front, front0);
     assert_true(fabs(front - front0) <= 0.02 * front0);
     assert_true(memcmp(alt->y, ref->y, sizeof ref->y) != 0);
+    mfree_system_destroy(&alt->sys);
     /* back to the default: the default run, bitwise */
     make_dam(alt);
     assert_ok(ctx, mfree_system_set_approximation(alt->sys, choices[c].method, choices[c].order, choices[c].kernel, 0.0));

@@ -39,7 +39,8 @@ class ExactSum {
     const int64_t mi = static_cast<int64_t>(std::ldexp(m, 53));  // exact: x = mi 2^(e - 53)
     const int pos = e - 53 + kBias;                               // >= 26 (subnormals included)
     const int k = pos / 32;
-    __int128 v = static_cast<__int128>(mi) << (pos % 32);
+    // (a product, not a left shift: shifting a negative value is undefined before C++20)
+    __int128 v = static_cast<__int128>(mi) * (static_cast<__int128>(1) << (pos % 32));
     // v = c0 + c1 2^32 + c2 2^64, c0 and c1 in [0, 2^32), c2 signed and small
     w_[k] += static_cast<int64_t>(static_cast<uint64_t>(v) & 0xffffffffu);
     v >>= 32;
