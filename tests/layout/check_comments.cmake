@@ -2,7 +2,7 @@
 #
 # Fails, listing file and line, on a comment of a C, C++ or Fortran source, header or
 # CMake script that holds
-#   - a timing: a number with ms, us, µs or ns;
+#   - a timing: a number with ms, us, µs or ns, or micro-, milli- or nanoseconds at all;
 #   - a speed comparison: "N % faster", "N x slower", "N times faster", "N % of a search";
 #   - an issue or pull-request number: "issue 8", "issue-8", "#12", "PR 3".
 # Measurements belong in BENCHMARKS.md (with the command that reproduces them), history
@@ -23,6 +23,7 @@ set(history_patterns
   "(^|[^a-z])(pr|pull request) ?#?[0-9]")
 set(speed_patterns
   "[0-9] ?(ms|us|µs|ns)([^a-z0-9]|$)"
+  "(^|[^a-z])(micro|milli|nano)-?seconds?([^a-z]|$)"
   "[0-9] ?(%|x|times) (faster|slower)"
   "[0-9] ?% of [^.;]*(search|setup|step|run|work|time)")
 

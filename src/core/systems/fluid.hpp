@@ -60,9 +60,9 @@ class FluidSystem : public System {
 
  private:
   void check_ready() const;
-  // Threads for a loop of a few operations per particle (checks, volumes, updates): a team
-  // and its barrier (a few microseconds on idle cores, far more on a loaded machine) pay
-  // off from ~8,000 particles.
+  // Threads for a loop of a few operations per particle (checks, volumes, updates): waking a
+  // team and meeting at its barrier cost as much as thousands of such operations, and more
+  // on a loaded machine, so they pay off only from ~8,000 particles.
   static int light_threads(int64_t n) { return num_threads(n / 4); }
   // Validate the state (unless checked: integrate's state after a step, which
   // check_state has just passed) and build the shape-function tables at the nodes (below).
