@@ -385,23 +385,8 @@ contains
     real(c_double), intent(inout), target :: field(..)
     integer(c_int64_t), intent(in) :: ld
     real(c_double), pointer :: pf(:)
-    integer(c_int32_t) :: no, ng
-    integer(c_int64_t) :: need
-    st = MFREE_SUCCESS
-    ! (a plan that is not set up, or a bad ncomp or ld: the C call says so on every rank)
-    if (mfree_halo_get_size_c(halo%ptr, no, ng) == MFREE_SUCCESS .and. ncomp >= 1 .and. ld >= ncomp) then
-      need = 0
-      if (no + ng > 0) need = (int(no, c_int64_t) + ng - 1) * ld + ncomp
-      st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_exchange', 'field', is_contiguous(field), &
-                                   size(field, kind=c_int64_t), need)
-    end if
-    pf => empty_dbl
-    if (st /= MFREE_SUCCESS) then
-      if (mfree_halo_set_pending_error_c(halo%ptr) /= MFREE_SUCCESS) return
-    else if (size(field) > 0) then
-      call c_f_pointer(c_loc(field), pf, [size(field)])
-    end if
-    st = mfree_halo_exchange_c(halo%ptr, ncomp, pf, ld)
+    st = exchange_field(halo, 'mfree_halo_exchange', ncomp, field, ld, pf)
+    if (st == MFREE_SUCCESS) st = mfree_halo_exchange_c(halo%ptr, ncomp, pf, ld)
   end function mfree_halo_exchange
 
   !> Typed wrapper of mfree_halo_exchange_callback (mfree_mpi.h): the exchange a system on
@@ -412,23 +397,38 @@ contains
     real(c_double), intent(inout), target :: field(..)
     integer(c_int64_t), intent(in) :: ld
     real(c_double), pointer :: pf(:)
+    st = exchange_field(halo, 'mfree_halo_exchange_callback', ncomp, field, ld, pf)
+    if (st == MFREE_SUCCESS) st = mfree_halo_exchange_callback_c(halo%ptr, ncomp, pf, ld)
+  end function mfree_halo_exchange_callback
+
+  !> The check of field that both exchanges make (fn names the caller in the message): pf
+  !> views field; or, when field is too short or not contiguous, pf is empty and the failure
+  !> is handed to the plan, so that the exchange fails on every rank. A status other than
+  !> MFREE_SUCCESS where even that failed: the caller returns it. A plan that is not set up,
+  !> or a bad ncomp or ld, is left to the C call, which says so on every rank.
+  integer(c_int) function exchange_field(halo, fn, ncomp, field, ld, pf) result(st)
+    type(mfree_halo), intent(in) :: halo
+    character(len=*), intent(in) :: fn
+    integer(c_int32_t), intent(in) :: ncomp
+    real(c_double), intent(inout), target :: field(..)
+    integer(c_int64_t), intent(in) :: ld
+    real(c_double), pointer, intent(out) :: pf(:)
     integer(c_int32_t) :: no, ng
     integer(c_int64_t) :: need
     st = MFREE_SUCCESS
     if (mfree_halo_get_size_c(halo%ptr, no, ng) == MFREE_SUCCESS .and. ncomp >= 1 .and. ld >= ncomp) then
       need = 0
       if (no + ng > 0) need = (int(no, c_int64_t) + ng - 1) * ld + ncomp
-      st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_exchange_callback', 'field', &
-                                   is_contiguous(field), size(field, kind=c_int64_t), need)
+      st = mfree_wrapper_check_out(halo_ctx(halo), fn, 'field', is_contiguous(field), &
+                                   size(field, kind=c_int64_t), need)
     end if
     pf => empty_dbl
     if (st /= MFREE_SUCCESS) then
-      if (mfree_halo_set_pending_error_c(halo%ptr) /= MFREE_SUCCESS) return
+      if (mfree_halo_set_pending_error_c(halo%ptr) == MFREE_SUCCESS) st = MFREE_SUCCESS
     else if (size(field) > 0) then
       call c_f_pointer(c_loc(field), pf, [size(field)])
     end if
-    st = mfree_halo_exchange_callback_c(halo%ptr, ncomp, pf, ld)
-  end function mfree_halo_exchange_callback
+  end function exchange_field
 
   !> Typed wrapper of mfree_halo_allgather (mfree_mpi.h): every rank's n values of in
   !> concatenated in rank order into out (cap values; cap = 0 asks for the total only).

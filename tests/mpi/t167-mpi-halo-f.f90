@@ -10,7 +10,7 @@
 !> (mfree_halo_exchange_correction), and SPH, which has none, fails on every rank. The
 !> callbacks of systems on ranks: the all-gather in rank order (a capacity beyond out on
 !> one rank fails on every rank, one below the total writes nothing) and the exchange
-!> callback.
+!> callback (a field one short on one rank fails on every rank, naming that rank).
 program t167_mpi_halo_f
   use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_int64_t, c_double
   use mpi
@@ -184,6 +184,18 @@ program t167_mpi_halo_f
   do k = no + 1, no + ng
     call check(x(1, k) == real(ids(k), c_double) / n, 'exchange callback: ghost position is its owner''s')
   end do
+  ! the callback with a field one item short on the last rank: every rank fails, naming it,
+  ! no ghost written
+  x(1, no + 1:no + ng) = -1
+  if (rank == last) then
+    st_ = mfree_halo_exchange_callback(halo, 1_c_int32_t, x(:, 1:no + ng - 1), 1_c_int64_t)
+  else
+    st_ = mfree_halo_exchange_callback(halo, 1_c_int32_t, x(:, 1:no + ng), 1_c_int64_t)
+  end if
+  call check(st_ == MFREE_ERR_ARG .and. index(mfree_last_error(hctx), trim(who)) > 0 .and. &
+             index(mfree_last_error(hctx), 'field holds') > 0, &
+             'exchange callback, short field on the last rank: '//mfree_last_error(hctx))
+  call check(all(x(1, no + 1:no + ng) == -1.0_c_double), 'no ghost written by a failed exchange callback')
   deallocate (hs, vs)
 
   call check(mfree_halo_destroy(halo) == MFREE_SUCCESS, 'destroy')
