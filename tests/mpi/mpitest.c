@@ -7,6 +7,29 @@
 
 int mpitest_failures = 0;
 
+void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle, const char *what) {
+  char msg[600] = "";
+  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  CHECK(got == want, "%s: status %d, expected %d (%s)", what, (int)got, (int)want, msg);
+  CHECK(!needle || strstr(msg, needle), "%s: message '%s' lacks '%s'", what, msg, needle);
+}
+
+char *slurp(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  const long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
+  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
+    free(s);
+    s = NULL;
+  }
+  if (s) s[n] = 0;
+  fclose(f);
+  return s;
+}
+
 int mpitest_finish(const char *name) {
   int total = 0, rank = 0;
   MPI_Allreduce(&mpitest_failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);

@@ -1,5 +1,5 @@
 /* Helpers of the MPI tests (label mpi): a cloud every rank builds alike, its
- * decompositions, and checks that end every rank with the same verdict. */
+ * decompositions, checks that end every rank with the same verdict, and a file reader. */
 #ifndef MFREE_MPITEST_H
 #define MFREE_MPITEST_H
 
@@ -24,6 +24,14 @@ extern int mpitest_failures;
       ++mpitest_failures;                                            \
     }                                                                \
   } while (0)
+
+/* One call's outcome on this rank, checked where every rank must agree (a collective call
+ * returns the same status everywhere): status want, and a context message holding needle
+ * (NULL: any message); what names the case in a failed check. */
+void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle, const char *what);
+
+/* The whole file at path, NUL-terminated, to be freed; NULL when it cannot be read. */
+char *slurp(const char *path);
 
 /* 0 when no rank failed a check (printed by rank 0), else 1: main's exit code. */
 int mpitest_finish(const char *name);

@@ -28,14 +28,6 @@
 
 static int rank = 0, size = 1;
 
-static void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle,
-                   const char *what) {
-  char msg[600] = "";
-  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
-  CHECK(got == want, "%s: status %d, expected %d (%s)", what, (int)got, (int)want, msg);
-  CHECK(!needle || strstr(msg, needle), "%s: message '%s' lacks '%s'", what, msg, needle);
-}
-
 /* The particle set of the plan (owned positions xo and supports ho given; ghosts
  * exchanged; volumes h^2), set up; the arrays it borrows are returned for freeing. */
 static mfree_particles_t *plan_set(mfree_context_t *ctx, mfree_halo_t *halo, const double *xo, const double *ho,

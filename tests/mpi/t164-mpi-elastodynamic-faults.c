@@ -27,14 +27,6 @@
 enum { N = 120 };
 static int rank = 0, size = 1;
 
-static void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle,
-                   const char *what) {
-  char msg[600] = "";
-  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
-  CHECK(got == want, "%s: status %d, expected %d (%s)", what, (int)got, (int)want, msg);
-  CHECK(!needle || strstr(msg, needle), "%s: message '%s' lacks '%s'", what, msg, needle);
-}
-
 static int nan_rank = -1; /* the rank whose load history turns NaN after 1 us */
 static double nan_history(void *user, double t) {
   (void)user;

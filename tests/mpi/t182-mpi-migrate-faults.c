@@ -32,22 +32,6 @@ static int rank = 0, size = 1;
 #error "MFREE_MPI_HEADER and MFREE_TEST_SOURCE (mfree_mpi.h and this file) must be defined by the build"
 #endif
 
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
-    free(s);
-    s = NULL;
-  }
-  if (s) s[n] = 0;
-  fclose(f);
-  return s;
-}
-
 /* Every mfree_migration_* function declared in the header is called in this file with a
  * bad argument (a row above names it followed by "(NULL" or "(m"); returns the missing. */
 static int missing_rows(void) {
@@ -68,14 +52,6 @@ static int missing_rows(void) {
   free(h);
   free(me);
   return missing;
-}
-
-static void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle,
-                   const char *what) {
-  char msg[600] = "";
-  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
-  CHECK(got == want, "%s: status %d, expected %d (%s)", what, (int)got, (int)want, msg);
-  CHECK(!needle || strstr(msg, needle), "%s: message '%s' lacks '%s'", what, msg, needle);
 }
 
 int main(int argc, char **argv) {

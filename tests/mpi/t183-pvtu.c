@@ -21,22 +21,6 @@
 
 static int rank = 0, size = 1;
 
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
-    free(s);
-    s = NULL;
-  }
-  if (s) s[n] = 0;
-  fclose(f);
-  return s;
-}
-
 static int count_of(const char *s, const char *needle) {
   int k = 0;
   for (const char *p = s; (p = strstr(p, needle)); p += strlen(needle)) ++k;
