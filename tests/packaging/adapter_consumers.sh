@@ -6,6 +6,8 @@
 # "...: ok" line per solver or integrator, and its CMake project builds
 # BIN_PREFIX_consumer_shared and BIN_PREFIX_consumer_static. EXTRA_LIBS are linked after
 # the pkg-config flags (SUNDIALS ships no pkg-config file: its host links it itself).
+# An adapter named a_b has the pkg-config module mfree-a-b; $CONSUMER_DIR (relative to
+# SOURCE_DIR, default tests/ADAPTER/consumer) names another host program's folder.
 #
 # usage: adapter_consumers.sh BUILD_DIR SCRATCH_DIR SOURCE_DIR C_COMPILER ADAPTER
 #          BIN_PREFIX EXPECTED_OK [EXTRA_LIBS...]
@@ -25,7 +27,7 @@ bin_prefix=$6
 expected_ok=$7
 shift 7
 extra_libs="$*"
-pkg=mfree-$adapter
+pkg=mfree-${adapter//_/-}
 lib=mfree_$adapter
 cmake_cmd=${CMAKE:-cmake}
 
@@ -46,7 +48,7 @@ esac
 rm -rf -- "$scratch"
 mkdir -p -- "$scratch"
 prefix=$scratch/prefix
-consumer=$src/tests/$adapter/consumer
+consumer=$src/${CONSUMER_DIR:-tests/$adapter/consumer}
 
 step "install $build into $prefix"
 "$cmake_cmd" --install "$build" --prefix "$prefix" >"$scratch/install.log" 2>&1 ||
@@ -83,13 +85,16 @@ readelf -d "$scratch/pc_shared" | grep -q "NEEDED.*\\[lib$lib\\.so" ||
   fail "pkg-config shared build does not use lib$lib.so"
 run pkgconfig-shared "$scratch/pc_shared"
 
-static_libs=$(pkg-config --static --libs-only-l $pkg |
-  sed -e "s/-l$lib\\b//" -e 's/-lmfree\b//')
+# Every mfree library the module requires (-lmfree_X, then -lmfree_Y it builds on, then
+# -lmfree), in pkg-config's order, forced static; the rest as pkg-config gives them.
+all_static=$(pkg-config --static --libs-only-l $pkg)
+mfree_static=$(tr ' ' '\n' <<<"$all_static" | { grep -E '^-lmfree(_[a-z_]+)?$' || true; } | tr '\n' ' ')
+static_libs=$(tr ' ' '\n' <<<"$all_static" | { grep -vE '^-lmfree(_[a-z_]+)?$' || true; } | tr '\n' ' ')
 static_ldirs=$(pkg-config --static --libs-only-L $pkg)
-step "pkg-config, static archives: -Wl,-Bstatic -l$lib -lmfree -Wl,-Bdynamic $static_libs"
+step "pkg-config, static archives: -Wl,-Bstatic $mfree_static-Wl,-Bdynamic $static_libs"
 # shellcheck disable=SC2086
 "$cc" "$consumer/main.c" -o "$scratch/pc_static" $cflags $ldirs $static_ldirs \
-  -Wl,-Bstatic -l$lib -lmfree -Wl,-Bdynamic $static_libs $extra_libs -lm ||
+  -Wl,-Bstatic $mfree_static -Wl,-Bdynamic $static_libs $extra_libs -lm ||
   fail "pkg-config static build"
 if readelf -d "$scratch/pc_static" | grep -q 'NEEDED.*\[libmfree'; then
   fail "static build still needs a shared libmfree*"

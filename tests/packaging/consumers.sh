@@ -7,7 +7,8 @@
 #         serial     find_package(mfree) in hosts where MPI cannot be found (C with
 #                    CMAKE_DISABLE_FIND_PACKAGE_MPI, C++ alone), from the same tree as
 #                    the adapters: mfree::mfree and mfree::mfree_static, no MPI target,
-#                    the mpi component refused by name (or left out when optional)
+#                    the mpi and sundials_mpi components refused by name (or left out
+#                    when optional)
 #   SCRATCH_DIR must lie under BUILD_DIR; it is wiped first, so reruns start clean.
 # The cmake consumer uses $CMAKE (default: cmake on PATH).
 set -euo pipefail
@@ -141,39 +142,41 @@ consumer_serial() {
     run_consumer "$lang-only mfree::mfree_static" "$out/consumer_static"
   done
 
-  # The mpi component in a C host where MPI is disabled: optional, it is left out;
-  # required, the package is not found and says why (not CMake's error for a REQUIRED
-  # search of a disabled package).
-  local comp=$scratch/serial-components expected
+  # The components over MPI (mpi, sundials_mpi) in a C host where MPI is disabled:
+  # optional, each is left out; required, the package is not found and says why (not
+  # CMake's error for a REQUIRED search of a disabled package).
+  local comp=$scratch/serial-components expected c
   mkdir -p "$comp"
   cat >"$comp/CMakeLists.txt" <<'END'
 cmake_minimum_required(VERSION 3.16)
 project(mfree_serial_components LANGUAGES C)
 if(REQUIRE_MPI)
-  find_package(mfree REQUIRED COMPONENTS mpi)
+  find_package(mfree REQUIRED COMPONENTS ${COMP})
 else()
-  find_package(mfree REQUIRED OPTIONAL_COMPONENTS mpi)
+  find_package(mfree REQUIRED OPTIONAL_COMPONENTS ${COMP})
 endif()
-if(mfree_mpi_FOUND OR TARGET mfree::mfree_mpi OR NOT TARGET mfree::mfree)
-  message(FATAL_ERROR "OPTIONAL_COMPONENTS mpi without MPI: mfree_mpi_FOUND '${mfree_mpi_FOUND}'")
+if(mfree_${COMP}_FOUND OR TARGET mfree::mfree_${COMP} OR NOT TARGET mfree::mfree)
+  message(FATAL_ERROR "OPTIONAL_COMPONENTS ${COMP} without MPI: mfree_${COMP}_FOUND '${mfree_${COMP}_FOUND}'")
 endif()
 END
-  step "CMake, C with MPI disabled: find_package(mfree OPTIONAL_COMPONENTS mpi)"
-  "$cmake_cmd" -S "$comp" -B "$comp/optional" -DCMAKE_PREFIX_PATH="$prefix" \
-    -DCMAKE_C_COMPILER="$cc" -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON >"$comp/optional.log" 2>&1 ||
-    { cat "$comp/optional.log" >&2; fail "find_package(mfree OPTIONAL_COMPONENTS mpi) without MPI"; }
-  step "CMake, C with MPI disabled: find_package(mfree REQUIRED COMPONENTS mpi) refused"
-  if "$cmake_cmd" -S "$comp" -B "$comp/required" -DCMAKE_PREFIX_PATH="$prefix" \
-    -DCMAKE_C_COMPILER="$cc" -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON -DREQUIRE_MPI=ON \
-    >"$comp/required.log" 2>&1; then
-    fail "find_package(mfree REQUIRED COMPONENTS mpi) succeeded without MPI"
-  fi
-  expected="this installation was built without libmfree_mpi"
-  if [[ -f "$cfgdir/mfree_mpiTargets.cmake" ]]; then
-    expected="component 'mpi' needs MPI::MPI_C"
-  fi
-  grep -qF "$expected" "$comp/required.log" ||
-    { cat "$comp/required.log" >&2; fail "the refusal does not say: $expected"; }
+  for c in mpi sundials_mpi; do
+    step "CMake, C with MPI disabled: find_package(mfree OPTIONAL_COMPONENTS $c)"
+    "$cmake_cmd" -S "$comp" -B "$comp/optional-$c" -DCMAKE_PREFIX_PATH="$prefix" -DCOMP=$c \
+      -DCMAKE_C_COMPILER="$cc" -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON >"$comp/optional-$c.log" 2>&1 ||
+      { cat "$comp/optional-$c.log" >&2; fail "find_package(mfree OPTIONAL_COMPONENTS $c) without MPI"; }
+    step "CMake, C with MPI disabled: find_package(mfree REQUIRED COMPONENTS $c) refused"
+    if "$cmake_cmd" -S "$comp" -B "$comp/required-$c" -DCMAKE_PREFIX_PATH="$prefix" -DCOMP=$c \
+      -DCMAKE_C_COMPILER="$cc" -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON -DREQUIRE_MPI=ON \
+      >"$comp/required-$c.log" 2>&1; then
+      fail "find_package(mfree REQUIRED COMPONENTS $c) succeeded without MPI"
+    fi
+    expected="this installation was built without libmfree_$c"
+    if [[ -f "$cfgdir/mfree_${c}Targets.cmake" ]]; then
+      expected="component '$c' needs MPI::MPI_C"
+    fi
+    grep -qF "$expected" "$comp/required-$c.log" ||
+      { cat "$comp/required-$c.log" >&2; fail "the refusal does not say: $expected"; }
+  done
 }
 
 case "$mode" in
