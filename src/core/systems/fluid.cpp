@@ -6,10 +6,7 @@
 #include <sstream>
 
 #include "core/base/parallel.hpp"
-
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
+#include "core/base/simd.hpp"
 
 namespace mfree {
 
@@ -145,24 +142,33 @@ Report FluidSystem::check_state(const double *y, int64_t step) const {
     // the common case first: branch-free over flat arrays (vectorisable), then the
     // particle-by-particle search only in a block that holds an invalid particle
     bool bad = false;
-#ifdef __SSE2__
+#if MFREE_VECTOR_EXTENSIONS
     if (dim == 2) {  // two particles (densities) and one particle (x, v) per operation
-      const __m128d big = _mm_set1_pd(DBL_MAX), zero = _mm_setzero_pd();
-      const __m128d absm = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffLL));
-      const __m128d lo = _mm_setr_pd(lo_[0], lo_[1]), hi = _mm_setr_pd(hi_[0], hi_[1]);
-      __m128d ok = _mm_castsi128_pd(_mm_set1_epi64x(-1));
+      // No lane masks: SSE2 has no blend, and GCC splits a masked accumulation into
+      // scalar selects. A product with 0 is NaN exactly for a non-finite value, so a sum
+      // of them is 0 exactly when every entry is finite; minima and maxima (minpd,
+      // maxpd) of the finite values then decide the signs and the box.
+      using simd::V2;
+      V2 fin = {0.0, 0.0}, rmin = {DBL_MAX, DBL_MAX}, xmin = rmin, xmax = -rmin;
       int64_t i = b;
       for (; i + 2 <= e; i += 2) {
-        const __m128d r = _mm_loadu_pd(rho + i);
-        ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmpgt_pd(r, zero), _mm_cmple_pd(r, big)));
+        V2 r;
+        simd::load<2>(r, rho + i);
+        fin += r * 0.0;
+        rmin = rmin < r ? rmin : r;
       }
       for (; i < e; ++i) bad |= !(rho[i] > 0.0) | !(rho[i] <= DBL_MAX);
       for (i = b; i < e; ++i) {
-        const __m128d xi = _mm_loadu_pd(x + 2 * i), vi = _mm_loadu_pd(v + 2 * i);
-        ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmple_pd(_mm_and_pd(xi, absm), big), _mm_cmple_pd(_mm_and_pd(vi, absm), big)));
-        if (box_) ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmpge_pd(xi, lo), _mm_cmple_pd(xi, hi)));
+        V2 xi, vi;
+        simd::load<2>(xi, x + 2 * i);
+        simd::load<2>(vi, v + 2 * i);
+        fin += xi * 0.0 + vi * 0.0;
+        xmin = xmin < xi ? xmin : xi;
+        xmax = xmax > xi ? xmax : xi;
       }
-      if (bad || _mm_movemask_pd(ok) != 3) {
+      bad |= !(fin[0] == 0.0 && fin[1] == 0.0) || !(rmin[0] > 0.0 && rmin[1] > 0.0);
+      if (box_) bad |= !(xmin[0] >= lo_[0] && xmin[1] >= lo_[1] && xmax[0] <= hi_[0] && xmax[1] <= hi_[1]);
+      if (bad) {
         for (int64_t k = b; k < e; ++k)
           if (!valid(k)) {
             first[t] = static_cast<int32_t>(k);
@@ -318,20 +324,22 @@ double FluidSystem::stable_dt(const double *y) const {
   double tmax[64] = {};  // per thread (parallel_blocks runs at most 64): a maximum is exact in any order
   parallel_blocks(n_, light_threads(n_), [&](int t, int64_t b, int64_t e) {
     double cm = 0.0;
-#ifdef __SSE2__
+#if MFREE_VECTOR_EXTENSIONS
     if (dim_ == 2) {  // two particles at a time: the same correctly rounded roots, an exact maximum
-      const __m128d gk = _mm_set1_pd(gamma_ * kappa_);
-      __m128d m2 = _mm_setzero_pd();
+      using simd::V2;
+      const V2 gk = {gamma_ * kappa_, gamma_ * kappa_};
+      V2 m2 = {0.0, 0.0};
       for (; b + 2 <= e; b += 2) {
-        const __m128d v0 = _mm_loadu_pd(v + 2 * b), v1 = _mm_loadu_pd(v + 2 * b + 2);
-        const __m128d vx = _mm_unpacklo_pd(v0, v1), vy = _mm_unpackhi_pd(v0, v1);
-        const __m128d vv = _mm_add_pd(_mm_mul_pd(vx, vx), _mm_mul_pd(vy, vy));
-        const __m128d c = _mm_sqrt_pd(_mm_div_pd(gk, _mm_loadu_pd(rho + b)));
-        m2 = _mm_max_pd(m2, _mm_add_pd(c, _mm_sqrt_pd(vv)));
+        V2 v0, v1, r;
+        simd::load<2>(v0, v + 2 * b);
+        simd::load<2>(v1, v + 2 * b + 2);
+        simd::load<2>(r, rho + b);
+        const V2 vx = {v0[0], v1[0]}, vy = {v0[1], v1[1]};
+        const V2 vv = vx * vx + vy * vy, q = gk / r;
+        const V2 s = V2{std::sqrt(q[0]), std::sqrt(q[1])} + V2{std::sqrt(vv[0]), std::sqrt(vv[1])};
+        m2 = m2 > s ? m2 : s;  // maxpd
       }
-      double t2[2];
-      _mm_storeu_pd(t2, m2);
-      cm = std::max(t2[0], t2[1]);
+      cm = std::max(m2[0], m2[1]);
     }
 #endif
     for (int64_t i = b; i < e; ++i) {
