@@ -106,13 +106,8 @@ typedef struct {
  * shallow-water solution predicts (the depth behind the bore; NaN if empty), or -1 when
  * the file cannot be written. */
 static double profile(const fc_run_t *r, const bore_t *b, const double *height, double t) {
-  char path[4096];
-  ex_join(path, sizeof path, r->out, "profile.csv");
-  FILE *f = fopen(path, "w");
-  if (!f) {
-    fprintf(stderr, "mfree_bore: error: cannot write %s\n", path);
-    return -1.0;
-  }
+  FILE *f = fc_open_csv(r, "profile.csv");
+  if (!f) return -1.0;
   fprintf(f, "# free surface at t = %.4f s: mfree (highest particle + d/2 within 3 columns) and shallow water\n"
              "x,height,height_sw\n", t);
   const double pa = b->xg + (b->um - sqrt(kG * b->hm)) * t, pb = b->xg + b->S * t;
@@ -182,13 +177,8 @@ int main(int argc, char **argv) {
   const double thr = 0.5 * (h0 + hm), win_lo = 2.0 * h1, win_hi = (L - xg) - 2.0 * h1;
   const int bend = (int)floor((L - h1) / d); /* the scan starts one depth before the end wall */
 
-  char path[4096];
-  ex_join(path, sizeof path, ro.out, "bore.csv");
-  FILE *csv = fopen(path, "w");
-  if (!csv) {
-    fprintf(stderr, "mfree_bore: error: cannot write %s\n", path);
-    return 1;
-  }
+  FILE *csv = fc_open_csv(&ro, "bore.csv");
+  if (!csv) return 1;
   fprintf(csv, "# bore between depths %g and %g m (gate at x = %g m), %d particles; shallow-water bore "
                "speed %.4f m/s\nt,x_bore,travel\n", h1, h0, xg, n, S);
   fc_vtu_t vtu;

@@ -180,13 +180,8 @@ int main(int argc, char **argv) {
   const int ndata = read_data(o.data, dT, dZ, 64);
   if (!ndata && !o.run.quiet)
     fprintf(stderr, "mfree_dam_break: no Martin & Moyce data at %s; the comparison is skipped\n", o.data);
-  char path[4096];
-  ex_join(path, sizeof path, out_dir, "front.csv");
-  FILE *csv = fopen(path, "w");
-  if (!csv) {
-    fprintf(stderr, "mfree_dam_break: error: cannot write %s\n", path);
-    return 1;
-  }
+  FILE *csv = fc_open_csv(&o.run, "front.csv");
+  if (!csv) return 1;
   fc_vtu_t vtu;
   if (fc_vtu_open(&vtu, fc_run_vtu_dir(&o.run), "dam_break", o.run.vtu_every)) return 1;
   fprintf(csv, "# Martin & Moyce dam break, a = %g m, nx = %d, %d particles\n"

@@ -106,31 +106,16 @@ int main(int argc, char **argv) {
   const double h = 1.5 * d, off = 0.5 * d, ds = d / 3.0;
   const int nx = (int)lround(width / d), np = nx * nz;
   const double W = nx * d, xc = 0.5 * W, zc0 = kHp + gap + R;
-  /* the drop: lattice points (xc + i d, zc0 + j d) inside the circle */
-  const int ir = (int)floor(R / d);
-  int nd = 0;
-  for (int j = -ir; j <= ir; ++j)
-    for (int i = -ir; i <= ir; ++i) nd += (i * i + j * j) * d * d <= R * R;
-  const int n = np + nd;
+  const int nd = fc_water_drop(NULL, NULL, 0, 0, xc, zc0, R, d, kRho0, kV0), n = np + nd;
   const double v_impact = sqrt(kV0 * kV0 + 2.0 * kG * gap);
   const double c0 = 10.0 * fmax(sqrt(2.0 * kG * kHp), v_impact), kappa = kRho0 * c0 * c0 / kGamma;
   double *y = calloc(5 * (size_t)n, sizeof *y), *m = malloc((size_t)n * sizeof *m);
-  int *tag = malloc((size_t)n * sizeof *tag);
+  int32_t *tag = malloc((size_t)n * sizeof *tag);
   probe_t pr = {NULL, NULL, n, nd, malloc((size_t)n * sizeof(double)), malloc(5 * (size_t)n * sizeof(double))};
   if (!y || !m || !tag || !pr.lumped || !pr.rate_twin) return 1;
-  int q = fc_water_block(y, m, n, 0, 0.0, nx, nz, d, kHp, kRho0, kappa, kGamma, kG);
-  for (int k = 0; k < np; ++k) tag[k] = 1;
-  for (int j = -ir; j <= ir; ++j)
-    for (int i = -ir; i <= ir; ++i)
-      if ((i * i + j * j) * d * d <= R * R) {
-        y[2 * q] = xc + i * d;
-        y[2 * q + 1] = zc0 + j * d;
-        y[2 * n + 2 * q + 1] = -kV0;
-        y[4 * n + q] = kRho0;
-        m[q] = kRho0 * d * d;
-        tag[q] = 2;
-        ++q;
-      }
+  const int q = fc_water_block(y, m, n, 0, 0.0, nx, nz, d, kHp, kRho0, kappa, kGamma, kG);
+  fc_water_drop(y, m, n, q, xc, zc0, R, d, kRho0, kV0);
+  for (int k = 0; k < n; ++k) tag[k] = k < np ? 1 : 2;
   double mass0 = 0.0, mass_d = 0.0, zd0 = 0.0;
   for (int k = 0; k < n; ++k) mass0 += m[k];
   for (int k = np; k < n; ++k) mass_d += m[k], zd0 += m[k] * y[2 * k + 1];
@@ -152,13 +137,8 @@ int main(int argc, char **argv) {
   const double lo[2] = {-off, -off}, hi[2] = {W + off, 10.0 * wtop};
   CHECK(mfree_system_set_box(sys, lo, hi));
 
-  char path[4096];
-  ex_join(path, sizeof path, ro.out, "drop.csv");
-  FILE *csv = fopen(path, "w");
-  if (!csv) {
-    fprintf(stderr, "mfree_drop: error: cannot write %s\n", path);
-    return 1;
-  }
+  FILE *csv = fc_open_csv(&ro, "drop.csv");
+  if (!csv) return 1;
   fprintf(csv, "# drop of diameter %g m at 2 m/s onto water %g m deep; %d + %d particles\n"
                "t,z_c,z_free_fall,gap,P_x,P_z,P_drop_z\n", diameter, kHp, np, nd);
   fc_vtu_t vtu;

@@ -56,6 +56,26 @@ int fc_water_block(double *y, double *m, int n, int q0, double x0, int ni, int n
   return q;
 }
 
+int fc_water_drop(double *y, double *m, int n, int q0, double xc, double zc, double R, double d, double rho0,
+                  double v0) {
+  const int ir = (int)floor(R / d + 1e-9);
+  const double rr = (R / d) * (R / d) * (1.0 + 1e-9);
+  int q = q0;
+  for (int j = -ir; j <= ir; ++j)
+    for (int i = -ir; i <= ir; ++i) {
+      if (i * i + j * j > rr) continue;
+      if (y) {
+        y[2 * q] = xc + i * d;
+        y[2 * q + 1] = zc + j * d;
+        y[2 * (size_t)n + 2 * q + 1] = -v0;
+        y[4 * (size_t)n + q] = rho0;
+        m[q] = rho0 * d * d;
+      }
+      ++q;
+    }
+  return q;
+}
+
 void fc_walls_free(fc_walls_t *w) {
   free(w->x);
   free(w->nrm);
@@ -175,40 +195,20 @@ int fc_run_prepare(fc_run_t *r) {
   return v ? make_dir(r->name, v) : 0;
 }
 
-/* ---- VTU ---- */
-
-int fc_write_vtu(const char *path, int n, const double *y, const double *vhat, const double *p,
-                 const int *tag) {
+/* path opened for writing, or NULL after "mfree_<name>: error: cannot write <path>". */
+static FILE *create_file(const char *name, const char *path) {
   FILE *f = fopen(path, "w");
-  if (!f) return 1;
-  fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
-             "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"%d\" "
-             "NumberOfCells=\"%d\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" "
-             "format=\"ascii\">\n",
-          n, n);
-  for (int i = 0; i < n; ++i) fprintf(f, "%.9g %.9g 0\n", y[2 * i], y[2 * i + 1]);
-  fprintf(f, "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int32\" Name=\"connectivity\" "
-             "format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%d\n", i);
-  fprintf(f, "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%d\n", i + 1);
-  fprintf(f, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "1\n");
-  fprintf(f, "</DataArray>\n</Cells>\n<PointData Scalars=\"pressure\" Vectors=\"velocity\">\n"
-             "<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%.6g %.6g 0\n", vhat[2 * i], vhat[2 * i + 1]);
-  fprintf(f, "</DataArray>\n<DataArray type=\"Float64\" Name=\"pressure\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%.6g\n", p[i]);
-  fprintf(f, "</DataArray>\n<DataArray type=\"Float64\" Name=\"density\" format=\"ascii\">\n");
-  for (int i = 0; i < n; ++i) fprintf(f, "%.8g\n", y[4 * n + i]);
-  if (tag) {
-    fprintf(f, "</DataArray>\n<DataArray type=\"Int32\" Name=\"fluid\" format=\"ascii\">\n");
-    for (int i = 0; i < n; ++i) fprintf(f, "%d\n", tag[i]);
-  }
-  fprintf(f, "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-  const int bad = ferror(f);
-  return (fclose(f) != 0) || bad;
+  if (!f) fprintf(stderr, "mfree_%s: error: cannot write %s\n", name, path);
+  return f;
 }
+
+FILE *fc_open_csv(const fc_run_t *r, const char *file) {
+  char path[4096];
+  ex_join(path, sizeof path, r->out, file);
+  return create_file(r->name, path);
+}
+
+/* ---- VTU ---- */
 
 int fc_vtu_open(fc_vtu_t *v, const char *dir, const char *prefix, double every) {
   memset(v, 0, sizeof *v);
@@ -218,17 +218,14 @@ int fc_vtu_open(fc_vtu_t *v, const char *dir, const char *prefix, double every) 
   v->every = every;
   char path[4096];
   snprintf(path, sizeof path, "%s/%s.pvd", dir, prefix);
-  v->pvd = fopen(path, "w");
-  if (!v->pvd) {
-    fprintf(stderr, "mfree_%s: error: cannot write %s\n", prefix, path);
-    return 1;
-  }
+  v->pvd = create_file(prefix, path);
+  if (!v->pvd) return 1;
   fprintf(v->pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
   return 0;
 }
 
 int fc_vtu_maybe(fc_vtu_t *v, mfree_system_t *sys, double T, double t, int n, const double *y,
-                 const int *tag) {
+                 const int32_t *tag) {
   if (!v->pvd || T < v->next - 1e-9 * (1.0 + fabs(T))) return 0;
   double *vhat = malloc(2 * (size_t)n * sizeof *vhat + 1), *p = malloc((size_t)n * sizeof *p + 1);
   char path[4096];
@@ -236,7 +233,13 @@ int fc_vtu_maybe(fc_vtu_t *v, mfree_system_t *sys, double T, double t, int n, co
   int rc = !vhat || !p;
   if (!rc) rc = mfree_system_get_velocity(sys, y, vhat) != MFREE_SUCCESS;
   if (!rc) rc = mfree_system_get_pressure(sys, y, p) != MFREE_SUCCESS;
-  if (!rc) rc = fc_write_vtu(path, n, y, vhat, p, tag);
+  if (!rc) {
+    const ex_vtu_array_t arrays[4] = {{"velocity", EX_VTU_FLOAT64, 2, vhat, 2},
+                                      {"pressure", EX_VTU_FLOAT64, 1, p, 1},
+                                      {"density", EX_VTU_FLOAT64, 1, y + 4 * (size_t)n, 1},
+                                      {"fluid", EX_VTU_INT32, 1, tag, 1}};
+    rc = ex_vtu_write(path, n, 2, y, 2, tag ? 4 : 3, arrays);
+  }
   free(vhat);
   free(p);
   if (rc) {

@@ -18,6 +18,7 @@
 #define MFREE_EXAMPLES_FLUID_COMMON_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include <mfree.h>
@@ -48,6 +49,15 @@ void fc_walls_free(fc_walls_t *w);
  * next index, q0 + ni nj. */
 int fc_water_block(double *y, double *m, int n, int q0, double x0, int ni, int nj, double d, double H,
                    double rho0, double kappa, double gamma, double g);
+
+/* Particles q0, q0 + 1, ... of a circular drop of radius R at rest density rho0, falling
+ * at speed v0: the points (xc + i d, zc + j d) of the lattice of spacing d inside the
+ * circle (those on it included whatever the rounding), velocity parameters (0, -v0) (a
+ * constant field is reproduced exactly, 003 eq 100), masses rho0 d^2. y is the state of n
+ * particles; with y NULL nothing is written (m may be NULL too), to count the drop's
+ * particles first. Returns the next index, q0 + the drop's particles. */
+int fc_water_drop(double *y, double *m, int n, int q0, double xc, double zc, double R, double d, double rho0,
+                  double v0);
 
 /* ---- run options ---- */
 
@@ -83,13 +93,11 @@ void fc_run_usage(FILE *f);
 int fc_run_prepare(fc_run_t *r);
 /* The directory of the VTU series, NULL when there is none. */
 const char *fc_run_vtu_dir(const fc_run_t *r);
+/* Open the CSV file (any name) in the out directory for writing; NULL after
+ * "mfree_<name>: error: cannot write <path>" on stderr. */
+FILE *fc_open_csv(const fc_run_t *r, const char *file);
 
 /* ---- VTU series for ParaView ---- */
-
-/* VTU of the particles (position, interpolated velocity, pressure, density, and an
- * optional integer tag such as the fluid). Returns 0 on success. */
-int fc_write_vtu(const char *path, int n, const double *y, const double *vhat, const double *p,
-                 const int *tag);
 
 typedef struct {
   FILE *pvd;
@@ -102,9 +110,11 @@ typedef struct {
  * message. */
 int fc_vtu_open(fc_vtu_t *v, const char *dir, const char *prefix, double every);
 /* Write the state when T (the example's time unit) has reached the next output time;
- * t is the physical time recorded in the PVD. Returns 0, or 1 with a message. */
+ * t is the physical time recorded in the PVD: a VTU of the particles (examples/util's
+ * ex_vtu_write) with their interpolated velocity, pressure, density and, unless tag is
+ * NULL, the integer tag "fluid". Returns 0, or 1 with a message. */
 int fc_vtu_maybe(fc_vtu_t *v, mfree_system_t *sys, double T, double t, int n, const double *y,
-                 const int *tag);
+                 const int32_t *tag);
 /* Close the PVD. Returns 0, or 1 when it could not be written. */
 int fc_vtu_close(fc_vtu_t *v);
 

@@ -117,7 +117,7 @@ int main(int argc, char **argv) {
   const double kappa = 100.0 * kRho2 * 2.0 * kG * kD / kGamma; /* 003 eq 125, heavier fluid */
   double *y = calloc(5 * (size_t)n, sizeof *y), *m = malloc((size_t)n * sizeof *m),
          *rho0 = malloc((size_t)n * sizeof *rho0);
-  int *tag = malloc((size_t)n * sizeof *tag);
+  int32_t *tag = malloc((size_t)n * sizeof *tag);
   double *xs = malloc((size_t)n * sizeof *xs);
   if (!y || !m || !rho0 || !tag || !xs) return 1;
   for (int j = 0; j < nz; ++j)
@@ -165,9 +165,7 @@ int main(int argc, char **argv) {
   double mass0 = 0.0;
   for (int q = 0; q < n; ++q) mass0 += m[q];
 
-  char path[4096];
-  snprintf(path, sizeof path, "%s/head.csv", out);
-  FILE *csv = fopen(path, "w");
+  FILE *csv = fc_open_csv(&ro, "head.csv");
   if (!csv) return 1;
   fprintf(csv, "t,x_head,travel,x_leftmost\n");
   fc_vtu_t vtu;

@@ -113,26 +113,12 @@ int main(int argc, char **argv) {
   const double d = diameter / nd, R = 0.5 * diameter, h = 1.5 * d, ds = d / 3.0;
   const int ir = (int)floor(R / d + 1e-9);
   const double zc0 = ir * d + 2.0 * d; /* the lowest particle 2 d above the plate's face z = 0 */
-  /* lattice points inside the circle, those on it included whatever the rounding */
-  const double rr = (R / d) * (R / d) * (1.0 + 1e-9);
-  int n = 0;
-  for (int j = -ir; j <= ir; ++j)
-    for (int i = -ir; i <= ir; ++i) n += i * i + j * j <= rr;
+  const int n = fc_water_drop(NULL, NULL, 0, 0, 0.0, zc0, R, d, kRho0, kV0);
   const double c0 = 10.0 * kV0, kappa = kRho0 * c0 * c0 / kGamma;
   double *y = calloc(5 * (size_t)n, sizeof *y), *m = malloc((size_t)n * sizeof *m),
          *lumped = malloc((size_t)n * sizeof *lumped);
   if (!y || !m || !lumped) return 1;
-  int q = 0;
-  for (int j = -ir; j <= ir; ++j)
-    for (int i = -ir; i <= ir; ++i)
-      if (i * i + j * j <= rr) {
-        y[2 * q] = i * d;
-        y[2 * q + 1] = zc0 + j * d;
-        y[2 * n + 2 * q + 1] = -kV0;
-        y[4 * n + q] = kRho0;
-        m[q] = kRho0 * d * d;
-        ++q;
-      }
+  fc_water_drop(y, m, n, 0, 0.0, zc0, R, d, kRho0, kV0);
   double mass = 0.0;
   for (int k = 0; k < n; ++k) mass += m[k];
   const double half = 0.5 * plate * diameter;
@@ -152,13 +138,8 @@ int main(int argc, char **argv) {
   const double lo[2] = {-2.0 * half, -0.5 * d}, hi[2] = {2.0 * half, zc0 + 10.0 * diameter};
   CHECK(mfree_system_set_box(sys, lo, hi));
 
-  char path[4096];
-  ex_join(path, sizeof path, ro.out, "force.csv");
-  FILE *csv = fopen(path, "w");
-  if (!csv) {
-    fprintf(stderr, "mfree_impact: error: cannot write %s\n", path);
-    return 1;
-  }
+  FILE *csv = fc_open_csv(&ro, "force.csv");
+  if (!csv) return 1;
   fprintf(csv, "# drop of diameter %g m at 2 m/s onto a rigid plate; %d particles\n"
                "t,F_x,F_z,I_z\n", diameter, n);
   fc_vtu_t vtu;
