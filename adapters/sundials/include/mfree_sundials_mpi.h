@@ -56,7 +56,10 @@ extern "C" {
  * N_VWrmsNorm, N_VWrmsNormMask, N_VWL2Norm, N_VL1Norm) by exact, reproducible ones and
  * remove its fused and local reductions (see the file's description). Not collective.
  * @param[in]     ctx  context for errors
- * @param[in,out] v    an NVECTOR_PARALLEL vector (its clones inherit the change)
+ * @param[in,out] v    an NVECTOR_PARALLEL vector (its clones made afterwards inherit the
+ *                     change; a clone made before keeps NVECTOR_PARALLEL's sums, and
+ *                     SUNDIALS 6 computes N_VDotProd(x, y) with y's operations, so call
+ *                     this before cloning)
  * @return MFREE_SUCCESS; MFREE_ERR_NULL (NULL ctx: without a message); MFREE_ERR_UNSUPPORTED
  *         for another vector type
  */
