@@ -63,11 +63,10 @@ typedef struct {
   const char *name;
 } cloud_t;
 
-static int full_matrix(void);
 /* particles per axis: 1D 30, 2D 12 x 12, 3D 6 x 6 x 6 (5 x 5 x 5 in the reduced matrix) */
 static int per_axis(int dim) {
   static const int m[4] = {0, 30, 12, 6};
-  return (dim == 3 && !full_matrix()) ? 5 : m[dim];
+  return (dim == 3 && !mfree_test_full_matrix()) ? 5 : m[dim];
 }
 
 /* Jittered lattice on [0,1]^dim: offsets uniform in +-30 % of the spacing; uniform
@@ -472,17 +471,9 @@ static double support_factor(int dim, const mcase_t *mc) {
 static int nfail_total;
 static int verbose;
 
-/* Unoptimised builds (the asan preset is Debug, -O0) run Eigen about 100 times slower
- * than Release. They check a reduced matrix: every method, cloud and dimension with one
- * kernel in rotation (so that every kernel still meets many methods), plus the kernel
- * rejections for all. MFREE_TEST_FULL=1 restores the full matrix. */
-static int full_matrix(void) {
-#if defined(__OPTIMIZE__)
-  return 1;
-#else
-  return getenv("MFREE_TEST_FULL") != NULL;
-#endif
-}
+/* The reduced matrix of unoptimised builds (mfree_test_full_matrix() false): every
+ * method, cloud and dimension with one kernel in rotation (so that every kernel still
+ * meets many methods), plus the kernel rejections for all. */
 
 #define EXPECT(cond, ...)                                                                    \
   do {                                                                                       \
@@ -674,7 +665,7 @@ static void run_dim(int dim) {
       const int rot = (ci + 5 * type + 7 * dim) % NKERNELS;
       for (int ki = 0; ki < NKERNELS; ++ki) {
         const int flat = kAll[ki] == MFREE_KERNEL_LINEAR || kAll[ki] == MFREE_KERNEL_QUADRATIC;
-        if (full_matrix() || ki == rot) run_case(mc, &c, kAll[ki], seed + (uint64_t)ki, 0);
+        if (mfree_test_full_matrix() || ki == rot) run_case(mc, &c, kAll[ki], seed + (uint64_t)ki, 0);
         else if (flat) run_case(mc, &c, kAll[ki], seed + (uint64_t)ki, 1);
       }
     }

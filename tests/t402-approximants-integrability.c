@@ -29,16 +29,7 @@ static int teardown(void **s) { (void)s; return mfree_context_destroy(&ctx) != M
 
 #define NMAX 216
 
-/* Unoptimised builds (the asan preset is Debug, -O0) run Eigen about 100 times slower
- * than Release; they check a reduced matrix (noted at each loop). MFREE_TEST_FULL=1
- * restores the full one. */
-static int full_matrix(void) {
-#if defined(__OPTIMIZE__)
-  return 1;
-#else
-  return getenv("MFREE_TEST_FULL") != NULL;
-#endif
-}
+/* (mfree_test_full_matrix: unoptimised builds check a reduced matrix, noted at each loop) */
 #define PMAX 40
 
 static const mfree_kernel_t kAll[12] = {
@@ -274,7 +265,7 @@ static void test_true_derivatives(void **s) {
     for (size_t ci = 0; ci < sizeof cases / sizeof cases[0]; ++ci) {
       const cfg_t *cf = &cases[ci];
       /* reduced matrix: orders <= 2 in 2D, <= 1 in 3D */
-      if (!full_matrix() && cf->order > (dim == 1 ? 3 : 4 - dim)) continue;
+      if (!mfree_test_full_matrix() && cf->order > (dim == 1 ? 3 : 4 - dim)) continue;
       const double hf = 1.6 + 0.3 * (cf->order > 1 ? cf->order - 1 : 0);
       make_cloud(&c, dim, m, hf, 11u + 7u * (uint64_t)dim);
       make_points(&c, radius_of(cf->kernel), npts, 1.3 * hf * dx, 5u + (uint64_t)dim, x, h);
@@ -292,7 +283,7 @@ static void test_true_derivatives(void **s) {
                    "the gradient table by %.3g (relative)", (int)cf->m, cf->order, (int)cf->kernel,
                    dim, d, eg);
         for (int k = 0; k < dim; ++k) {
-          if (!full_matrix() && k != d) continue; /* reduced matrix: diagonal entries */
+          if (!mfree_test_full_matrix() && k != d) continue; /* reduced matrix: diagonal entries */
           const double eh = fd_mismatch(ps, cf, &c, npts, x, h, eps, MFREE_DERIV_HESSIAN,
                                         hidx(dim, d, k), MFREE_DERIV_GRADIENT, k, d);
           if (eh > FD_TOL)
@@ -370,8 +361,9 @@ static void test_ssph_equals_rkpm_values(void **s) {
       for (int hv = 0; hv < 2; ++hv) {
         const mfree_kernel_t k = kAll[ki];
         /* reduced matrix: one support per kernel and order, alternating */
-        if (!full_matrix() && hv != (ki + order) % 2) continue;
-        const int where0 = full_matrix() ? 0 : (ki + order) % 2, where1 = full_matrix() ? 1 : where0;
+        if (!mfree_test_full_matrix() && hv != (ki + order) % 2) continue;
+        const int where0 = mfree_test_full_matrix() ? 0 : (ki + order) % 2,
+                  where1 = mfree_test_full_matrix() ? 1 : where0;
         const double hf = (order == 3 ? 2.2 : 1.7) + 0.4 * hv;
         make_cloud(&c, dim, m, hf, 100u + (uint64_t)(ki * 8 + order * 2 + hv));
         make_points(&c, radius_of(k), npts, 1.2 * hf * dx, 77u + (uint64_t)ki, x, h);
@@ -426,7 +418,7 @@ static void test_mls_equals_ssph_constant_volumes(void **s) {
   static double A[NMAX * NMAX], B[NMAX * NMAX];
   for (int dim = 1; dim <= 3; ++dim)
     for (int order = 1; order <= 3; ++order) {
-      if (!full_matrix() && dim == 3 && order == 3) continue; /* reduced matrix */
+      if (!mfree_test_full_matrix() && dim == 3 && order == 3) continue; /* reduced matrix */
       const int m = dim == 1 ? 30 : (dim == 2 ? 12 : 6);
       const double hf = dim == 1 ? 1.6 + 0.2 * order : (dim == 2 ? 1.3 + 0.3 * order : 1.3 + 0.3 * order);
       make_cloud(&c, dim, m, hf, 300u + (uint64_t)(dim * 4 + order));

@@ -27,16 +27,7 @@ static int teardown(void **s) { (void)s; return mfree_context_destroy(&ctx) != M
 
 #define NMAX 512
 
-/* Unoptimised builds (the asan preset is Debug, -O0) run Eigen about 100 times slower
- * than Release; they check a reduced matrix (noted at each loop). MFREE_TEST_FULL=1
- * restores the full one. */
-static int full_matrix(void) {
-#if defined(__OPTIMIZE__)
-  return 1;
-#else
-  return getenv("MFREE_TEST_FULL") != NULL;
-#endif
-}
+/* (mfree_test_full_matrix: unoptimised builds check a reduced matrix, noted at each loop) */
 
 typedef struct {
   int dim, n;
@@ -204,9 +195,9 @@ static void test_points_on_particles(void **s) {
         const mcase_t *mc = &kPointMethods[mi];
         /* reduced matrix: one convention per method and dimension, in rotation; no
          * order 3 in 3D */
-        if (!full_matrix() && (cv != (mi + dim) % 3 || (dim == 3 && mc->order == 3))) continue;
+        if (!mfree_test_full_matrix() && (cv != (mi + dim) % 3 || (dim == 3 && mc->order == 3))) continue;
         const mfree_kernel_t k = kSmooth[(mi + cv) % 5];
-        const int m = dim == 1 ? 30 : (dim == 2 ? 12 : (full_matrix() ? 6 : 5)); /* reduced: 5^3 */
+        const int m = dim == 1 ? 30 : (dim == 2 ? 12 : (mfree_test_full_matrix() ? 6 : 5)); /* reduced: 5^3 */
         const double hf = 1.5 + (dim == 2 ? 0.4 : 0.3) * (mc->order > 1 ? mc->order - 1 : 0);
         make_cloud(&c, dim, m, hf, 0.3, 40u + (uint64_t)(dim * 3 + cv));
         const int flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT | (mc->hessian ? MFREE_DERIV_HESSIAN : 0);
@@ -344,7 +335,7 @@ static void test_borrowed_particles_update(void **s) {
   (void)s;
   static cloud_t c, c2;
   for (int dim = 1; dim <= 3; ++dim) {
-    const int m = dim == 1 ? 30 : (dim == 2 ? 12 : (full_matrix() ? 6 : 5)); /* reduced: 5^3 */
+    const int m = dim == 1 ? 30 : (dim == 2 ? 12 : (mfree_test_full_matrix() ? 6 : 5)); /* reduced: 5^3 */
     make_cloud(&c, dim, m, 1.8, 0.3, 77u + (uint64_t)dim);
     mfree_particles_t *ps = make_set(&c, MFREE_KERNEL_CUBIC_SPLINE, MFREE_SEARCH_SYMMETRIC_MAX, MFREE_BORROW);
     const int flags = MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT | MFREE_DERIV_HESSIAN;

@@ -8,6 +8,7 @@
 #include <stdint.h>
 /* cmocka needs the three headers above first */
 #include <cmocka.h>
+#include <stdlib.h>
 
 #include <mfree.h>
 
@@ -60,6 +61,18 @@ int mfree_test_tank_walls(double L, double d, double off, double top, double **x
  * and gamma, viscosity mu, smoothing length h (no gravity, no walls). */
 mfree_system_t *mfree_test_fluid_create(mfree_context_t *ctx, int n, const double *m, double rho0, double kappa,
                                         double gamma, double mu, double h);
+
+/* 1 in optimised builds. Unoptimised ones (the asan preset compiles the tests without
+ * __OPTIMIZE__) run Eigen about 100 times slower than Release: there a test checks a
+ * reduced matrix, unless MFREE_TEST_FULL is set (to anything) in the environment. Inline,
+ * so that the calling test's own compilation decides. */
+static inline int mfree_test_full_matrix(void) {
+#if defined(__OPTIMIZE__)
+  return 1;
+#else
+  return getenv("MFREE_TEST_FULL") != NULL;
+#endif
+}
 
 /* The backend a conformance test runs on: MFREE_BACKEND_REF when its first argument is
  * "ref" (CTest registers those tests once more as <name>-ref), else MFREE_BACKEND_OPT. */
