@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "../../common/guard.hpp"
+
 namespace {
 
 // A PETSc call that failed, with PETSc's message.
@@ -39,16 +41,7 @@ struct Outcome {
 
 Outcome fail(mfree_status_t st, std::string msg) { return Outcome{st, std::move(msg)}; }
 
-mfree_status_t record(mfree_context_t *ctx, mfree_status_t st, const char *fn,
-                      const std::string &msg) noexcept {
-  try {
-    const std::string text = std::string(fn) + ": " + msg;
-    mfree_context_set_error(ctx, st, text.c_str());
-  } catch (...) {
-    mfree_context_set_error(ctx, st, fn);
-  }
-  return st;
-}
+using mfree_adapter::record;
 
 Outcome petsc_outcome(const PetscFailure &f) {
   const char *text = nullptr;

@@ -18,6 +18,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "../../common/guard.hpp"
 #include "index_width.h"
 
 static_assert(std::is_same<int32_t, int>::value, "the 32-bit SuiteSparse variants take int");
@@ -635,33 +636,8 @@ struct mfree_suitesparse {
 
 namespace {
 
-mfree_status_t record(mfree_context_t *ctx, mfree_status_t st, const char *fn,
-                      const std::string &msg) noexcept {
-  try {
-    const std::string text = std::string(fn) + ": " + msg;
-    mfree_context_set_error(ctx, st, text.c_str());
-  } catch (...) {  // no memory for the message: keep at least the code and the function
-    mfree_context_set_error(ctx, st, fn);
-  }
-  return st;
-}
-
-template <class Body>
-mfree_status_t guarded(mfree_context_t *ctx, const char *fn, Body &&body) noexcept {
-  try {
-    return body();
-  } catch (const std::bad_alloc &) {
-    return record(ctx, MFREE_ERR_ALLOC, fn, "out of memory");
-  } catch (const std::exception &e) {
-    try {
-      return record(ctx, MFREE_ERR_INTERNAL, fn, std::string("internal error: ") + e.what());
-    } catch (...) {
-      return MFREE_ERR_INTERNAL;
-    }
-  } catch (...) {
-    return MFREE_ERR_INTERNAL;
-  }
-}
+using mfree_adapter::guarded;
+using mfree_adapter::record;
 
 // Size, pattern fingerprint and finiteness, from the matrix's own arrays.
 mfree_status_t inspect(const mfree_matrix_t *A, Inspection *out) {

@@ -12,6 +12,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "../../common/guard.hpp"
+
 static_assert(std::is_same<sunrealtype, double>::value,
               "mfree hands N_Vector data to the system without conversion: sunrealtype must "
               "be double");
@@ -47,34 +49,8 @@ struct mfree_sundials {
 
 namespace {
 
-mfree_status_t record(mfree_context_t *ctx, mfree_status_t st, const char *fn,
-                      const std::string &msg) noexcept {
-  try {
-    const std::string text = std::string(fn) + ": " + msg;
-    mfree_context_set_error(ctx, st, text.c_str());
-  } catch (...) {  // no memory for the message: keep at least the code and the function
-    mfree_context_set_error(ctx, st, fn);
-  }
-  return st;
-}
-
-// Run an mfree_status_t body: no exception leaves the C ABI.
-template <class Body>
-mfree_status_t guarded(mfree_context_t *ctx, const char *fn, Body &&body) noexcept {
-  try {
-    return body();
-  } catch (const std::bad_alloc &) {
-    return record(ctx, MFREE_ERR_ALLOC, fn, "out of memory");
-  } catch (const std::exception &e) {
-    try {
-      return record(ctx, MFREE_ERR_INTERNAL, fn, std::string("internal error: ") + e.what());
-    } catch (...) {
-      return MFREE_ERR_INTERNAL;
-    }
-  } catch (...) {
-    return MFREE_ERR_INTERNAL;
-  }
-}
+using mfree_adapter::guarded;
+using mfree_adapter::record;
 
 // SUNDIALS' convention: 0 success, > 0 recoverable, < 0 unrecoverable. mfree's positive
 // statuses are its data-dependent (recoverable) failures; they pass through unchanged.
