@@ -56,25 +56,8 @@ static void t_fn(void *user, const double *x, double *v) { (void)user; v[0] = du
 static mfree_context_t *ctx;
 
 /* Stop on a failed call with mfree's message. */
-#define CHECK(call)                                                                       \
-  do {                                                                                    \
-    mfree_status_t st_ = (call);                                                          \
-    if (st_ != MFREE_SUCCESS) {                                                           \
-      char m_[1024] = "";                                                                 \
-      mfree_context_get_last_error(ctx, NULL, m_, sizeof m_);                             \
-      fprintf(stderr, "error: %s: %s (%s)\n", #call, mfree_status_string(st_), m_);       \
-      exit(1);                                                                            \
-    }                                                                                     \
-  } while (0)
-
-static void *xmalloc(size_t n) {
-  void *p = malloc(n ? n : 1);
-  if (!p) {
-    fprintf(stderr, "error: out of memory\n");
-    exit(1);
-  }
-  return p;
-}
+#define CHECK(call) ex_check_exit(ctx, "mfree_mpfem_1d", (call), #call)
+#define xmalloc(n) ex_xmalloc("mfree_mpfem_1d", (n))
 
 /* Gauss-Legendre points on [-1, 1] from a one-element mesh's quadrature. */
 static void gauss(int n, double *xg, double *wg) {

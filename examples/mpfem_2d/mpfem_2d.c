@@ -34,25 +34,8 @@ static const int32_t kN[NL] = {8, 16, 32};
 static const double PI = 3.14159265358979323846;
 static mfree_context_t *ctx;
 
-#define CHECK(call)                                                                       \
-  do {                                                                                    \
-    mfree_status_t st_ = (call);                                                          \
-    if (st_ != MFREE_SUCCESS) {                                                           \
-      char m_[1024] = "";                                                                 \
-      mfree_context_get_last_error(ctx, NULL, m_, sizeof m_);                             \
-      fprintf(stderr, "error: %s: %s (%s)\n", #call, mfree_status_string(st_), m_);       \
-      exit(1);                                                                            \
-    }                                                                                     \
-  } while (0)
-
-static void *xmalloc(size_t n) {
-  void *p = malloc(n ? n : 1);
-  if (!p) {
-    fprintf(stderr, "error: out of memory\n");
-    exit(1);
-  }
-  return p;
-}
+#define CHECK(call) ex_check_exit(ctx, "mfree_mpfem_2d", (call), #call)
+#define xmalloc(n) ex_xmalloc("mfree_mpfem_2d", (n))
 
 static double u_exact(const double *x) { return sin(PI * x[0]) * sin(PI * x[1]) + 0.5 * x[0] * x[1]; }
 static void du_exact(const double *x, double *g) {

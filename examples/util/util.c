@@ -73,6 +73,19 @@ int ex_fail(mfree_context_t *ctx, const char *prog, mfree_status_t st, const cha
   return 1;
 }
 
+void ex_check_exit(mfree_context_t *ctx, const char *prog, mfree_status_t st, const char *what) {
+  if (st != MFREE_SUCCESS) exit(ex_fail(ctx, prog, st, what));
+}
+
+void *ex_xmalloc(const char *prog, size_t n) {
+  void *p = malloc(n ? n : 1);
+  if (!p) {
+    fprintf(stderr, "%s: out of memory\n", prog);
+    exit(1);
+  }
+  return p;
+}
+
 int ex_plot_option(int argc, char **argv, int *i, const char **out, int *plot) {
   if (strcmp(argv[*i], "--out") == 0 && *i + 1 < argc) {
     *out = argv[++*i];

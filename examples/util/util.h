@@ -34,6 +34,11 @@ int ex_plot_path_ok(const char *path);
 
 /* Print ctx's last error for a failed call `what` of program prog; returns 1. */
 int ex_fail(mfree_context_t *ctx, const char *prog, mfree_status_t st, const char *what);
+/* For programs that stop at the first failure: exit(1) after ex_fail's message unless st
+ * is MFREE_SUCCESS; ex_xmalloc: malloc (n = 0: one byte), or exit(1) after "<prog>: out of
+ * memory". */
+void ex_check_exit(mfree_context_t *ctx, const char *prog, mfree_status_t st, const char *what);
+void *ex_xmalloc(const char *prog, size_t n);
 
 /* The plot options every plotting example takes: --out DIR (sets *out) and --no-plot
  * (clears *plot). Returns 1 when argv[*i] was one of them (advancing *i past a value). */
