@@ -15,6 +15,18 @@ mfree_system_t *sun_fluid(mfree_context_t *ctx) {
   return s;
 }
 
+int sun_fixture_setup(mfree_context_t **ctx, SUNContext *sunctx, double *ystart) {
+  if (mfree_context_create(ctx) != MFREE_SUCCESS) return 1;
+  if (SUNContext_Create(MFREE_SUNDIALS_COMM_NULL, sunctx) != 0) return 1;
+  sun_initial_state(ystart);
+  return 0;
+}
+
+int sun_fixture_teardown(mfree_context_t **ctx, SUNContext *sunctx) {
+  SUNContext_Free(sunctx);
+  return mfree_context_destroy(ctx) != MFREE_SUCCESS;
+}
+
 void sun_initial_state(double *y) {
   const double L = SUN_NX * SUN_D, k = 3.14159265358979323846 / L;
   for (int j = 0; j < SUN_NX; ++j)

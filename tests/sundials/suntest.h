@@ -30,6 +30,12 @@ mfree_system_t *sun_fluid(mfree_context_t *ctx);
  * psi = U L / pi sin(pi x / L) sin(pi y / L), L = 8 D (u = dpsi/dy, v = -dpsi/dx). */
 void sun_initial_state(double *y);
 
+/* The group fixture of the patch's tests: an mfree context, a SUNDIALS context and the
+ * initial state in ystart (SUN_NEQ values); each returns 0 on success (cmocka's group
+ * setup and teardown). */
+int sun_fixture_setup(mfree_context_t **ctx, SUNContext *sunctx, double *ystart);
+int sun_fixture_teardown(mfree_context_t **ctx, SUNContext *sunctx);
+
 /* Block-wise difference of two states a, b of the patch, each relative to the size of
  * the reference's motion: positions and densities to max |b - y0| over the block (the
  * displacement and the density change), velocities to max |b|. */

@@ -56,18 +56,8 @@ enum { PC2, PC1, ERK1, ERK, ARK1, IDA1, IDA, ARKC, IDAC, NRUNS };
 static double result[NRUNS][SUN_NEQ];
 static int done[NRUNS];
 
-static int setup(void **s) {
-  (void)s;
-  if (mfree_context_create(&ctx) != MFREE_SUCCESS) return 1;
-  if (SUNContext_Create(MFREE_SUNDIALS_COMM_NULL, &sunctx) != 0) return 1;
-  sun_initial_state(ystart);
-  return 0;
-}
-static int teardown(void **s) {
-  (void)s;
-  SUNContext_Free(&sunctx);
-  return mfree_context_destroy(&ctx) != MFREE_SUCCESS;
-}
+static int setup(void **s) { (void)s; return sun_fixture_setup(&ctx, &sunctx, ystart); }
+static int teardown(void **s) { (void)s; return sun_fixture_teardown(&ctx, &sunctx); }
 
 static void report(const char *what, double secs, long nst, const mfree_sundials_t *ad) {
   int64_t nrhs = 0, nres = 0, nmass = 0, npred = 0, npat = 0;

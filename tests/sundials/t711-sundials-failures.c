@@ -19,18 +19,8 @@ static mfree_context_t *ctx;
 static SUNContext sunctx;
 static double ystart[SUN_NEQ];
 
-static int setup(void **s) {
-  (void)s;
-  if (mfree_context_create(&ctx) != MFREE_SUCCESS) return 1;
-  if (SUNContext_Create(MFREE_SUNDIALS_COMM_NULL, &sunctx) != 0) return 1;
-  sun_initial_state(ystart);
-  return 0;
-}
-static int teardown(void **s) {
-  (void)s;
-  SUNContext_Free(&sunctx);
-  return mfree_context_destroy(&ctx) != MFREE_SUCCESS;
-}
+static int setup(void **s) { (void)s; return sun_fixture_setup(&ctx, &sunctx, ystart); }
+static int teardown(void **s) { (void)s; return sun_fixture_teardown(&ctx, &sunctx); }
 
 /* A callback returned `ret` and left code `code` with `needle` in its message. */
 static void expect(int got, int ret, mfree_status_t code, const char *needle, const char *what) {
