@@ -107,7 +107,10 @@ typedef MFREE_ENUM(mfree_status) {
   MFREE_FAIL_SUPPORT = 7      /**< a kernel support exceeds a method's size limit: an
                                    MPFEM node's support reaches an element not
                                    connected to it, so the functions do not interpolate
-                                   ([Hao2004] eq 13) */
+                                   ([Hao2004] eq 13) */,
+  MFREE_FAIL_CAPACITY = 8     /**< a fluid's pool of dormant particles cannot supply an
+                                   inflow gate: nothing was changed, the state is the
+                                   last valid one */
 } mfree_status_t;
 
 /** How an input array is held. */
@@ -1893,6 +1896,120 @@ MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
                                                 double *t, double t_end, double cfl,
                                                 double dt_max, mfree_progress_fn progress,
                                                 void *user, int64_t *nsteps);
+
+/* ---- Open boundaries of the fluid: inflow gates and outflow planes ----
+ * A fluid created with n particles can keep some of them dormant: a pool that inflow
+ * gates draw from and outflow planes return to, so that the state keeps its length
+ * (2 dim + 1) n (docs/fluid.md, "Inflow and outflow"). Dormant particles keep their entries
+ * in y, get zero rates and take no part in the nodes, the checks or the step. The native
+ * integrator updates the boundaries between steps; a host integrating with SUNDIALS calls
+ * mfree_system_update_open_boundaries between its windows. */
+
+/** States of a fluid's particles (mfree_system_get_active). */
+typedef enum {
+  MFREE_PARTICLE_DORMANT = 0, /**< in the pool: no part in the flow, zero rates */
+  MFREE_PARTICLE_FLUID = 1,   /**< an active fluid particle */
+  MFREE_PARTICLE_INFLOW = 2   /**< in a gate's buffer: active, its motion imposed */
+} mfree_particle_state_t;
+
+/**
+ * Make particles 0 .. nactive - 1 the fluid and the others dormant (default: all active).
+ * Only before the boundaries' first update (an integration or
+ * mfree_system_update_open_boundaries); else MFREE_ERR_STATE.
+ * @param[in] sys      a fluid system
+ * @param[in] nactive  0 <= nactive <= n (else MFREE_ERR_ARG)
+ * @return MFREE_SUCCESS, or a failure named with the parameters
+ */
+MFREE_API mfree_status_t mfree_system_set_active(mfree_system_t *sys, int32_t nactive);
+/**
+ * Set inflow gate number gate: a segment (2D: origin + s e1) or parallelogram (3D: origin
+ * + s e1 + u e2), s, u in [0, 1], through which fluid of the given density enters along
+ * the unit normal at the given speed. The gate carries a lattice of round(|e_k| / spacing)
+ * points per edge (at least one); behind it a buffer of rows at the spacing, as deep as
+ * the support radius, moves at the imposed velocity with imposed density. When the front
+ * row reaches the gate it joins the fluid and a row of dormant particles (the lowest
+ * indices first) is activated at the back, so the mass entering by time t is rho U A
+ * (t - t0) to half a row, t0 being the gate's first update. Injected particles take the
+ * density as rest density and the mass rho spacing A / (points on the gate).
+ * @param[in] sys      a fluid system
+ * @param[in] gate     0 .. the number of gates (that number adds one; else MFREE_ERR_ARG);
+ *                     a gate that has started injecting cannot be replaced (MFREE_ERR_STATE)
+ * @param[in] origin   dim values (copied)
+ * @param[in] edges    e1 (2D) or e1, e2 (3D), dim values each (copied); each at least
+ *                     spacing / 2 long and orthogonal to the normal, in 3D not parallel
+ *                     (else MFREE_ERR_ARG)
+ * @param[in] normal   unit normal pointing into the fluid domain, dim values (copied)
+ * @param[in] speed    U > 0
+ * @param[in] density  rho > 0
+ * @param[in] spacing  particle spacing d > 0 along the normal and, rounded to fit, along
+ *                     the edges
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_INPUT for non-finite coordinates;
+ *         MFREE_ERR_ARG for bad values or geometry
+ */
+MFREE_API mfree_status_t mfree_system_set_inflow(mfree_system_t *sys, int32_t gate,
+                                                 const double *origin, const double *edges,
+                                                 const double *normal, double speed,
+                                                 double density, double spacing);
+/**
+ * Set outflow plane number k: an active fluid particle x with (x - point).normal > 0 is
+ * returned to the dormant pool at the next update (between steps of the native
+ * integrator). Keep the box, if any, a few spacings beyond the plane.
+ * @param[in] sys     a fluid system
+ * @param[in] k       0 .. the number of outflow planes (that number adds one; else
+ *                    MFREE_ERR_ARG)
+ * @param[in] point   a point of the plane, dim values (copied)
+ * @param[in] normal  unit normal pointing out of the fluid domain, dim values (copied)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL; MFREE_ERR_INPUT; MFREE_ERR_ARG
+ */
+MFREE_API mfree_status_t mfree_system_set_outflow(mfree_system_t *sys, int32_t k,
+                                                  const double *point, const double *normal);
+/**
+ * Update the open boundaries at time t: particles past an outflow plane become dormant,
+ * gate rows that reached their gate join the fluid, new buffer rows are activated and
+ * every buffer particle is put at its imposed position, velocity and density in y.
+ * mfree_system_integrate does this itself; a host integrating otherwise calls it once
+ * before integrating and between windows (a window longer than spacing / (2 speed) lets
+ * rows join late, their mass counted all the same), and restarts its integrator there.
+ * @param[in]     sys  a fluid system
+ * @param[in]     t    time (finite, else MFREE_ERR_ARG)
+ * @param[in,out] y    state of length (2 dim + 1) n
+ * @return MFREE_SUCCESS; MFREE_FAIL_CAPACITY when the dormant pool cannot supply a row
+ *         (nothing changed; the message names the gate and the counts); MFREE_ERR_STATE
+ *         when the masses or the smoothing length are not set
+ */
+MFREE_API mfree_status_t mfree_system_update_open_boundaries(mfree_system_t *sys, double t,
+                                                             double *y);
+/**
+ * Number of active particles and, optionally, every particle's mfree_particle_state_t.
+ * @param[in]  sys      a fluid system
+ * @param[out] nactive  active particles (fluid and buffer)
+ * @param[in]  n        values state holds: the system's particle count (else
+ *                      MFREE_ERR_ARG; ignored when state is NULL)
+ * @param[out] state    n values, or NULL
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL nactive
+ */
+MFREE_API mfree_status_t mfree_system_get_active(const mfree_system_t *sys, int32_t *nactive,
+                                                 int32_t n, int32_t *state);
+/**
+ * Particles gate has released into the fluid and their total mass.
+ * @param[in]  sys    a fluid system
+ * @param[in]  gate   a set gate (else MFREE_ERR_ARG)
+ * @param[out] count  particles, or NULL
+ * @param[out] mass   their mass, or NULL
+ * @return MFREE_SUCCESS, or a failure named with the parameters
+ */
+MFREE_API mfree_status_t mfree_system_get_inflow(const mfree_system_t *sys, int32_t gate,
+                                                 int64_t *count, double *mass);
+/**
+ * Particles outflow plane k has returned to the pool and their total mass.
+ * @param[in]  sys    a fluid system
+ * @param[in]  k      a set outflow plane (else MFREE_ERR_ARG)
+ * @param[out] count  particles, or NULL
+ * @param[out] mass   their mass, or NULL
+ * @return MFREE_SUCCESS, or a failure named with the parameters
+ */
+MFREE_API mfree_status_t mfree_system_get_outflow(const mfree_system_t *sys, int32_t k,
+                                                  int64_t *count, double *mass);
 
 /**
  * Linear elastodynamics by strong-form collocation ([ZhangBatra2009] Sect. 6.4):

@@ -20,6 +20,7 @@ static void test_status_values(void **s) {
   assert_int_equal(MFREE_FAIL_DOMAIN, 5);
   assert_int_equal(MFREE_FAIL_CFL, 6);
   assert_int_equal(MFREE_FAIL_SUPPORT, 7);
+  assert_int_equal(MFREE_FAIL_CAPACITY, 8);
   assert_int_equal(sizeof(mfree_status_t), sizeof(int));
 }
 
@@ -99,6 +100,9 @@ static void test_assembly_values(void **s) {
   assert_int_equal(MFREE_INTEGRATOR_PREDICTOR_CORRECTOR, 2);
   assert_int_equal(MFREE_LUMP_GALERKIN, 1);
   assert_int_equal(MFREE_LUMP_PHYSICAL, 2);
+  assert_int_equal(MFREE_PARTICLE_DORMANT, 0);
+  assert_int_equal(MFREE_PARTICLE_FLUID, 1);
+  assert_int_equal(MFREE_PARTICLE_INFLOW, 2);
   assert_int_equal(MFREE_ELEMENT_LINE2, 1);
   assert_int_equal(MFREE_ELEMENT_TRI3, 2);
   assert_int_equal(MFREE_ELEMENT_QUAD4, 3);

@@ -53,6 +53,7 @@ module mfree
   integer(c_int), parameter, public :: MFREE_FAIL_DOMAIN = 5
   integer(c_int), parameter, public :: MFREE_FAIL_CFL = 6
   integer(c_int), parameter, public :: MFREE_FAIL_SUPPORT = 7
+  integer(c_int), parameter, public :: MFREE_FAIL_CAPACITY = 8
 
   ! ---- mfree_mem_t ---------------------------------------------------------------
   integer(c_int), parameter, public :: MFREE_COPY = 1
@@ -139,6 +140,9 @@ module mfree
   ! ---- mfree_lumping_t -----------------------------------------------------------
   integer(c_int), parameter, public :: MFREE_LUMP_GALERKIN = 1
   integer(c_int), parameter, public :: MFREE_LUMP_PHYSICAL = 2
+  integer(c_int), parameter, public :: MFREE_PARTICLE_DORMANT = 0
+  integer(c_int), parameter, public :: MFREE_PARTICLE_FLUID = 1
+  integer(c_int), parameter, public :: MFREE_PARTICLE_INFLOW = 2
   ! mfree_backend_t, mfree_pages_t (mfree.h)
   integer(c_int), parameter, public :: MFREE_BACKEND_REF = 1
   integer(c_int), parameter, public :: MFREE_BACKEND_OPT = 2
@@ -1390,6 +1394,66 @@ module mfree
       type(c_ptr), value :: per_wall
     end function mfree_system_get_wall_force_c
 
+    integer(c_int) function mfree_system_set_active_c(sys, nactive) &
+        bind(C, name="mfree_system_set_active")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: nactive
+    end function mfree_system_set_active_c
+
+    integer(c_int) function mfree_system_set_inflow_c(sys, gate, origin, edges, normal, speed, &
+                                                      density, spacing) &
+        bind(C, name="mfree_system_set_inflow")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: gate
+      real(c_double), intent(in) :: origin(*), edges(*), normal(*)
+      real(c_double), value :: speed, density, spacing
+    end function mfree_system_set_inflow_c
+
+    integer(c_int) function mfree_system_set_outflow_c(sys, k, point, normal) &
+        bind(C, name="mfree_system_set_outflow")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: k
+      real(c_double), intent(in) :: point(*), normal(*)
+    end function mfree_system_set_outflow_c
+
+    integer(c_int) function mfree_system_update_open_boundaries_c(sys, t, y) &
+        bind(C, name="mfree_system_update_open_boundaries")
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), value :: t
+      real(c_double), intent(inout) :: y(*)
+    end function mfree_system_update_open_boundaries_c
+
+    integer(c_int) function mfree_system_get_active_c(sys, nactive, n, state) &
+        bind(C, name="mfree_system_get_active")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), intent(out) :: nactive
+      integer(c_int32_t), value :: n
+      type(c_ptr), value :: state
+    end function mfree_system_get_active_c
+
+    integer(c_int) function mfree_system_get_inflow_c(sys, gate, count, mass) &
+        bind(C, name="mfree_system_get_inflow")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: gate
+      integer(c_int64_t), intent(out) :: count
+      real(c_double), intent(out) :: mass
+    end function mfree_system_get_inflow_c
+
+    integer(c_int) function mfree_system_get_outflow_c(sys, k, count, mass) &
+        bind(C, name="mfree_system_get_outflow")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: k
+      integer(c_int64_t), intent(out) :: count
+      real(c_double), intent(out) :: mass
+    end function mfree_system_get_outflow_c
+
     integer(c_int) function mfree_system_integrate_c(sys, scheme, y, t, t_end, cfl, dt_max, &
                                                      progress, user, nsteps) &
         bind(C, name="mfree_system_integrate")
@@ -1548,6 +1612,9 @@ module mfree
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
   public :: mfree_system_get_wall_force_c
+  public :: mfree_system_set_active_c, mfree_system_set_inflow_c, mfree_system_set_outflow_c
+  public :: mfree_system_update_open_boundaries_c, mfree_system_get_active_c
+  public :: mfree_system_get_inflow_c, mfree_system_get_outflow_c
   public :: mfree_system_create_elastodynamic_c, mfree_system_set_load_history_c
   public :: mfree_system_create_elastodynamic_galerkin_c
   public :: mfree_system_create_elastodynamic_ranks_c
@@ -1668,6 +1735,9 @@ module mfree
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
   public :: mfree_system_get_wall_force
+  public :: mfree_system_set_active, mfree_system_set_inflow, mfree_system_set_outflow
+  public :: mfree_system_update_open_boundaries, mfree_system_get_active
+  public :: mfree_system_get_inflow, mfree_system_get_outflow
   public :: mfree_system_create_elastodynamic, mfree_system_set_load_history
   public :: mfree_system_create_elastodynamic_galerkin
   public :: mfree_system_set_shepard_condition
@@ -3833,6 +3903,107 @@ contains
     end if
     st = mfree_system_get_wall_force_c(sys%ptr, y, c_loc(total), nwall, pw)
   end function mfree_system_get_wall_force
+
+  !> Particles 0 .. nactive - 1 active, the others dormant (open boundaries, mfree.h).
+  integer(c_int) function mfree_system_set_active(sys, nactive) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: nactive
+    st = mfree_system_set_active_c(sys%ptr, nactive)
+  end function mfree_system_set_active
+
+  !> Inflow gate (mfree.h): origin(dim), edges(dim * (dim - 1)), normal(dim), each at
+  !> least that long (else MFREE_ERR_ARG).
+  integer(c_int) function mfree_system_set_inflow(sys, gate, origin, edges, normal, speed, &
+                                                  density, spacing) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: gate
+    real(c_double), intent(in) :: origin(:), edges(:), normal(:)
+    real(c_double), intent(in) :: speed, density, spacing
+    integer(c_int32_t), target :: dim, n
+    type(c_ptr) :: ctx
+    st = mfree_system_get_dimension_c(sys%ptr, c_loc(dim), c_loc(n))
+    if (st /= MFREE_SUCCESS) return
+    ctx = c_null_ptr
+    st = mfree_system_get_context_c(sys%ptr, ctx)
+    st = check_out(ctx, 'mfree_system_set_inflow', 'origin', .true., size(origin, kind=c_int64_t), &
+                   int(dim, c_int64_t))
+    if (st == MFREE_SUCCESS) &
+      st = check_out(ctx, 'mfree_system_set_inflow', 'edges', .true., size(edges, kind=c_int64_t), &
+                     int(dim, c_int64_t) * (dim - 1))
+    if (st == MFREE_SUCCESS) &
+      st = check_out(ctx, 'mfree_system_set_inflow', 'normal', .true., size(normal, kind=c_int64_t), &
+                     int(dim, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_system_set_inflow_c(sys%ptr, gate, origin, edges, normal, speed, density, spacing)
+  end function mfree_system_set_inflow
+
+  !> Outflow plane (mfree.h): point(dim), normal(dim) (else MFREE_ERR_ARG).
+  integer(c_int) function mfree_system_set_outflow(sys, k, point, normal) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: k
+    real(c_double), intent(in) :: point(:), normal(:)
+    integer(c_int32_t), target :: dim, n
+    type(c_ptr) :: ctx
+    st = mfree_system_get_dimension_c(sys%ptr, c_loc(dim), c_loc(n))
+    if (st /= MFREE_SUCCESS) return
+    ctx = c_null_ptr
+    st = mfree_system_get_context_c(sys%ptr, ctx)
+    st = check_out(ctx, 'mfree_system_set_outflow', 'point', .true., size(point, kind=c_int64_t), &
+                   int(dim, c_int64_t))
+    if (st == MFREE_SUCCESS) &
+      st = check_out(ctx, 'mfree_system_set_outflow', 'normal', .true., size(normal, kind=c_int64_t), &
+                     int(dim, c_int64_t))
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_system_set_outflow_c(sys%ptr, k, point, normal)
+  end function mfree_system_set_outflow
+
+  !> Update the open boundaries at t; y holds neq values, contiguous (else MFREE_ERR_ARG).
+  integer(c_int) function mfree_system_update_open_boundaries(sys, t, y) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: t
+    real(c_double), intent(inout), target :: y(:)
+    st = check_system_out(sys, 'mfree_system_update_open_boundaries', 'y', is_contiguous(y), &
+                          size(y, kind=c_int64_t), 0)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_system_update_open_boundaries_c(sys%ptr, t, y)
+  end function mfree_system_update_open_boundaries
+
+  !> Active count; state (optional) receives n values, its size exactly n (else MFREE_ERR_ARG).
+  integer(c_int) function mfree_system_get_active(sys, nactive, state) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(out) :: nactive
+    integer(c_int32_t), intent(out), target, optional :: state(:)
+    integer(c_int32_t) :: ns
+    type(c_ptr) :: ps
+    ps = c_null_ptr
+    ns = 0
+    if (present(state)) then
+      st = check_system_out(sys, 'mfree_system_get_active', 'state', is_contiguous(state), &
+                            size(state, kind=c_int64_t), 1)
+      if (st /= MFREE_SUCCESS) return
+      ns = int(size(state), c_int32_t)
+      if (size(state) > 0) ps = c_loc(state)
+    end if
+    st = mfree_system_get_active_c(sys%ptr, nactive, ns, ps)
+  end function mfree_system_get_active
+
+  !> Particles a gate released into the fluid and their mass.
+  integer(c_int) function mfree_system_get_inflow(sys, gate, count, mass) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: gate
+    integer(c_int64_t), intent(out) :: count
+    real(c_double), intent(out) :: mass
+    st = mfree_system_get_inflow_c(sys%ptr, gate, count, mass)
+  end function mfree_system_get_inflow
+
+  !> Particles an outflow plane returned to the pool and their mass.
+  integer(c_int) function mfree_system_get_outflow(sys, k, count, mass) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: k
+    integer(c_int64_t), intent(out) :: count
+    real(c_double), intent(out) :: mass
+    st = mfree_system_get_outflow_c(sys%ptr, k, count, mass)
+  end function mfree_system_get_outflow
 
   !> Integrate y (neq values, contiguous: else MFREE_ERR_ARG) from t to t_end (both updated
   !> in place); progress (optional) is called after every accepted step; nsteps

@@ -108,6 +108,7 @@ mfree_status_t mfree_system_destroy(mfree_system_t **sys) {
   return mfree::with_handle(sys, name, [&](mfree::System &base) {             \
     auto &f = kind<mfree::FluidSystem>(base, "fluid parameters (not a fluid)"); \
     call;                                                                     \
+    f.options_changed();                                                      \
     return MFREE_SUCCESS;                                                     \
   })
 
@@ -230,6 +231,58 @@ mfree_status_t mfree_system_integrate(mfree_system_t *sys, mfree_integrator_t sc
   });
   if (nsteps) *nsteps = steps;
   return status;
+}
+
+mfree_status_t mfree_system_set_active(mfree_system_t *sys, int32_t nactive) {
+  MFREE_SYS_SETTER("mfree_system_set_active", f.set_active(nactive));
+}
+mfree_status_t mfree_system_set_inflow(mfree_system_t *sys, int32_t gate, const double *origin, const double *edges,
+                                       const double *normal, double speed, double density, double spacing) {
+  MFREE_SYS_SETTER("mfree_system_set_inflow", f.set_inflow(gate, origin, edges, normal, speed, density, spacing));
+}
+mfree_status_t mfree_system_set_outflow(mfree_system_t *sys, int32_t k, const double *point, const double *normal) {
+  MFREE_SYS_SETTER("mfree_system_set_outflow", f.set_outflow(k, point, normal));
+}
+
+mfree_status_t mfree_system_update_open_boundaries(mfree_system_t *sys, double t, double *y) {
+  return mfree::with_handle(sys, "mfree_system_update_open_boundaries", [&](mfree::System &base) {
+    auto &f = kind<mfree::FluidSystem>(base, "open boundaries (not a fluid)");
+    MFREE_REQUIRE(y || f.size() == 0, MFREE_ERR_NULL, "y is NULL");
+    return mfree::finish(sys->ctx, "mfree_system_update_open_boundaries", f.update_open(t, y));
+  });
+}
+
+mfree_status_t mfree_system_get_active(const mfree_system_t *sys, int32_t *nactive, int32_t n, int32_t *state) {
+  return mfree::with_handle(sys, "mfree_system_get_active", [&](const mfree::System &base) {
+    const auto &f = kind<mfree::FluidSystem>(base, "active particles (not a fluid)");
+    MFREE_REQUIRE(nactive, MFREE_ERR_NULL, "nactive is NULL");
+    *nactive = f.active_states(n, state);
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_get_inflow(const mfree_system_t *sys, int32_t gate, int64_t *count, double *mass) {
+  return mfree::with_handle(sys, "mfree_system_get_inflow", [&](const mfree::System &base) {
+    const auto &f = kind<mfree::FluidSystem>(base, "inflow (not a fluid)");
+    int64_t c = 0;
+    double m = 0.0;
+    f.inflow_totals(gate, c, m);
+    if (count) *count = c;
+    if (mass) *mass = m;
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_get_outflow(const mfree_system_t *sys, int32_t k, int64_t *count, double *mass) {
+  return mfree::with_handle(sys, "mfree_system_get_outflow", [&](const mfree::System &base) {
+    const auto &f = kind<mfree::FluidSystem>(base, "outflow (not a fluid)");
+    int64_t c = 0;
+    double m = 0.0;
+    f.outflow_totals(k, c, m);
+    if (count) *count = c;
+    if (mass) *mass = m;
+    return MFREE_SUCCESS;
+  });
 }
 
 mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx, mfree_assembler_t *as, double density,

@@ -30,6 +30,7 @@ const char *mfree_status_string(mfree_status_t s) {
     case MFREE_FAIL_DOMAIN: return "a particle left the domain";
     case MFREE_FAIL_CFL: return "time step violates the CFL condition";
     case MFREE_FAIL_SUPPORT: return "kernel support exceeds the method's size limit";
+    case MFREE_FAIL_CAPACITY: return "the pool of dormant particles is exhausted";
   }
   return "unknown status";
 }

@@ -1150,6 +1150,46 @@ static void rows_system(void) {
   ROW(MFREE_ERR_ARG, mfree_system_integrate(F.sys, MFREE_INTEGRATOR_LEAPFROG, yb, &t, 1e-3, 0.0, 0.0, NULL, NULL, &steps));
   ROW(MFREE_ERR_ARG, mfree_system_integrate(F.sys, MFREE_INTEGRATOR_LEAPFROG, yb, &t, 1e-3, 0.2, -1.0, NULL, NULL, &steps));
   ROW(MFREE_FAIL_NONFINITE, mfree_system_integrate(F.sys, MFREE_INTEGRATOR_LEAPFROG, yb, &t, 1e-3, 0.2, 0, NULL, NULL, &steps));
+  /* open boundaries: the fixture's fluid has no gate or outflow (failures create none) */
+  {
+    const double go[2] = {0.0, 0.0}, ge[2] = {0.0, 1.0}, gn[2] = {1.0, 0.0}, gbad[2] = {0.6, 0.6};
+    const double gnan[2] = {NAN, 0.0};
+    int32_t states[N + 1];
+    int64_t cnt = 0;
+    double gm = 0.0;
+    ROW0(MFREE_ERR_NULL, mfree_system_set_active(NULL, 1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_active(F.sys, -1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_active(F.sys, N + 1));
+    ROW0(MFREE_ERR_NULL, mfree_system_set_inflow(NULL, 0, go, ge, gn, 1.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_NULL, mfree_system_set_inflow(F.sys, 0, NULL, ge, gn, 1.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_NULL, mfree_system_set_inflow(F.sys, 0, go, NULL, gn, 1.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_NULL, mfree_system_set_inflow(F.sys, 0, go, ge, NULL, 1.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_inflow(F.sys, 1, go, ge, gn, 1.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_inflow(F.sys, -1, go, ge, gn, 1.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_inflow(F.sys, 0, go, ge, gbad, 1.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_inflow(F.sys, 0, go, gn, gn, 1.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_inflow(F.sys, 0, go, ge, gn, 1.0, 1000.0, 3.0));
+    ROW(MFREE_ERR_ARG, mfree_system_set_inflow(F.sys, 0, go, ge, gn, 0.0, 1000.0, 0.1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_inflow(F.sys, 0, go, ge, gn, 1.0, NAN, 0.1));
+    ROW(MFREE_ERR_ARG, mfree_system_set_inflow(F.sys, 0, go, ge, gn, 1.0, 1000.0, INFINITY));
+    ROW(MFREE_ERR_INPUT, mfree_system_set_inflow(F.sys, 0, gnan, ge, gn, 1.0, 1000.0, 0.1));
+    ROW0(MFREE_ERR_NULL, mfree_system_set_outflow(NULL, 0, go, gn));
+    ROW(MFREE_ERR_NULL, mfree_system_set_outflow(F.sys, 0, NULL, gn));
+    ROW(MFREE_ERR_NULL, mfree_system_set_outflow(F.sys, 0, go, NULL));
+    ROW(MFREE_ERR_ARG, mfree_system_set_outflow(F.sys, 1, go, gn));
+    ROW(MFREE_ERR_ARG, mfree_system_set_outflow(F.sys, 0, go, gbad));
+    ROW(MFREE_ERR_INPUT, mfree_system_set_outflow(F.sys, 0, gnan, gn));
+    ROW0(MFREE_ERR_NULL, mfree_system_update_open_boundaries(NULL, 0.0, yb));
+    ROW(MFREE_ERR_NULL, mfree_system_update_open_boundaries(F.sys, 0.0, NULL));
+    ROW(MFREE_ERR_ARG, mfree_system_update_open_boundaries(F.sys, NAN, yb));
+    ROW0(MFREE_ERR_NULL, mfree_system_get_active(NULL, &i32, N, states));
+    ROW(MFREE_ERR_NULL, mfree_system_get_active(F.sys, NULL, N, states));
+    ROW(MFREE_ERR_ARG, mfree_system_get_active(F.sys, &i32, N + 1, states));
+    ROW0(MFREE_ERR_NULL, mfree_system_get_inflow(NULL, 0, &cnt, &gm));
+    ROW(MFREE_ERR_ARG, mfree_system_get_inflow(F.sys, 0, &cnt, &gm));
+    ROW0(MFREE_ERR_NULL, mfree_system_get_outflow(NULL, 0, &cnt, &gm));
+    ROW(MFREE_ERR_ARG, mfree_system_get_outflow(F.sys, 0, &cnt, &gm));
+  }
 
   ROW0(MFREE_ERR_NULL, mfree_system_create_elastodynamic(NULL, F.as, 1.0, &s));
   ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic(F.ctx, NULL, 1.0, &s));

@@ -213,6 +213,7 @@ double FluidSystem::tait(double rho, double rho0) const {
 
 Report FluidSystem::rhs(double t, const double *y, double *ydot) {
   (void)t;
+  if (open_) return open_rhs(y, ydot);
   Report rep = prepare(y);
   if (!rep.ok()) return rep;
   const size_t nd = static_cast<size_t>(dim_) * n_;
@@ -223,6 +224,7 @@ Report FluidSystem::rhs(double t, const double *y, double *ydot) {
 }
 
 Report FluidSystem::velocity(const double *y, double *vhat) {
+  if (open_) return open_velocity(y, vhat);
   Report rep = prepare(y);
   if (!rep.ok()) return rep;
   const size_t nd = static_cast<size_t>(dim_) * n_;
@@ -231,11 +233,13 @@ Report FluidSystem::velocity(const double *y, double *vhat) {
 }
 
 void FluidSystem::pressure(const double *y, double *p) const {
+  if (open_) return open_pressure(y, p);
   const double *rho = y + 2 * static_cast<size_t>(dim_) * n_;
   for (int32_t i = 0; i < n_; ++i) p[i] = kappa_ * (std::pow(rho[i] / rho0_[i], gamma_) - 1.0);
 }
 
 Report FluidSystem::interpolation(const double *y, SparseMatrix &S) {
+  if (open_) return open_interpolation(y, S);
   Report rep = prepare(y);
   if (!rep.ok()) return rep;
   // rows are not guaranteed sorted by column: sort each row with its values
@@ -261,6 +265,7 @@ Report FluidSystem::interpolation(const double *y, SparseMatrix &S) {
 }
 
 Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
+  if (open_) return open_mass(y, consistent, M);
   Report rep = prepare(y);
   if (!rep.ok()) return rep;
   const int dim = dim_;
@@ -379,6 +384,7 @@ std::string FluidSystem::fastest(const double *y) const {
 
 Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                               mfree_progress_fn progress, void *user, int64_t &nsteps) {
+  if (open_) return open_integrate(scheme, y, t, t_end, cfl, dt_max, progress, user, nsteps);
   if (scheme != MFREE_INTEGRATOR_LEAPFROG && scheme != MFREE_INTEGRATOR_PREDICTOR_CORRECTOR)
     throw Error(MFREE_ERR_ARG, "unknown integrator");
   if (!(std::isfinite(t_end) && std::isfinite(t))) throw Error(MFREE_ERR_ARG, "times must be finite");

@@ -11,6 +11,7 @@
 #include "core/shape/approximant.hpp"
 #include "core/base/error.hpp"
 #include "core/base/parallel.hpp"
+#include "core/systems/fluid_inflow.hpp"
 #include "core/systems/fluid_wall.hpp"
 #include "core/discretize/matrix.hpp"
 #include "mfree.h"
@@ -57,6 +58,20 @@ class FluidSystem : public System {
   Report wall_force(const double *y, double *total, int32_t nwall, double *per_wall);
   Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                    mfree_progress_fn progress, void *user, int64_t &nsteps) override;
+
+  // Open boundaries (fluid_inflow.cpp): with any of these n is a capacity, of which the
+  // active particles are the fluid; the evaluations above then run on the active ones
+  // (a fluid of their own, built with this system's options: a new option must be
+  // copied in open_inner too).
+  void set_active(int32_t nactive);
+  void set_inflow(int32_t gate, const double *origin, const double *edges, const double *normal, double speed,
+                  double density, double spacing);
+  void set_outflow(int32_t k, const double *point, const double *normal);
+  Report update_open(double t, double *y);
+  int32_t active_states(int32_t n, int32_t *state) const;  // the active count; states if n > 0
+  void inflow_totals(int32_t gate, int64_t &count, double &mass) const;
+  void outflow_totals(int32_t k, int64_t &count, double &mass) const;
+  void options_changed() { if (open_) open_->dirty = true; }  // after every setter
 
  private:
   void check_ready() const;
@@ -219,6 +234,24 @@ class FluidSystem : public System {
   std::vector<int32_t> chunk_color_, chunk_fill_;  // scratch of color_chunks
   bool scatter_threads_ = true;       // false: one colour, the chunks in order, one thread
   std::vector<double> acc_;           // per node: force, mass, lumped mass, wall force
+
+  // Open boundaries (fluid_inflow.cpp); null: every particle is active (paper 003).
+  std::unique_ptr<FluidOpen> open_;
+  FluidOpen &open();
+  FluidSystem &open_inner() const;                // built when dirty
+  const double *open_gather(const double *y) const;  // compact state of the active particles
+  Report open_result(Report r) const;               // particle numbers of the capacity
+  Report open_rhs(const double *y, double *ydot);
+  Report open_velocity(const double *y, double *vhat);
+  void open_pressure(const double *y, double *p) const;
+  Report open_interpolation(const double *y, SparseMatrix &S);
+  Report open_mass(const double *y, bool consistent, SparseMatrix &M);
+  Report open_wall_force(const double *y, double *total, int32_t nwall, double *per_wall);
+  Report open_integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
+                        mfree_progress_fn progress, void *user, int64_t &nsteps);
+  void place_buffer(double t, double *y, bool compact) const;  // imposed state of the buffers
+  bool open_crossed(const double *y, bool compact) const;      // a fluid particle past an outflow
+  static int32_t open_progress(void *u, int64_t step, double t, double dt);  // integrate's, per step
 };
 
 }  // namespace mfree

@@ -367,6 +367,7 @@ namespace mfree {
 // through N_i(x_k), hence on the fluid as (sum_i m_i N_i(x_k)) f1 f2 n_w; the same
 // test of approach as accel, with the interpolated velocity summed here.
 Report FluidSystem::wall_force(const double *y, double *total, int32_t nwall, double *per_wall) {
+  if (open_) return open_wall_force(y, total, nwall, per_wall);
   const int32_t nw = walls_ ? walls_->size() : 0;
   if (per_wall && nwall != nw)
     throw Error(MFREE_ERR_ARG, "per_wall holds " + std::to_string(nwall) + " wall particles, the system has " +
