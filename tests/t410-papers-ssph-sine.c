@@ -22,14 +22,7 @@ static mfree_context_t *ctx;
 static int setup(void **s) { (void)s; return mfree_context_create(&ctx) != MFREE_SUCCESS; }
 static int teardown(void **s) { (void)s; return mfree_context_destroy(&ctx) != MFREE_SUCCESS; }
 
-/* ---- checks that name their source -------------------------------------------------- */
-
-#define expect_near(got, want, tol, src)                                                   \
-  do {                                                                                     \
-    const double g_ = (got), w_ = (want), t_ = (tol);                                      \
-    if (!(fabs(g_ - w_) <= t_))                                                            \
-      fail_msg("%s: got %.8g, expected %.8g +- %.3g", (src), g_, w_, t_);                  \
-  } while (0)
+/* ---- checks that name their source (and expect_near of testutil.h) ------------------ */
 
 #define expect_less(a, b, src)                                                             \
   do {                                                                                     \

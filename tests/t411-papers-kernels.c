@@ -19,13 +19,6 @@ static mfree_context_t *ctx;
 static int setup(void **s) { (void)s; return mfree_context_create(&ctx) != MFREE_SUCCESS; }
 static int teardown(void **s) { (void)s; return mfree_context_destroy(&ctx) != MFREE_SUCCESS; }
 
-#define expect_near(got, want, tol, src)                                                   \
-  do {                                                                                     \
-    const double g_ = (got), w_ = (want), t_ = (tol);                                      \
-    if (!(fabs(g_ - w_) <= t_))                                                            \
-      fail_msg("%s: got %.8g, expected %.8g +- %.3g", (src), g_, w_, t_);                  \
-  } while (0)
-
 /* The nine kernel variants of Tables 3-5, in the paper's column order. */
 enum { LIN, QUAD, CUB, QUART, RGAUSS, RSG10, RSG12, RSG14, RSG16, NK };
 static const mfree_kernel_t kKernel[NK] = {

@@ -33,6 +33,15 @@ void mfree_test_expect_error(mfree_context_t *ctx, mfree_status_t got, mfree_sta
 #define assert_error(ctx, call, expected, needle) \
   mfree_test_expect_error((ctx), (call), (expected), (needle), #call)
 
+/* A published number checked: got within tol of want, else the test fails naming src (the
+ * paper, table and row the number comes from). The caller includes <math.h>. */
+#define expect_near(got, want, tol, src)                                                   \
+  do {                                                                                     \
+    const double g_ = (got), w_ = (want), t_ = (tol);                                      \
+    if (!(fabs(g_ - w_) <= t_))                                                            \
+      fail_msg("%s: got %.8g, expected %.8g +- %.3g", (src), g_, w_, t_);                  \
+  } while (0)
+
 /* Deterministic uniform random numbers in [0, 1) (xorshift64*). */
 typedef struct { uint64_t s; } mfree_rng_t;
 void mfree_rng_seed(mfree_rng_t *r, uint64_t seed);
