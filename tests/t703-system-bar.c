@@ -26,46 +26,9 @@ static double pulse(void *u, double t) {
   return t <= T0 ? 1.0 : 0.0;
 }
 
-typedef struct {
-  mfree_particles_t *ps;
-  mfree_approximant_t *a;
-  mfree_assembler_t *as;
-  mfree_system_t *sys;
-} bar_t;
-
-static bar_t make_bar(void) {
-  bar_t b;
-  const double dx = L / (N - 1), h = 1.5 * dx, vol = dx;
-  for (int i = 0; i < N; ++i) X[i] = i * dx;
-  assert_ok(ctx, mfree_particles_create(ctx, 1, N, &b.ps));
-  assert_ok(ctx, mfree_particles_set_positions(b.ps, X, MFREE_LAYOUT_AOS, 1, MFREE_BORROW));
-  assert_ok(ctx, mfree_particles_set_support(b.ps, &h, 0, MFREE_COPY));
-  assert_ok(ctx, mfree_particles_set_volumes(b.ps, &vol, 0, MFREE_COPY));
-  assert_ok(ctx, mfree_approximant_create(ctx, b.ps, MFREE_METHOD_SSPH, &b.a));
-  assert_ok(ctx, mfree_approximant_set_kernel(b.a, MFREE_KERNEL_REVISED_SUPER_GAUSS, 1.6));
-  assert_ok(ctx, mfree_approximant_set_order(b.a, 2));
-  assert_ok(ctx, mfree_approximant_set_derivatives(b.a, 7));
-  assert_ok(ctx, mfree_assembler_create(ctx, b.a, NULL, MFREE_FORM_COLLOCATION_LAPLACE, &b.as));
-  assert_ok(ctx, mfree_assembler_set_coefficient(b.as, E)); /* 1D bar: rho u'' = E u'' */
-  const int32_t ends[2] = {0, N - 1};
-  const double normals[2] = {-1.0, 1.0};
-  assert_ok(ctx, mfree_assembler_add_traction_nodes(b.as, 2, ends, normals, traction, NULL));
-  assert_ok(ctx, mfree_assembler_setup(b.as));
-  assert_ok(ctx, mfree_system_create_elastodynamic(ctx, b.as, RHO, &b.sys));
-  assert_ok(ctx, mfree_system_set_load_history(b.sys, pulse, NULL));
-  return b;
-}
-
-static void free_bar(bar_t *b) {
-  mfree_system_destroy(&b->sys);
-  mfree_assembler_destroy(&b->as);
-  mfree_approximant_destroy(&b->a);
-  mfree_particles_destroy(&b->ps);
-}
-
 static void test_wave(void **s) {
   (void)s;
-  bar_t b = make_bar();
+  mfree_test_bar_t b = mfree_test_bar_create(ctx, N, L, E, RHO, X, traction, pulse);
   int32_t neq = 0;
   assert_ok(ctx, mfree_system_get_size(b.sys, &neq));
   assert_int_equal(neq, 2 * N);
@@ -113,12 +76,12 @@ static void test_wave(void **s) {
   const double expect = c * (t - L / c) - 0.5 * c * T0; /* centre of the reflected pulse */
   assert_true(fabs(xmax - expect) < 0.6 * c * T0);
   free(y);
-  free_bar(&b);
+  mfree_test_bar_destroy(&b);
 }
 
 static void test_bad_input(void **s) {
   (void)s;
-  bar_t b = make_bar();
+  mfree_test_bar_t b = mfree_test_bar_create(ctx, N, L, E, RHO, X, traction, pulse);
   mfree_system_t *sys = NULL;
   assert_error(ctx, mfree_system_create_elastodynamic(ctx, NULL, RHO, &sys), MFREE_ERR_NULL, "assembler");
   assert_error(ctx, mfree_system_create_elastodynamic(ctx, b.as, -1.0, &sys), MFREE_ERR_ARG, "density");
@@ -153,7 +116,7 @@ static void test_bad_input(void **s) {
   double *y2 = calloc(2 * N, sizeof(double)), yd[2 * N];
   assert_ok(ctx, mfree_system_rhs(b.sys, 0.0, y2, yd));
   free(y2);
-  free_bar(&b);
+  mfree_test_bar_destroy(&b);
 }
 
 int main(void) {

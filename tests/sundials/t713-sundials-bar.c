@@ -80,43 +80,6 @@ static double history(void *u, double t) {
   return loaded ? 1.0 : 0.0;
 }
 
-typedef struct {
-  mfree_particles_t *ps;
-  mfree_approximant_t *a;
-  mfree_assembler_t *as;
-  mfree_system_t *sys;
-} bar_t;
-
-static bar_t make_bar(void) {
-  bar_t b;
-  const double dx = L / (N - 1), h = 1.5 * dx, vol = dx;
-  for (int i = 0; i < N; ++i) X[i] = i * dx;
-  assert_ok(ctx, mfree_particles_create(ctx, 1, N, &b.ps));
-  assert_ok(ctx, mfree_particles_set_positions(b.ps, X, MFREE_LAYOUT_AOS, 1, MFREE_BORROW));
-  assert_ok(ctx, mfree_particles_set_support(b.ps, &h, 0, MFREE_COPY));
-  assert_ok(ctx, mfree_particles_set_volumes(b.ps, &vol, 0, MFREE_COPY));
-  assert_ok(ctx, mfree_approximant_create(ctx, b.ps, MFREE_METHOD_SSPH, &b.a));
-  assert_ok(ctx, mfree_approximant_set_kernel(b.a, MFREE_KERNEL_REVISED_SUPER_GAUSS, 1.6));
-  assert_ok(ctx, mfree_approximant_set_order(b.a, 2));
-  assert_ok(ctx, mfree_approximant_set_derivatives(b.a, 7));
-  assert_ok(ctx, mfree_assembler_create(ctx, b.a, NULL, MFREE_FORM_COLLOCATION_LAPLACE, &b.as));
-  assert_ok(ctx, mfree_assembler_set_coefficient(b.as, E));
-  const int32_t ends[2] = {0, N - 1};
-  const double normals[2] = {-1.0, 1.0};
-  assert_ok(ctx, mfree_assembler_add_traction_nodes(b.as, 2, ends, normals, traction, NULL));
-  assert_ok(ctx, mfree_assembler_setup(b.as));
-  assert_ok(ctx, mfree_system_create_elastodynamic(ctx, b.as, RHO, &b.sys));
-  assert_ok(ctx, mfree_system_set_load_history(b.sys, history, NULL));
-  return b;
-}
-
-static void free_bar(bar_t *b) {
-  mfree_system_destroy(&b->sys);
-  mfree_assembler_destroy(&b->as);
-  mfree_approximant_destroy(&b->a);
-  mfree_particles_destroy(&b->ps);
-}
-
 static void check_flag(const char *call, int flag) {
   if (flag < 0) {
     char msg[512];
@@ -163,7 +126,7 @@ static double distance(const double *a, const double *b) {
 static void test_native(void **s) {
   (void)s;
   for (int k = 0; k < 3; ++k) {
-    bar_t b = make_bar();
+    mfree_test_bar_t b = mfree_test_bar_create(ctx, N, L, E, RHO, X, traction, history);
     double *y = result[PC05 + k], t = 0.0;
     int64_t ns = 0, ns2 = 0;
     memset(y, 0, sizeof result[0]);
@@ -179,14 +142,14 @@ static void test_native(void **s) {
     snprintf(what, sizeof what, "(a) native, CFL %g", cfl);
     check_wave(b.sys, y, what);
     done[PC05 + k] = 1;
-    free_bar(&b);
+    mfree_test_bar_destroy(&b);
   }
 }
 
 /* (b) ERKStep, y' = f(t, y) */
 static void test_erkstep(void **s) {
   (void)s;
-  bar_t b = make_bar();
+  mfree_test_bar_t b = mfree_test_bar_create(ctx, N, L, E, RHO, X, traction, history);
   mfree_sundials_t *ad = NULL;
   assert_ok(ctx, mfree_sundials_create(ctx, b.sys, &ad));
   N_Vector y = N_VNew_Serial(NEQ, sunctx);
@@ -215,13 +178,13 @@ static void test_erkstep(void **s) {
   N_VDestroy(y);
   N_VDestroy(atol);
   mfree_sundials_destroy(&ad);
-  free_bar(&b);
+  mfree_test_bar_destroy(&b);
 }
 
 /* (c) ARKStep with the (identity) mass through KLU */
 static void test_arkstep_mass(void **s) {
   (void)s;
-  bar_t b = make_bar();
+  mfree_test_bar_t b = mfree_test_bar_create(ctx, N, L, E, RHO, X, traction, history);
   mfree_sundials_t *ad = NULL;
   assert_ok(ctx, mfree_sundials_create(ctx, b.sys, &ad));
   N_Vector y = N_VNew_Serial(NEQ, sunctx);
@@ -259,14 +222,14 @@ static void test_arkstep_mass(void **s) {
   N_VDestroy(y);
   N_VDestroy(atol);
   mfree_sundials_destroy(&ad);
-  free_bar(&b);
+  mfree_test_bar_destroy(&b);
 }
 
 /* (d) IDA, r = y' - f(t, y), to T0: BDF on an undamped wave front needs ~40000 steps to
  * T_END at rtol 1e-7 (a minute); at rtol 1e-5 to T0 it takes seconds */
 static void test_ida(void **s) {
   (void)s;
-  bar_t b = make_bar();
+  mfree_test_bar_t b = mfree_test_bar_create(ctx, N, L, E, RHO, X, traction, history);
   mfree_sundials_t *ad = NULL;
   assert_ok(ctx, mfree_sundials_create(ctx, b.sys, &ad));
   N_Vector yy = N_VNew_Serial(NEQ, sunctx), yp = N_VClone(yy);
@@ -294,7 +257,7 @@ static void test_ida(void **s) {
   N_VDestroy(yy);
   N_VDestroy(atol);
   mfree_sundials_destroy(&ad);
-  free_bar(&b);
+  mfree_test_bar_destroy(&b);
 }
 
 static const double TG = 1e-6; /* the stiffer consistent-mass system: 5 mm of travel */

@@ -97,3 +97,34 @@ mfree_system_t *mfree_test_fluid_create(mfree_context_t *ctx, int n, const doubl
 int32_t mfree_test_backend(int argc, char **argv) {
   return argc > 1 && strcmp(argv[1], "ref") == 0 ? MFREE_BACKEND_REF : MFREE_BACKEND_OPT;
 }
+
+mfree_test_bar_t mfree_test_bar_create(mfree_context_t *ctx, int n, double L, double E, double rho, double *x,
+                                       mfree_field_fn traction, mfree_history_fn history) {
+  mfree_test_bar_t b;
+  const double dx = L / (n - 1), h = 1.5 * dx, vol = dx;
+  for (int i = 0; i < n; ++i) x[i] = i * dx;
+  assert_ok(ctx, mfree_particles_create(ctx, 1, n, &b.ps));
+  assert_ok(ctx, mfree_particles_set_positions(b.ps, x, MFREE_LAYOUT_AOS, 1, MFREE_BORROW));
+  assert_ok(ctx, mfree_particles_set_support(b.ps, &h, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_volumes(b.ps, &vol, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_approximant_create(ctx, b.ps, MFREE_METHOD_SSPH, &b.a));
+  assert_ok(ctx, mfree_approximant_set_kernel(b.a, MFREE_KERNEL_REVISED_SUPER_GAUSS, 1.6));
+  assert_ok(ctx, mfree_approximant_set_order(b.a, 2));
+  assert_ok(ctx, mfree_approximant_set_derivatives(b.a, 7));
+  assert_ok(ctx, mfree_assembler_create(ctx, b.a, NULL, MFREE_FORM_COLLOCATION_LAPLACE, &b.as));
+  assert_ok(ctx, mfree_assembler_set_coefficient(b.as, E));
+  const int32_t ends[2] = {0, n - 1};
+  const double normals[2] = {-1.0, 1.0};
+  assert_ok(ctx, mfree_assembler_add_traction_nodes(b.as, 2, ends, normals, traction, NULL));
+  assert_ok(ctx, mfree_assembler_setup(b.as));
+  assert_ok(ctx, mfree_system_create_elastodynamic(ctx, b.as, rho, &b.sys));
+  assert_ok(ctx, mfree_system_set_load_history(b.sys, history, NULL));
+  return b;
+}
+
+void mfree_test_bar_destroy(mfree_test_bar_t *b) {
+  mfree_system_destroy(&b->sys);
+  mfree_assembler_destroy(&b->as);
+  mfree_approximant_destroy(&b->a);
+  mfree_particles_destroy(&b->ps);
+}

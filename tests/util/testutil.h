@@ -71,6 +71,22 @@ int mfree_test_tank_walls(double L, double d, double off, double top, double **x
 mfree_system_t *mfree_test_fluid_create(mfree_context_t *ctx, int n, const double *m, double rho0, double kappa,
                                         double gamma, double mu, double h);
 
+/* The collocation bar of paper 001 Sect. 6.4: n particles x_i = i L / (n - 1) written into
+ * x (n values, borrowed by the set: they must outlive the bar), h = 1.5 dx, volumes dx;
+ * SSPH with the revised super Gauss (a = 1.6), quadratic basis, derivatives to the second;
+ * the collocation Laplacian with coefficient E (1D: rho u'' = E u''), traction nodes at
+ * both ends (normals -1 and +1) loaded by traction; the elastodynamic system of density
+ * rho with the load history history. Fails the test on any error. */
+typedef struct {
+  mfree_particles_t *ps;
+  mfree_approximant_t *a;
+  mfree_assembler_t *as;
+  mfree_system_t *sys;
+} mfree_test_bar_t;
+mfree_test_bar_t mfree_test_bar_create(mfree_context_t *ctx, int n, double L, double E, double rho, double *x,
+                                       mfree_field_fn traction, mfree_history_fn history);
+void mfree_test_bar_destroy(mfree_test_bar_t *b);
+
 /* 1 in optimised builds. Unoptimised ones (the asan preset compiles the tests without
  * __OPTIMIZE__) run Eigen about 100 times slower than Release: there a test checks a
  * reduced matrix, unless MFREE_TEST_FULL is set (to anything) in the environment. Inline,
