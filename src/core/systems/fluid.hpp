@@ -82,30 +82,27 @@ class FluidSystem : public System {
   // Validate the state (unless checked: integrate's state after a step, which
   // check_state has just passed) and build the shape-function tables at the nodes (below).
   Report prepare(const double *y, bool checked = false);
-  // Candidate neighbour lists (Verlet lists with a skin, see tables_) for the node
-  // positions xn, rebuilt when a node moved more than half the skin since the last build.
+  // The tables' rows for the node positions xn: the search of ps_ with its skin (see
+  // cols_), and with new candidate lists the colouring and the wall lists on them.
   Report candidates(const double *xn);
-  // Tables rows [k0, k1) on thread t: the kept candidates, then the approximants' rows
-  // (the fast path, the general path with its fallbacks and Shepard rule where it does
-  // not finish a row or a row is worse conditioned than shepard_cond_); with transpose,
-  // also NT_ (true if a pair is in one node's row only, which the search rules out).
-  // k0 starts a chunk of kChunk rows (see rb_).
+  // Tables rows [k0, k1) on thread t: the approximants' rows (the fast path, the general
+  // path with its fallbacks and Shepard rule where it does not finish a row or a row is
+  // worse conditioned than shepard_cond_); with transpose, also NT_ (true if a pair is in
+  // one node's row only, which the search rules out). k0 starts a chunk of kChunk rows.
   bool table_rows(int t, int32_t k0, int32_t k1, const double *xn, const double *pack, bool transpose);
   // Per-thread scratch of the rows: the fast path's, the general path's input (offsets,
-  // volumes, supports) and work, and the row offsets of a chunk (nq() + 1).
+  // volumes, supports) and work.
   struct RowsScratch {
     FastScratch fast;
     HVec<double> d, v, h;
     LocalWork work;
-    std::vector<int64_t> rp;
   };
   // Row k by the general path (local.hpp, compute_site_rules); fast_done: the fast path's
   // rows stand, only the Shepard rule applies.
   void general_row(int32_t k, const double *xn, RowsScratch &w, bool fast_done);
   // Chunks of kChunk rows coloured so that no two chunks of a colour touch a common
-  // node (on the candidate pattern), for the scatter of accel (rebuilt with the lists).
-  void color_chunks();
-  void transposed_candidates();  // ctrans_, only for NT_ (consistent integration)
+  // node on the candidate pattern cand, for the scatter of accel (rebuilt with the lists).
+  void color_chunks(const Csr &cand);
   // Acceleration parameters a (dim per particle) from the prepared tables and v, rho:
   // accel_args (node arrays, zeroed sums), accel_point for every row in colour order
   // (chunk_order_), accel_end (the nodes' accelerations).
@@ -177,40 +174,35 @@ class FluidSystem : public System {
 
   // Shape functions at the nodes, rebuilt at every prepare (003: linear MLS with the
   // cubic spline, nodal quadrature): rows sorted by column, entries [rb(k), re(k)) of
-  // cols_, values N_ and gradients G_ (dim per entry) of node cols_[e] at node k. The
-  // rows of a chunk of kChunk rows lie one after another from where the chunk's candidate
-  // rows start (the tables never outgrow the candidates), so that one thread writes a
-  // chunk as it computes it, without a count pass; a few entries at a chunk's end are
-  // unused. Only with consistent
-  // integration (vci_, whose sums fluid_wall.cpp takes as gathers) also the transpose NT_
-  // on the same pattern (it is symmetric: one h for all), value and gradient interleaved
-  // (dim + 1 per entry): entry e of row i holds N_i(x_j), j = cols_[e]. The force
-  // assembly itself scatters row by row (see chunk_order_) and needs no transpose.
+  // cols_, values N_ and gradients G_ (dim per entry) of node cols_[e] at node k. Only
+  // with consistent integration (vci_, whose sums fluid_wall.cpp takes as gathers) also
+  // the transpose NT_ on the same pattern (it is symmetric: one h for all), value and
+  // gradient interleaved (dim + 1 per entry): entry e of row i holds N_i(x_j), j =
+  // cols_[e]. The force assembly itself scatters row by row (see chunk_order_) and needs
+  // no transpose.
   //
-  // The rows come from candidate (Verlet) lists cand_ of radius 2h + skin built by ps_
-  // at positions xref_; they are reused while no node has moved more than skin / 2 since
-  // (then every pair closer than 2h now was closer than 2h + skin then), so that the
-  // tables never depend on the skin, only the cost does. The wall lists use the same rule.
+  // The rows are the neighbour lists of ps_ (the nodes, search radius R h, the kernel's
+  // closed support): its search keeps candidate lists of radius R h + skin_ h and filters
+  // the rows from them while no node has moved more than half the skin since their build
+  // (particles/neighbors_verlet.inc), so that the tables never depend on the skin, only
+  // the cost does. The tables are sized for the candidates (no allocation until the next
+  // build); the colouring and the wall lists are built on them, with each new build
+  // (cand_search_: the set's search count they are for).
   ParticleSet ps_;
   HVec<double> vol_;
   int64_t rb(int64_t k) const { return rb_[k]; }
   int64_t re(int64_t k) const { return re_[k]; }
-  std::vector<int64_t> rb_, re_;  // row begins and ends
+  // row begins and ends and the columns: ps_.neighbors() after the last prepare
+  const int64_t *rb_ = nullptr, *re_ = nullptr;
+  const int32_t *cols_ = nullptr;
   // HVec: without an allocator hook, blocks >= 2 MiB get transparent huge pages (alloc.hpp):
   // the tables (~18 MB at 25,000 particles) are written and read three times per step
-  HVec<int32_t> cols_;
   HVec<double> N_, G_, NT_;
   std::vector<double> cond_;
-  Csr cand_;
-  std::vector<int64_t> ctrans_;  // transposed candidate entry, -1 if none (only with NT_)
-  bool ctrans_valid_ = false;
-  std::vector<int32_t> cpos_;    // position of a candidate in its row of the tables, -1 if out (only with NT_)
-  std::vector<double> xref_;
   double skin_ = 0.25;  // in units of h
-  bool lists_valid_ = false;
-  double href_ = 0.0;
+  bool lists_valid_ = false;  // false: colour and find the wall lists at the next prepare
+  int64_t cand_search_ = -1;
   const double *xbound_ = nullptr;  // node positions ps_ borrows
-  int64_t rebuilds_ = 0;
   int64_t maxrow_ = 0;               // longest candidate row
   std::vector<RowsScratch> rows_scratch_;
   // per node: the rows' status, support and order, the node's place in its row; the

@@ -19,8 +19,8 @@ namespace mfree {
 void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, double *drho) const {
   v = node_velocities(v);
   const int dim = dim_;
-  const int64_t *rb = rb_.data(), *re = re_.data();
-  const int32_t *cols = cols_.data();
+  const int64_t *rb = rb_, *re = re_;
+  const int32_t *cols = cols_;
   const double *N = N_.data(), *G = G_.data();
   const bool avx2 = dim == 2 && simd::use_avx2();  // once per call: every thread runs the same copy
   parallel_blocks(n_, num_threads(n_), [&](int, int64_t b, int64_t e) {
@@ -160,7 +160,7 @@ void FluidSystem::accel_point(int64_t k, const AccelArgs &arg) {
   constexpr int A = 2 * D + 2;  // acc_ per node: force, mass sum_k N M, lumped mass, wall force
   const double *v = arg.v;
   const int64_t q0 = rb_[k], q1 = re_[k];
-  const int32_t *cols = cols_.data();
+  const int32_t *cols = cols_;
   const double *N = N_.data(), *G = G_.data();
   double *acc = acc_.data();
   // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
@@ -332,7 +332,7 @@ MFREE_ALWAYS_INLINE Entries4 entries4(const double *v, const int32_t *cols, cons
 void FluidSystem::accel_rows2_avx2(int64_t k0, int64_t k1, const AccelArgs &arg) {
   constexpr int A = 6;
   const double *v = arg.v;
-  const int32_t *cols = cols_.data();
+  const int32_t *cols = cols_;
   const double *N = N_.data(), *G = G_.data();
   double *acc = acc_.data();
   const __m256d zero = _mm256_setzero_pd();
@@ -407,7 +407,7 @@ void FluidSystem::accel_rows2_avx2(int64_t k0, int64_t k1, const AccelArgs &arg)
 // div_k = sum v_j . grad N_j in four sums of registers.
 void FluidSystem::kinematics2_avx2(int64_t k0, int64_t k1, const double *v, const double *rho, double *vhat,
                                    double *drho) const {
-  const int32_t *cols = cols_.data();
+  const int32_t *cols = cols_;
   const double *N = N_.data(), *G = G_.data();
   const __m256d zero = _mm256_setzero_pd();
   for (int64_t k = k0; k < k1; ++k) {
