@@ -185,8 +185,8 @@ static void tables_against_references(int dim, int steps) {
     assert_ok(ctx, mfree_system_rhs(sys, t, y, yd));
     for (int k = 0; k < N; ++k) {
       if (!(ref.cond[k] < 50.0)) continue;
-      /* merge the two rows by column: the search may hand the approximant pairs at
-       * exactly 2h (zero weight), which the fluid leaves out */
+      /* merge the two rows by column: a row may hold pairs at exactly 2h (zero
+       * weight) that the other lacks */
       double div = 0.0, scale = 0.0;
       int64_t e = rp[k], f = ref.rp[k];
       while (e < rp[k + 1] || f < ref.rp[k + 1]) {
