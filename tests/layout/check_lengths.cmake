@@ -32,9 +32,7 @@ if(NOT DEFINED MAX_FUNCTION)
 endif()
 
 set(exceptions
-  # the fused AVX2 rows of linear MLS in 2D (moved from the fluid): to be cut into
-  # inlined parts, or to say why not in a Length: comment
-  "core/shape/shape_fast_mls1.cpp:mls1_rows2_avx2"
+  # none at present
 )
 
 file(GLOB_RECURSE files RELATIVE "${SRC}" LIST_DIRECTORIES false

@@ -38,6 +38,7 @@
 // (read in config.cpp) or runs the reference backend.
 #pragma once
 
+#include <cstdint>
 #include <cstring>
 
 #include "core/base/config.hpp"
@@ -69,8 +70,8 @@
 #define MFREE_AVX2_END
 #endif
 
-// Per-function target attribute: kept only for the neighbour search's kernels written
-// before the one style (particles/neighbors_*.inc); new code uses the region above.
+// Per-function target attribute: kept only for the fluid's kernels written before the one
+// style (systems/fluid_*.cpp); new code uses the region above.
 #if MFREE_SIMD_X86
 #define MFREE_TARGET_AVX2 __attribute__((target("avx2,fma")))
 #else
@@ -113,6 +114,34 @@ template <int N>
 MFREE_ALWAYS_INLINE void load(double &v, const double *p) { v = *p; }
 
 #if MFREE_VECTOR_EXTENSIONS
+typedef long long I4 __attribute__((vector_size(32)));
+// Lanes of two V4 a, b (indices 0-3: a, 4-7: b), e.g. MFREE_SHUF(a, b, 0, 4, 2, 6).
+#if defined(__clang__)
+#define MFREE_SHUF(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+#define MFREE_SHUF(a, b, i, j, k, l) __builtin_shuffle(a, b, ::mfree::simd::I4{i, j, k, l})
+#endif
+
+// {lo, hi}: two V2 into one V4 (in the AVX2 copy one vinsertf128, from memory when lo
+// and hi were just loaded).
+MFREE_ALWAYS_INLINE void concat(V4 &v, const V2 &lo, const V2 &hi) {
+#if defined(__clang__) || __GNUC__ >= 12
+  v = __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
+#else
+  v = V4{lo[0], lo[1], hi[0], hi[1]};
+#endif
+}
+
+// The sum of the lanes, in the one order of every horizontal sum: (v0 + v1) + (v2 + v3).
+MFREE_ALWAYS_INLINE double hsum(const V4 &v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+// r[k] = hsum(v_k) for four vectors at once (bitwise the same sums as hsum).
+MFREE_ALWAYS_INLINE void hsum4(const V4 &a, const V4 &b, const V4 &c, const V4 &d, double *r) {
+  const V4 ab = MFREE_SHUF(a, b, 0, 4, 2, 6) + MFREE_SHUF(a, b, 1, 5, 3, 7);  // a01 b01 a23 b23
+  const V4 cd = MFREE_SHUF(c, d, 0, 4, 2, 6) + MFREE_SHUF(c, d, 1, 5, 3, 7);
+  const V4 s = MFREE_SHUF(ab, cd, 0, 1, 4, 5) + MFREE_SHUF(ab, cd, 2, 3, 6, 7);
+  std::memcpy(r, &s, sizeof(V4));
+}
+
 // v = {v1, v2, v3, v0}: lanes 1-3 down to 0-2.
 MFREE_ALWAYS_INLINE void rotate_down(V4 &v) {
 #if defined(__clang__)
@@ -138,6 +167,31 @@ MFREE_ALWAYS_INLINE double lane(double v, int) { return v; }
 #if MFREE_SIMD_X86
 // Clears the upper halves of the vector registers (vzeroupper); call only in AVX2 code.
 #define MFREE_ZERO_UPPER() __builtin_ia32_vzeroupper()
+
+// What the vector extensions cannot say, for the AVX2 copies only (defined in the region:
+// a call from baseline code does not compile): the square root of a vector, a
+// comparison's sign bits gathered into an int, a byte shuffle by indices known only at
+// run time (Clang's extensions have none) and a masked load (the lanes it skips are
+// never read, so they may lie past the end of an array).
+MFREE_AVX2_BEGIN
+namespace x86 {
+typedef char B16 __attribute__((vector_size(16)));
+typedef int I8 __attribute__((vector_size(32)));
+MFREE_ALWAYS_INLINE V4 sqrt(const V4 &x) { return __builtin_ia32_sqrtpd256(x); }
+// Bit k set when lane k of the comparison result m of two V4 is true.
+template <class M>
+MFREE_ALWAYS_INLINE int movemask(const M &m) {
+  static_assert(sizeof(M) == sizeof(V4), "a comparison of two V4");
+  return __builtin_ia32_movmskpd256((V4)m);
+}
+// r[i] = v[idx[i]], or 0 where idx[i] has its top bit set (pshufb).
+MFREE_ALWAYS_INLINE B16 shuffle_bytes(const B16 &v, const B16 &idx) { return __builtin_ia32_pshufb128(v, idx); }
+// The lanes of p where mask has its top bit set, 0 elsewhere.
+MFREE_ALWAYS_INLINE I8 maskload(const int32_t *p, const I8 &mask) {
+  return __builtin_ia32_maskloadd256(reinterpret_cast<const I8 *>(p), mask);
+}
+}  // namespace x86
+MFREE_AVX2_END
 #endif
 
 // True when the AVX2 + FMA copies may run: the CPU has both (and the OS saves the YMM

@@ -224,25 +224,56 @@ MFREE_ALWAYS_INLINE bool inverse2(const double (&A)[2][2], double (&X)[2][2], do
   return cond <= 1.0 / kMinRcond;  // false for inf and NaN (a zero determinant)
 }
 
+// The adjugate C of a 3x3 matrix (A C = det(A) I); returns det(A), expanded along the
+// first row.
+MFREE_ALWAYS_INLINE double adjugate3(const double (&A)[3][3], double (&C)[3][3]) {
+  C[0][0] = A[1][1] * A[2][2] - A[1][2] * A[2][1];
+  C[1][0] = A[1][2] * A[2][0] - A[1][0] * A[2][2];
+  C[2][0] = A[1][0] * A[2][1] - A[1][1] * A[2][0];
+  C[0][1] = A[0][2] * A[2][1] - A[0][1] * A[2][2];
+  C[1][1] = A[0][0] * A[2][2] - A[0][2] * A[2][0];
+  C[2][1] = A[0][1] * A[2][0] - A[0][0] * A[2][1];
+  C[0][2] = A[0][1] * A[1][2] - A[0][2] * A[1][1];
+  C[1][2] = A[0][2] * A[1][0] - A[0][0] * A[1][2];
+  C[2][2] = A[0][0] * A[1][1] - A[0][1] * A[1][0];
+  return A[0][0] * C[0][0] + A[0][1] * C[1][0] + A[0][2] * C[2][0];
+}
+
+// The 3x3 inverse of a symmetric A in closed form (adjugate over determinant), with
+// spd_inverse's verdict and condition number: positive definite by the leading minors
+// (Sylvester; the LDL^T pivots up to rounding), cond = ||A||_1 ||A^-1||_1 exactly. That is
+// the whole condition rule here: for symmetric A the pivot ratio of LDL^T is at most the
+// 2-norm condition number (the pivots lie between the extreme eigenvalues), which is at
+// most the 1-norm one. False when A is not positive definite or the rule fails.
+MFREE_ALWAYS_INLINE bool spd_inverse3(const double (&A)[3][3], double (&X)[3][3], double &cond) {
+  double C[3][3];
+  const double det = adjugate3(A, C);
+  cond = 1.0;
+  if (!(A[0][0] > 0.0 && C[2][2] > 0.0 && det > 0.0)) return false;
+  const double id = 1.0 / det;
+  cond = norm1<3>(A) * norm1<3>(C) * id;
+  if (!(std::isfinite(cond) && cond > 0.0 && 1.0 / cond >= kMinRcond)) return false;
+  MFREE_UNROLL
+  for (int a = 0; a < 3; ++a) {
+    MFREE_UNROLL
+    for (int b = 0; b < 3; ++b) X[a][b] = C[a][b] * id;
+  }
+  return true;
+}
+
 // The 3x3 inverse in closed form (adjugate over determinant), with gen_inverse's
 // singularity test and condition number: the pivots of partial pivoting (first largest
 // |entry| of the column, in gen_inverse's row order after the swap) from the first
 // column and the 2x2 Schur complement, branch-free; cond = max(||A||_1 ||A^-1||_1,
 // largest / smallest pivot). A zero pivot or determinant gives inf or NaN: false.
 MFREE_ALWAYS_INLINE bool inverse3(const double (&A)[3][3], double (&X)[3][3], double &cond) {
-  const double c00 = A[1][1] * A[2][2] - A[1][2] * A[2][1];
-  const double c01 = A[1][2] * A[2][0] - A[1][0] * A[2][2];
-  const double c02 = A[1][0] * A[2][1] - A[1][1] * A[2][0];
-  const double id = 1.0 / (A[0][0] * c00 + A[0][1] * c01 + A[0][2] * c02);
-  X[0][0] = c00 * id;
-  X[1][0] = c01 * id;
-  X[2][0] = c02 * id;
-  X[0][1] = (A[0][2] * A[2][1] - A[0][1] * A[2][2]) * id;
-  X[1][1] = (A[0][0] * A[2][2] - A[0][2] * A[2][0]) * id;
-  X[2][1] = (A[0][1] * A[2][0] - A[0][0] * A[2][1]) * id;
-  X[0][2] = (A[0][1] * A[1][2] - A[0][2] * A[1][1]) * id;
-  X[1][2] = (A[0][2] * A[1][0] - A[0][0] * A[1][2]) * id;
-  X[2][2] = (A[0][0] * A[1][1] - A[0][1] * A[1][0]) * id;
+  double C[3][3];
+  const double id = 1.0 / adjugate3(A, C);
+  MFREE_UNROLL
+  for (int a = 0; a < 3; ++a) {
+    MFREE_UNROLL
+    for (int b = 0; b < 3; ++b) X[a][b] = C[a][b] * id;
+  }
   // first pivot: row p of the largest |A_i0| (the first on ties); the other two rows in
   // gen_inverse's order after swapping rows 0 and p: (1, 2), (0, 2) or (1, 0)
   const double a0 = std::fabs(A[0][0]), a1 = std::fabs(A[1][0]), a2 = std::fabs(A[2][0]);

@@ -24,10 +24,6 @@
 #include "core/shape/local.hpp"
 #include "core/shape/shape_fast_mls1.hpp"
 
-#if MFREE_SIMD_X86
-#include <immintrin.h>
-#endif
-
 // Loops over the neighbours of a site: vectorised even at -O2 when OpenMP is on (the
 // simd loops carry no dependence between neighbours); loops of compile-time length over
 // monomials and small matrices: unrolled, so that their indices fold and the
@@ -47,26 +43,18 @@
 #endif
 #define MFREE_UNROLL _Pragma("GCC unroll 64")
 
-// Four neighbours at a time in GCC/Clang vector extensions: AVX2 registers in the AVX2
-// copy, pairs of SSE2 (or NEON) registers in the baseline one. Only in locals, never
-// passed by value (whose ABI would differ between the copies).
-#if defined(__GNUC__) || defined(__clang__)
-#define MFREE_VEC4 1
-typedef double V4 __attribute__((vector_size(32)));
-// Lane shuffles of two V4 (indices 0-3: the first, 4-7: the second).
-typedef long long I4 __attribute__((vector_size(32)));
-#if defined(__clang__)
-#define MFREE_SHUF(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
-#else
-#define MFREE_SHUF(a, b, i, j, k, l) __builtin_shuffle(a, b, I4{i, j, k, l})
-#endif
-#else
-#define MFREE_VEC4 0
-#endif
+// Four neighbours at a time in GCC/Clang vector extensions (simd.hpp): AVX2 registers in
+// the AVX2 copy, pairs of SSE2 (or NEON) registers in the baseline one.
+#define MFREE_VEC4 MFREE_VECTOR_EXTENSIONS
 
 namespace mfree {
 
 namespace {
+
+#if MFREE_VEC4
+using simd::I4;
+using simd::V4;
+#endif
 
 // The row kernels, compiled for the baseline target and, on x86-64 with GCC or Clang,
 // once more for AVX2 + FMA; FastPath picks one copy per call from the CPU (simd.hpp),
@@ -89,7 +77,7 @@ template <int D, class Kern>
 void block_fn_ret(const FastPath &fp, const FastTables &t, int64_t b, int64_t e, FastScratch &w,
                   const FastSites &out) {
   block_fn<D, Kern>(fp, t, b, e, w, out);
-  _mm256_zeroupper();
+  MFREE_ZERO_UPPER();
 }
 }  // namespace avx2
 MFREE_AVX2_END
