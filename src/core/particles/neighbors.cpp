@@ -47,10 +47,6 @@
 #include "core/particles/particles.hpp"
 #include "core/base/simd.hpp"
 
-#if MFREE_SIMD_X86
-#include <immintrin.h>
-#endif
-
 #include "core/particles/neighbors_cell_grid.inc"
 #include "core/particles/neighbors_cell_grid_scan.inc"
 
