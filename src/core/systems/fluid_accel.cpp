@@ -7,14 +7,12 @@
 #include "core/base/simd.hpp"
 #include "core/systems/fluid.hpp"
 
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
-#if MFREE_SIMD_X86
-#include <immintrin.h>
-#endif
-
 namespace mfree {
+
+#if MFREE_VECTOR_EXTENSIONS
+using simd::V2;
+using simd::V4;
+#endif
 
 void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, double *drho) const {
   v = node_velocities(v);
@@ -34,22 +32,21 @@ void FluidSystem::kinematics(const double *v, const double *rho, double *vhat, d
       double vh[3] = {0, 0, 0}, div = 0.0;
       if (dim == 2) {
         // independent sums (one chain through div was the bottleneck): v0 += N a0,
-        // v1 += N a1, d0 += a0 G0, d1 += a1 G1, in SSE2 pairs where there (same operations)
+        // v1 += N a1, d0 += a0 G0, d1 += a1 G1, in pairs where there (same operations)
         double v0 = 0, v1 = 0, d0 = 0, d1 = 0;
-#ifdef __SSE2__
-        __m128d vv = _mm_setzero_pd(), dd = _mm_setzero_pd();
+#if MFREE_VECTOR_EXTENSIONS
+        V2 vv = {}, dd = {};
         for (int64_t q = rb[k]; q < re[k]; ++q) {
-          const __m128d a = _mm_loadu_pd(v + static_cast<size_t>(cols[q]) * 2);
-          vv = _mm_add_pd(vv, _mm_mul_pd(_mm_set1_pd(N[q]), a));
-          dd = _mm_add_pd(dd, _mm_mul_pd(a, _mm_loadu_pd(G + 2 * q)));
+          V2 a, g;
+          simd::load<2>(a, v + static_cast<size_t>(cols[q]) * 2);
+          simd::load<2>(g, G + 2 * q);
+          vv += N[q] * a;
+          dd += a * g;
         }
-        double t[4];
-        _mm_storeu_pd(t, vv);
-        _mm_storeu_pd(t + 2, dd);
-        v0 = t[0];
-        v1 = t[1];
-        d0 = t[2];
-        d1 = t[3];
+        v0 = vv[0];
+        v1 = vv[1];
+        d0 = dd[0];
+        d1 = dd[1];
 #else
         for (int64_t q = rb[k]; q < re[k]; ++q) {
           const double *vj = v + static_cast<size_t>(cols[q]) * 2;
@@ -166,27 +163,24 @@ void FluidSystem::accel_point(int64_t k, const AccelArgs &arg) {
   // interpolated velocity and velocity gradient L_ab = sum_j v_j,a dN_j/dx_b at x_k
   double vh[D] = {}, L[D][D] = {};
   if constexpr (D == 2) {
-    // six independent sums (the vectoriser's pairing made one dependent chain), in SSE2
+    // six independent sums (the vectoriser's pairing made one dependent chain), in
     // pairs where there: (v0, v1) += N a, (l00, l10) += a g0, (l01, l11) += a g1
     double v0 = 0, v1 = 0, l00 = 0, l01 = 0, l10 = 0, l11 = 0;
-#ifdef __SSE2__
-    __m128d vv = _mm_setzero_pd(), c0 = _mm_setzero_pd(), c1 = _mm_setzero_pd();
+#if MFREE_VECTOR_EXTENSIONS
+    V2 vv = {}, c0 = {}, c1 = {};
     for (int64_t q = q0; q < q1; ++q) {
-      const __m128d a = _mm_loadu_pd(v + static_cast<size_t>(cols[q]) * 2);
-      vv = _mm_add_pd(vv, _mm_mul_pd(_mm_set1_pd(N[q]), a));
-      c0 = _mm_add_pd(c0, _mm_mul_pd(a, _mm_set1_pd(G[2 * q])));
-      c1 = _mm_add_pd(c1, _mm_mul_pd(a, _mm_set1_pd(G[2 * q + 1])));
+      V2 a;
+      simd::load<2>(a, v + static_cast<size_t>(cols[q]) * 2);
+      vv += N[q] * a;
+      c0 += a * G[2 * q];
+      c1 += a * G[2 * q + 1];
     }
-    double t[6];
-    _mm_storeu_pd(t, vv);
-    _mm_storeu_pd(t + 2, c0);
-    _mm_storeu_pd(t + 4, c1);
-    v0 = t[0];
-    v1 = t[1];
-    l00 = t[2];
-    l10 = t[3];
-    l01 = t[4];
-    l11 = t[5];
+    v0 = vv[0];
+    v1 = vv[1];
+    l00 = c0[0];
+    l10 = c0[1];
+    l01 = c1[0];
+    l11 = c1[1];
 #else
     for (int64_t q = q0; q < q1; ++q) {
       const double *vj = v + static_cast<size_t>(cols[q]) * 2;
@@ -220,15 +214,17 @@ void FluidSystem::accel_point(int64_t k, const AccelArgs &arg) {
   const double(&S)[D][D] = pt.S;
   const double Mk = pt.Mk, Lk = pt.Lk, *F = pt.F;
   // the row's terms to its nodes i: -sigma_k V_k grad N_i(x_k), N_i(x_k) M_k (003 eq 56)
-#ifdef __SSE2__
+#if MFREE_VECTOR_EXTENSIONS
   if constexpr (D == 2) {  // the same operations in the same order, two lanes at a time
-    const __m128d s0 = _mm_setr_pd(S[0][0], S[1][0]), s1 = _mm_setr_pd(S[0][1], S[1][1]);
-    const __m128d ml = _mm_setr_pd(Mk, Lk);
+    const V2 s0 = {S[0][0], S[1][0]}, s1 = {S[0][1], S[1][1]}, ml = {Mk, Lk};
     for (int64_t q = q0; q < q1; ++q) {
       double *ai = acc + static_cast<size_t>(cols[q]) * A;
-      const __m128d sg = _mm_add_pd(_mm_mul_pd(s0, _mm_set1_pd(G[2 * q])), _mm_mul_pd(s1, _mm_set1_pd(G[2 * q + 1])));
-      _mm_storeu_pd(ai, _mm_sub_pd(_mm_loadu_pd(ai), sg));
-      _mm_storeu_pd(ai + 2, _mm_add_pd(_mm_loadu_pd(ai + 2), _mm_mul_pd(_mm_set1_pd(N[q]), ml)));
+      V2 f, m;
+      simd::load<2>(f, ai);
+      simd::load<2>(m, ai + 2);
+      const V2 sg = s0 * G[2 * q] + s1 * G[2 * q + 1];
+      simd::store<2>(ai, f - sg);
+      simd::store<2>(ai + 2, m + N[q] * ml);
     }
   } else
 #endif
@@ -270,10 +266,13 @@ Report FluidSystem::accel_end(const AccelArgs &aa, double *a) {
         continue;
       }
       // the boundary force acts as an acceleration (003 Sect. 6.1 step 7)
-#ifdef __SSE2__
+#if MFREE_VECTOR_EXTENSIONS
       if constexpr (D == 2) {  // both components in one division (the same operations)
-        const __m128d f = _mm_add_pd(_mm_loadu_pd(ai), _mm_mul_pd(_mm_set1_pd(ai[D]), _mm_loadu_pd(g_)));
-        _mm_storeu_pd(a + i * D, _mm_add_pd(_mm_div_pd(f, _mm_set1_pd(m)), _mm_loadu_pd(ai + D + 2)));
+        V2 f, g, w;
+        simd::load<2>(f, ai);
+        simd::load<2>(g, g_);
+        simd::load<2>(w, ai + D + 2);
+        simd::store<2>(a + i * D, (f + ai[D] * g) / m + w);
         continue;
       }
 #endif
@@ -295,32 +294,38 @@ Report FluidSystem::accel_end(const AccelArgs &aa, double *a) {
 MFREE_AVX2_BEGIN
 namespace {
 
-// sum of the four lanes of each of a, b, c, d: (sum a, sum b, sum c, sum d)
-MFREE_TARGET_AVX2 MFREE_ALWAYS_INLINE __m256d hsum4(__m256d a, __m256d b, __m256d c, __m256d d) {
-  const __m256d ab = _mm256_hadd_pd(a, b), cd = _mm256_hadd_pd(c, d);  // (a01, b01, a23, b23), ...
-  return _mm256_add_pd(_mm256_permute2f128_pd(ab, cd, 0x20), _mm256_permute2f128_pd(ab, cd, 0x31));
+// p[0..3] += u.
+MFREE_ALWAYS_INLINE void add4(double *p, const V4 &u) {
+  V4 r;
+  simd::load<4>(r, p);
+  simd::store<4>(p, r + u);
 }
 
 // Table entries q .. q + 3 of a 2D row in registers, lanes in the order (q, q + 2, q + 1,
 // q + 3) that the in-lane unpacks of interleaved pairs give: velocities (vx, vy) of the
 // columns, values N and gradients (gx, gy).
 struct Entries4 {
-  __m256d vx, vy, n, gx, gy;
+  V4 vx, vy, n, gx, gy;
 };
-MFREE_ALWAYS_INLINE Entries4 entries4(const double *v, const int32_t *cols, const double *N, const double *G, int64_t q) {
-  Entries4 e;
+MFREE_ALWAYS_INLINE void entries4(const double *v, const int32_t *cols, const double *N, const double *G, int64_t q,
+                                  Entries4 &e) {
   const int32_t *c = cols + q;
-  const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(v + 2 * static_cast<size_t>(c[0]))),
-                                          _mm_loadu_pd(v + 2 * static_cast<size_t>(c[1])), 1);  // v0 | v1
-  const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(v + 2 * static_cast<size_t>(c[2]))),
-                                          _mm_loadu_pd(v + 2 * static_cast<size_t>(c[3])), 1);  // v2 | v3
-  e.vx = _mm256_unpacklo_pd(lo, hi);  // (v0x, v2x, v1x, v3x)
-  e.vy = _mm256_unpackhi_pd(lo, hi);
-  e.n = _mm256_permute4x64_pd(_mm256_loadu_pd(N + q), 0xD8);  // (N0, N2, N1, N3)
-  const __m256d g01 = _mm256_loadu_pd(G + 2 * q), g23 = _mm256_loadu_pd(G + 2 * q + 4);
-  e.gx = _mm256_unpacklo_pd(g01, g23);  // (g0x, g2x, g1x, g3x)
-  e.gy = _mm256_unpackhi_pd(g01, g23);
-  return e;
+  V2 v0, v1, v2, v3;
+  simd::load<2>(v0, v + 2 * static_cast<size_t>(c[0]));
+  simd::load<2>(v1, v + 2 * static_cast<size_t>(c[1]));
+  simd::load<2>(v2, v + 2 * static_cast<size_t>(c[2]));
+  simd::load<2>(v3, v + 2 * static_cast<size_t>(c[3]));
+  V4 lo, hi, n, g01, g23;
+  simd::concat(lo, v0, v1);  // v0 | v1
+  simd::concat(hi, v2, v3);  // v2 | v3
+  e.vx = MFREE_SHUF(lo, hi, 0, 4, 2, 6);  // (v0x, v2x, v1x, v3x)
+  e.vy = MFREE_SHUF(lo, hi, 1, 5, 3, 7);
+  simd::load<4>(n, N + q);
+  e.n = MFREE_SHUF(n, n, 0, 2, 1, 3);  // (N0, N2, N1, N3)
+  simd::load<4>(g01, G + 2 * q);
+  simd::load<4>(g23, G + 2 * q + 4);
+  e.gx = MFREE_SHUF(g01, g23, 0, 4, 2, 6);  // (g0x, g2x, g1x, g3x)
+  e.gy = MFREE_SHUF(g01, g23, 1, 5, 3, 7);
 }
 
 }  // namespace
@@ -335,23 +340,24 @@ void FluidSystem::accel_rows2_avx2(int64_t k0, int64_t k1, const AccelArgs &arg)
   const int32_t *cols = cols_;
   const double *N = N_.data(), *G = G_.data();
   double *acc = acc_.data();
-  const __m256d zero = _mm256_setzero_pd();
+  const V4 zero = {};
   for (int64_t k = k0; k < k1; ++k) {
     const int64_t q0 = rb_[k], q1 = re_[k];
-    __m256d sv0 = zero, sv1 = zero, s00 = zero, s01 = zero, s10 = zero, s11 = zero;
+    V4 sv0 = {}, sv1 = {}, s00 = {}, s01 = {}, s10 = {}, s11 = {};
     int64_t q = q0;
     for (; q + 4 <= q1; q += 4) {
-      const Entries4 e = entries4(v, cols, N, G, q);
-      sv0 = _mm256_fmadd_pd(e.n, e.vx, sv0);
-      sv1 = _mm256_fmadd_pd(e.n, e.vy, sv1);
-      s00 = _mm256_fmadd_pd(e.vx, e.gx, s00);
-      s01 = _mm256_fmadd_pd(e.vx, e.gy, s01);
-      s10 = _mm256_fmadd_pd(e.vy, e.gx, s10);
-      s11 = _mm256_fmadd_pd(e.vy, e.gy, s11);
+      Entries4 e;
+      entries4(v, cols, N, G, q, e);
+      sv0 += e.n * e.vx;
+      sv1 += e.n * e.vy;
+      s00 += e.vx * e.gx;
+      s01 += e.vx * e.gy;
+      s10 += e.vy * e.gx;
+      s11 += e.vy * e.gy;
     }
     double t[8];
-    _mm256_storeu_pd(t, hsum4(sv0, sv1, s00, s01));
-    _mm256_storeu_pd(t + 4, hsum4(s10, s11, zero, zero));
+    simd::hsum4(sv0, sv1, s00, s01, t);
+    simd::hsum4(s10, s11, zero, zero, t + 4);
     double vh[2] = {t[0], t[1]}, L[2][2] = {{t[2], t[3]}, {t[4], t[5]}};
     for (; q < q1; ++q) {
       const double *vj = v + static_cast<size_t>(cols[q]) * 2;
@@ -366,26 +372,30 @@ void FluidSystem::accel_rows2_avx2(int64_t k0, int64_t k1, const AccelArgs &arg)
     PointTerms<2> pt;
     point_terms<2>(k, arg, vh, L, pt);
     // the row's terms to its nodes i: -sigma_k V_k grad N_i(x_k), N_i(x_k) M_k (003 eq 56)
-    const __m256d n00 = _mm256_set1_pd(-pt.S[0][0]), n01 = _mm256_set1_pd(-pt.S[0][1]);
-    const __m256d n10 = _mm256_set1_pd(-pt.S[1][0]), n11 = _mm256_set1_pd(-pt.S[1][1]);
-    const __m256d mk = _mm256_set1_pd(pt.Mk), lk = _mm256_set1_pd(pt.Lk);
+    const double n00 = -pt.S[0][0], n01 = -pt.S[0][1], n10 = -pt.S[1][0], n11 = -pt.S[1][1];
+    const double mk = pt.Mk, lk = pt.Lk;
     q = q0;
     for (; q + 4 <= q1; q += 4) {
       const int32_t *c = cols + q;
-      const __m256d nq = _mm256_permute4x64_pd(_mm256_loadu_pd(N + q), 0xD8);
-      const __m256d g01 = _mm256_loadu_pd(G + 2 * q), g23 = _mm256_loadu_pd(G + 2 * q + 4);
-      const __m256d gx = _mm256_unpacklo_pd(g01, g23), gy = _mm256_unpackhi_pd(g01, g23);
-      const __m256d fx = _mm256_fmadd_pd(n00, gx, _mm256_mul_pd(n01, gy));
-      const __m256d fy = _mm256_fmadd_pd(n10, gx, _mm256_mul_pd(n11, gy));
-      const __m256d cm = _mm256_mul_pd(nq, mk), cl = _mm256_mul_pd(nq, lk);
-      const __m256d t0 = _mm256_unpacklo_pd(fx, fy), t1 = _mm256_unpackhi_pd(fx, fy);  // entries 0 | 1, 2 | 3
-      const __m256d t2 = _mm256_unpacklo_pd(cm, cl), t3 = _mm256_unpackhi_pd(cm, cl);
+      V4 nq, g01, g23;
+      simd::load<4>(nq, N + q);
+      nq = MFREE_SHUF(nq, nq, 0, 2, 1, 3);  // (N0, N2, N1, N3)
+      simd::load<4>(g01, G + 2 * q);
+      simd::load<4>(g23, G + 2 * q + 4);
+      const V4 gx = MFREE_SHUF(g01, g23, 0, 4, 2, 6), gy = MFREE_SHUF(g01, g23, 1, 5, 3, 7);
+      const V4 fx = n00 * gx + n01 * gy, fy = n10 * gx + n11 * gy;
+      const V4 cm = nq * mk, cl = nq * lk;
+      // entries 0 | 1 and 2 | 3 of (fx, fy) and of (cm, cl), then one 4-double row each
+      const V4 t0 = MFREE_SHUF(fx, fy, 0, 4, 2, 6), t1 = MFREE_SHUF(fx, fy, 1, 5, 3, 7);
+      const V4 t2 = MFREE_SHUF(cm, cl, 0, 4, 2, 6), t3 = MFREE_SHUF(cm, cl, 1, 5, 3, 7);
       double *a0 = acc + static_cast<size_t>(c[0]) * A, *a1 = acc + static_cast<size_t>(c[1]) * A;
       double *a2 = acc + static_cast<size_t>(c[2]) * A, *a3 = acc + static_cast<size_t>(c[3]) * A;
-      _mm256_storeu_pd(a0, _mm256_add_pd(_mm256_loadu_pd(a0), _mm256_permute2f128_pd(t0, t2, 0x20)));
-      _mm256_storeu_pd(a1, _mm256_add_pd(_mm256_loadu_pd(a1), _mm256_permute2f128_pd(t0, t2, 0x31)));
-      _mm256_storeu_pd(a2, _mm256_add_pd(_mm256_loadu_pd(a2), _mm256_permute2f128_pd(t1, t3, 0x20)));
-      _mm256_storeu_pd(a3, _mm256_add_pd(_mm256_loadu_pd(a3), _mm256_permute2f128_pd(t1, t3, 0x31)));
+      // one node after the other (a node may appear twice in a group: each update reads
+      // the one before)
+      add4(a0, MFREE_SHUF(t0, t2, 0, 1, 4, 5));
+      add4(a1, MFREE_SHUF(t0, t2, 2, 3, 6, 7));
+      add4(a2, MFREE_SHUF(t1, t3, 0, 1, 4, 5));
+      add4(a3, MFREE_SHUF(t1, t3, 2, 3, 6, 7));
     }
     for (; q < q1; ++q) {
       double *ai = acc + static_cast<size_t>(cols[q]) * A;
@@ -409,20 +419,20 @@ void FluidSystem::kinematics2_avx2(int64_t k0, int64_t k1, const double *v, cons
                                    double *drho) const {
   const int32_t *cols = cols_;
   const double *N = N_.data(), *G = G_.data();
-  const __m256d zero = _mm256_setzero_pd();
   for (int64_t k = k0; k < k1; ++k) {
     const int64_t q0 = rb_[k], q1 = re_[k];
-    __m256d sv0 = zero, sv1 = zero, d0 = zero, d1 = zero;
+    V4 sv0 = {}, sv1 = {}, d0 = {}, d1 = {};
     int64_t q = q0;
     for (; q + 4 <= q1; q += 4) {
-      const Entries4 e = entries4(v, cols, N, G, q);
-      sv0 = _mm256_fmadd_pd(e.n, e.vx, sv0);
-      sv1 = _mm256_fmadd_pd(e.n, e.vy, sv1);
-      d0 = _mm256_fmadd_pd(e.vx, e.gx, d0);
-      d1 = _mm256_fmadd_pd(e.vy, e.gy, d1);
+      Entries4 e;
+      entries4(v, cols, N, G, q, e);
+      sv0 += e.n * e.vx;
+      sv1 += e.n * e.vy;
+      d0 += e.vx * e.gx;
+      d1 += e.vy * e.gy;
     }
     double t[4];
-    _mm256_storeu_pd(t, hsum4(sv0, sv1, d0, d1));
+    simd::hsum4(sv0, sv1, d0, d1, t);
     for (; q < q1; ++q) {
       const double *vj = v + static_cast<size_t>(cols[q]) * 2;
       t[0] += N[q] * vj[0];
