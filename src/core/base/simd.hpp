@@ -194,13 +194,15 @@ MFREE_ALWAYS_INLINE I8 maskload(const int32_t *p, const I8 &mask) {
 MFREE_AVX2_END
 #endif
 
-// True when the AVX2 + FMA copies may run: the CPU has both (and the OS saves the YMM
-// state, which __builtin_cpu_supports checks) and MFREE_SIMD is not "baseline".
+// True when the AVX2 + FMA copies may run: the running call is on the optimised backend
+// (the reference backend runs the baseline copies of every kernel that has no reference
+// path of its own: the fluid, the neighbour search), the CPU has both (and the OS saves
+// the YMM state, which __builtin_cpu_supports checks) and MFREE_SIMD is not "baseline".
 // Cheap enough to ask once per setup/update/apply (the CPU model is read once by the
 // compiler runtime; the override is one scan of the environment).
 inline bool use_avx2() {
 #if MFREE_SIMD_X86
-  if (env::simd_baseline()) return false;
+  if (!optimised() || env::simd_baseline()) return false;
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 #else
