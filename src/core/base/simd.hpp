@@ -168,8 +168,9 @@ MFREE_ALWAYS_INLINE double lane(double v, int) { return v; }
 // Clears the upper halves of the vector registers (vzeroupper); call only in AVX2 code.
 #define MFREE_ZERO_UPPER() __builtin_ia32_vzeroupper()
 
-// What the vector extensions cannot say, for the AVX2 copies only (defined in the region:
-// a call from baseline code does not compile): the square root of a vector, a
+// What the vector extensions cannot say (or GCC does not compile to one instruction), for
+// the AVX2 copies only (defined in the region: a call from baseline code does not
+// compile): the square root and the minimum of a vector, a
 // comparison's sign bits gathered into an int, a byte shuffle by indices known only at
 // run time (Clang's extensions have none) and a masked load (the lanes it skips are
 // never read, so they may lie past the end of an array).
@@ -178,6 +179,9 @@ namespace x86 {
 typedef char B16 __attribute__((vector_size(16)));
 typedef int I8 __attribute__((vector_size(32)));
 MFREE_ALWAYS_INLINE V4 sqrt(const V4 &x) { return __builtin_ia32_sqrtpd256(x); }
+// a < b ? a : b lane by lane in one instruction (GCC compiles the select to a compare and
+// a blend).
+MFREE_ALWAYS_INLINE V4 min(const V4 &a, const V4 &b) { return __builtin_ia32_minpd256(a, b); }
 // Bit k set when lane k of the comparison result m of two V4 is true.
 template <class M>
 MFREE_ALWAYS_INLINE int movemask(const M &m) {
