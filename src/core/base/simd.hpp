@@ -70,14 +70,6 @@
 #define MFREE_AVX2_END
 #endif
 
-// Per-function target attribute: kept only for the fluid's kernels written before the one
-// style (systems/fluid_*.cpp); new code uses the region above.
-#if MFREE_SIMD_X86
-#define MFREE_TARGET_AVX2 __attribute__((target("avx2,fma")))
-#else
-#define MFREE_TARGET_AVX2
-#endif
-
 namespace mfree {
 namespace simd {
 
