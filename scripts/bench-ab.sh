@@ -90,8 +90,10 @@ if [ "$callgrind" = 1 ]; then
         "$ab/driver" "$ab/case-$side.so" 1 "${cw[@]}" >"$ab/cg-$side.log" 2>&1 &
     done
     wait
-    n_old="$(callgrind_annotate "$ab/cg-old.out" | awk '/PROGRAM TOTALS/ {gsub(",", "", $1); print $1; exit}')"
-    n_new="$(callgrind_annotate "$ab/cg-new.out" | awk '/PROGRAM TOTALS/ {gsub(",", "", $1); print $1; exit}')"
+    # the total from the profile's summary line (an early exit of a reader of
+    # callgrind_annotate's output killed it by SIGPIPE, and set -o pipefail the script)
+    n_old="$(awk '/^summary:/ {print $2}' "$ab/cg-old.out")"
+    n_new="$(awk '/^summary:/ {print $2}' "$ab/cg-new.out")"
     [ -n "$n_old" ] && [ -n "$n_new" ] || die "callgrind failed, see $ab/cg-*.log"
     awk -v c="$c" -v a="$n_old" -v b="$n_new" 'BEGIN { printf("| %s | %.4g | %.4g | %.4f |\n", c, a, b, b / a) }'
   done
