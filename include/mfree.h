@@ -2116,6 +2116,48 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
     mfree_context_t *ctx, mfree_assembler_t *as, double density, mfree_exchange_fn exchange,
     mfree_allgather_fn allgather, void *user, mfree_system_t **sys);
 
+/**
+ * The Galerkin SPH fluid (mfree_system_create_fluid, paper 003) on one rank of several:
+ * the system's particles are this rank's n_owned owned particles and n_ghost ghosts, in
+ * the host's order (owned first), with their global ids; the ghosts must hold every
+ * particle within width of an owned particle, and width must reach two support radii
+ * (2 R h: an owned particle's terms come from the rows of its neighbours, which need
+ * their own neighbours). The per-particle setters (mfree_system_set_fluid,
+ * mfree_system_set_masses) take the n_owned + n_ghost items in the host's order; the
+ * state y of this rank holds its owned particles only (positions, velocities, densities
+ * of the owned items: neq = (2 dim + 1) n_owned). Every right-hand side and native step
+ * is collective: it exchanges the ghosts' states through exchange and agrees on the
+ * status and the step limit through allgather. The rows, their sums and the assembly of
+ * the forces run in global-id order, so that every owned particle's position, velocity
+ * and density are bitwise those of the same system on one rank, whatever the partition
+ * (the one-process mfree_system_create_fluid sums the forces in another order).
+ * The halo is checked at every evaluation against the owned particles' displacements
+ * since the first: when the layer may miss a particle, every rank returns
+ * MFREE_ERR_HALO (rebuild the halo and the system). A failure on one rank (a non-finite
+ * state: MFREE_FAIL_NONFINITE) is returned by every rank with that rank's message
+ * ("rank R: ..."). Leap-frog only (the predictor-corrector: MFREE_ERR_UNSUPPORTED); no
+ * dummy particles, density diffusion, consistent integration or velocity smoothing, and
+ * no pressure, velocity, wall-force, mass or interpolation output on ranks yet
+ * (MFREE_ERR_UNSUPPORTED). Creation is collective: bad input on one rank, or ranks that
+ * disagree on dim or width, make every rank fail alike.
+ * libmfree_mpi's mfree_halo_create_fluid supplies the callbacks from a halo plan.
+ * @param[in]  ctx         context (kept alive); NULL: MFREE_ERR_NULL on this rank alone
+ * @param[in]  dim         2 or 3, the same on every rank
+ * @param[in]  n_owned     owned particles on this rank (>= 0)
+ * @param[in]  n_ghost     ghosts on this rank (>= 0)
+ * @param[in]  global_ids  n_owned + n_ghost distinct ids >= 0, owned first (copied)
+ * @param[in]  width       depth of the ghost layer (> 0, the same on every rank)
+ * @param[in]  exchange    the forward halo exchange (NULL: MFREE_ERR_NULL, local)
+ * @param[in]  allgather   the all-gather (NULL: MFREE_ERR_NULL, local)
+ * @param[in]  user        passed to both callbacks; kept
+ * @param[out] sys         the new system (NULL: MFREE_ERR_NULL, local)
+ * @return MFREE_SUCCESS, or a failure named with the parameters, alike on every rank
+ */
+MFREE_API mfree_status_t mfree_system_create_fluid_ranks(
+    mfree_context_t *ctx, int32_t dim, int32_t n_owned, int32_t n_ghost,
+    const int64_t *global_ids, double width, mfree_exchange_fn exchange,
+    mfree_allgather_fn allgather, void *user, mfree_system_t **sys);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,5 +1,6 @@
 #include "core/systems/elastodynamics.hpp"
 #include "core/systems/fluid.hpp"
+#include "core/systems/fluid_ranks.hpp"
 #include "handles.hpp"
 
 struct mfree_system {
@@ -28,6 +29,14 @@ const T &kind(const mfree::System &s, const char *what) {
   return *t;
 }
 
+// The fluid outputs that read the state of every particle of the system: a system on
+// ranks holds its owned particles' state only.
+template <class S>
+S &one_process(S &f, const char *what) {
+  if (f.on_ranks())
+    throw mfree::Error(MFREE_ERR_UNSUPPORTED, std::string("no ") + what + " for the fluid on ranks yet");
+  return f;
+}
 
 // Fill *M (created when NULL) through a core routine that writes a SparseMatrix.
 template <class Fill>
@@ -188,13 +197,14 @@ mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys, const do
   if (sys && !y && sys->sys->neq() > 0)
     return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_interpolation", "y is NULL");
   return fill_matrix(sys, "mfree_system_assemble_interpolation", S, [&](mfree::System &f, mfree::SparseMatrix &m) {
-    return kind<mfree::FluidSystem>(f, "interpolation matrix (not a fluid)").interpolation(y, m);
+    return one_process(kind<mfree::FluidSystem>(f, "interpolation matrix (not a fluid)"), "interpolation matrix")
+        .interpolation(y, m);
   });
 }
 
 mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double *y, double *p) {
   return mfree::with_handle(sys, "mfree_system_get_pressure", [&](const mfree::System &base) {
-    const auto &f = kind<mfree::FluidSystem>(base, "pressure (not a fluid)");
+    const auto &f = one_process(kind<mfree::FluidSystem>(base, "pressure (not a fluid)"), "pressure output");
     MFREE_REQUIRE((y && p) || f.size() == 0, MFREE_ERR_NULL, "y or p is NULL");
     f.pressure(y, p);
     return MFREE_SUCCESS;
@@ -203,7 +213,7 @@ mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double
 
 mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, double *vhat) {
   return mfree::with_handle(sys, "mfree_system_get_velocity", [&](mfree::System &base) {
-    auto &f = kind<mfree::FluidSystem>(base, "interpolated velocity (not a fluid)");
+    auto &f = one_process(kind<mfree::FluidSystem>(base, "interpolated velocity (not a fluid)"), "velocity output");
     MFREE_REQUIRE((y && vhat) || f.size() == 0, MFREE_ERR_NULL, "y or vhat is NULL");
     return mfree::finish(sys->ctx, "mfree_system_get_velocity", f.velocity(y, vhat));
   });
@@ -212,7 +222,7 @@ mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, d
 mfree_status_t mfree_system_get_wall_force(mfree_system_t *sys, const double *y, double *total, int32_t nwall,
                                           double *per_wall) {
   return mfree::with_handle(sys, "mfree_system_get_wall_force", [&](mfree::System &base) {
-    auto &f = kind<mfree::FluidSystem>(base, "wall force (not a fluid)");
+    auto &f = one_process(kind<mfree::FluidSystem>(base, "wall force (not a fluid)"), "wall force output");
     MFREE_REQUIRE(total || per_wall, MFREE_ERR_NULL, "total and per_wall are both NULL");
     MFREE_REQUIRE(y || f.size() == 0, MFREE_ERR_NULL, "y is NULL");
     return mfree::finish(sys->ctx, "mfree_system_get_wall_force", f.wall_force(y, total, nwall, per_wall));
@@ -375,6 +385,26 @@ mfree_status_t mfree_system_get_context(const mfree_system_t *sys, mfree_context
   if (!sys || !ctx) return MFREE_ERR_NULL;
   *ctx = sys->ctx;
   return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_system_create_fluid_ranks(mfree_context_t *ctx, int32_t dim, int32_t n_owned, int32_t n_ghost,
+                                               const int64_t *global_ids, double width, mfree_exchange_fn exchange,
+                                               mfree_allgather_fn allgather, void *user, mfree_system_t **sys) {
+  if (!ctx) return MFREE_ERR_NULL;
+  return mfree::guard(ctx, "mfree_system_create_fluid_ranks", [&]() {
+    // (local failures: without the callbacks or the output no rank can be told)
+    MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
+    *sys = nullptr;
+    MFREE_REQUIRE(exchange && allgather, MFREE_ERR_NULL, "exchange or allgather callback is NULL");
+    auto impl = mfree::FluidRanks::create(dim, n_owned, n_ghost, global_ids, width,
+                                          mfree::Collective(exchange, allgather, user));
+    auto *s = new mfree_system_t();
+    s->ctx = ctx;
+    s->sys = std::move(impl);
+    mfree::retain(ctx);
+    *sys = s;
+    return MFREE_SUCCESS;
+  });
 }
 
 }  // extern "C"

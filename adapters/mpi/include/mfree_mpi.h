@@ -490,6 +490,23 @@ MFREE_MPI_API mfree_status_t mfree_halo_allgather(void *halo, const double *in, 
 MFREE_MPI_API mfree_status_t mfree_halo_create_elastodynamic(mfree_halo_t *halo, mfree_assembler_t *as,
                                                              double density, mfree_system_t **sys);
 
+/**
+ * mfree_system_create_fluid_ranks through this plan: the plan's owned particles and
+ * ghosts, in its order and with its global ids, the ghosts' states by
+ * mfree_halo_exchange, the reductions by mfree_halo_allgather; created on the plan's
+ * context, keeping a pointer to the plan, which must outlive it (destroy the system
+ * first). Collective. The per-particle setters of the system take the plan's
+ * n_owned + n_ghost items (fill the ghosts' masses with mfree_halo_exchange).
+ * @param[in]  halo   a set-up plan
+ * @param[in]  dim    2 or 3 (the plan's dimension)
+ * @param[in]  width  the width the plan was set up with (at least two support radii)
+ * @param[out] sys    the new system
+ * @return as mfree_system_create_fluid_ranks; MFREE_ERR_NULL (local) for a NULL plan or
+ *         output
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_create_fluid(mfree_halo_t *halo, int32_t dim, double width,
+                                                     mfree_system_t **sys);
+
 #ifdef __cplusplus
 }
 #endif

@@ -90,4 +90,20 @@ mfree_status_t mfree_halo_create_elastodynamic(mfree_halo_t *halo, mfree_assembl
                                                  mfree_halo_allgather, halo, sys);
 }
 
+mfree_status_t mfree_halo_create_fluid(mfree_halo_t *halo, int32_t dim, double width, mfree_system_t **sys) {
+  mfree_context_t *ctx = nullptr;
+  if (mfree_halo_get_context(halo, &ctx) != MFREE_SUCCESS || !sys) return MFREE_ERR_NULL;
+  int32_t n_owned = 0, n_ghost = 0;
+  mfree_status_t st = mfree_halo_get_size(halo, &n_owned, &n_ghost);
+  std::vector<int64_t> ids;
+  if (st == MFREE_SUCCESS) {
+    // (a plan that is not set up fails alike on every rank: the ids come from its setup)
+    ids.resize(static_cast<size_t>(n_owned) + n_ghost + 1);
+    st = mfree_halo_get_global_ids(halo, ids.data());
+  }
+  if (st != MFREE_SUCCESS) return st;
+  return mfree_system_create_fluid_ranks(ctx, dim, n_owned, n_ghost, ids.data(), width, mfree_halo_exchange_callback,
+                                         mfree_halo_allgather, halo, sys);
+}
+
 }  // extern "C"

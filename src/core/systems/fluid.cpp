@@ -29,6 +29,7 @@ void FluidSystem::set_fluid(const double *rho0, int64_t stride, double kappa, do
     if (!(std::isfinite(r[i]) && r[i] > 0.0))
       throw Error(MFREE_ERR_INPUT, "rest density of particle " + std::to_string(i) + " must be finite and > 0");
   }
+  to_nodes(r);
   rho0_.swap(r);
   kappa_ = kappa;
   gamma_ = gamma;
@@ -45,6 +46,7 @@ void FluidSystem::set_masses(const double *m, int64_t stride) {
     if (!(std::isfinite(v[i]) && v[i] > 0.0))
       throw Error(MFREE_ERR_INPUT, "mass of particle " + std::to_string(i) + " must be finite and > 0");
   }
+  to_nodes(v);
   mass_.swap(v);
 }
 

@@ -73,7 +73,20 @@ class FluidSystem : public System {
   void outflow_totals(int32_t k, int64_t &count, double &mass) const;
   void options_changed() { if (open_) open_->dirty = true; }  // after every setter
 
+  // On ranks (fluid_ranks.hpp): a FluidRanks numbers its nodes by global id and overrides
+  // these two hooks; the one-process fluid leaves them empty.
+  virtual bool on_ranks() const { return false; }
+
+ protected:
+  // Per-particle parameters given in the host's order (set_fluid, set_masses) into the
+  // nodes' order.
+  virtual void to_nodes(HVec<double> &per_particle) const { (void)per_particle; }
+  // After the rows of a prepare, before their statuses are checked: the rows a rank does
+  // not need are dropped there, and its scatter runs in node order.
+  virtual void rows_done() {}
+
  private:
+  friend class FluidRanks;
   void check_ready() const;
   // Threads for a loop of a few operations per particle (checks, volumes, updates): waking a
   // team and meeting at its barrier cost as much as thousands of such operations, and more

@@ -284,6 +284,7 @@ Report FluidSystem::prepare(const double *y, bool checked) {
     lists_valid_ = false;
     return rep;
   }
+  rows_done();  // (on ranks: drops the rows it does not need)
   for (int32_t k = 0; k < nall; ++k)
     if (site_status_[k] != 0) {  // every fallback failed (Shepard functions need one neighbour)
       rep.fail(static_cast<mfree_status_t>(site_status_[k]),

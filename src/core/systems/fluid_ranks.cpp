@@ -1,0 +1,434 @@
+// The fluid on ranks. A particle's acceleration sums the terms of the quadrature points
+// (the nodes) whose rows hold it, and each such row needs its own neighbours: the rows a
+// rank needs are its owned nodes' and those of the ghosts within one support radius of
+// them, and these are complete when the ghosts reach two radii. The nodes are numbered
+// by global id (owned and ghosts merged), so that every row, every sum over a row and
+// the scatter of the rows' terms (one colour, rows in node order) run in global-id
+// order: an owned particle's results then depend only on its neighbourhood, as on one
+// rank. The rows of ghosts further out are incomplete: they are dropped after each
+// prepare (rows_done), and their nodes' accelerations are never used. The step limit is
+// a minimum over ranks (exact); statuses are agreed through the all-gather, so that
+// every rank returns the same outcome and none waits alone in a collective call.
+#include "core/systems/fluid_ranks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <numeric>
+#include <sstream>
+
+namespace mfree {
+
+namespace {
+
+// The outcome of local work as a report: a rank must reach the next agreement even when
+// its own part failed.
+template <class F>
+Report guarded(F &&f) {
+  Report r;
+  try {
+    r = f();
+  } catch (const Error &e) {
+    r.status = e.status();
+    r.message = e.what();
+  } catch (const std::bad_alloc &) {
+    r.status = MFREE_ERR_ALLOC;
+    r.message = "out of memory";
+  }
+  return r;
+}
+
+int32_t local_count(int32_t n_owned, int32_t n_ghost) {
+  if (n_owned < 0 || n_ghost < 0)
+    throw Error(MFREE_ERR_ARG, "negative particle count (" + std::to_string(n_owned) + " owned, " +
+                                   std::to_string(n_ghost) + " ghosts)");
+  if (n_owned > INT32_MAX - n_ghost) throw Error(MFREE_ERR_ARG, "more than 2^31 - 1 particles on a rank");
+  return n_owned + n_ghost;
+}
+
+}  // namespace
+
+FluidRanks::FluidRanks(int dim, int32_t n_owned, int32_t n_ghost, const int64_t *ids, double width,
+                       const Collective &coll)
+    : FluidSystem(dim, local_count(n_owned, n_ghost)), coll_(coll), n_own_(n_owned), n_ghost_(n_ghost),
+      width_(width) {
+  if (!(std::isfinite(width) && width > 0.0))
+    throw Error(MFREE_ERR_ARG, "the halo width must be finite and > 0, not " + std::to_string(width));
+  const int32_t n = size();
+  if (n > 0 && !ids) throw Error(MFREE_ERR_NULL, "global ids are NULL");
+  std::vector<int32_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return ids[a] < ids[b]; });
+  for (int32_t q = 0; q < n; ++q) {
+    if (ids[order[q]] < 0)
+      throw Error(MFREE_ERR_INPUT, "global id " + std::to_string(ids[order[q]]) + " of item " +
+                                       std::to_string(order[q]) + " is negative");
+    if (q > 0 && ids[order[q]] == ids[order[q - 1]])
+      throw Error(MFREE_ERR_INPUT, "global id " + std::to_string(ids[order[q]]) + " is given twice (items " +
+                                       std::to_string(std::min(order[q], order[q - 1])) + " and " +
+                                       std::to_string(std::max(order[q], order[q - 1])) + ")");
+  }
+  node_.resize(n);
+  gid_.resize(n);
+  is_owned_.assign(n, 0);
+  for (int32_t q = 0; q < n; ++q) {
+    node_[order[q]] = q;
+    gid_[q] = ids[order[q]];
+  }
+  owned_.resize(n_owned);
+  for (int32_t p = 0; p < n_owned; ++p) {
+    owned_[p] = node_[p];
+    is_owned_[node_[p]] = 1;
+  }
+}
+
+std::unique_ptr<FluidRanks> FluidRanks::create(int dim, int32_t n_owned, int32_t n_ghost, const int64_t *ids,
+                                               double width, const Collective &coll) {
+  std::unique_ptr<FluidRanks> sys;
+  const Report mine = guarded([&] {
+    sys.reset(new FluidRanks(dim, n_owned, n_ghost, ids, width, coll));
+    return Report();
+  });
+  const double v[3] = {static_cast<double>(mine.status), static_cast<double>(dim), width};
+  const std::vector<double> all = coll.allgather(v, 3);
+  const size_t np = all.size() / 3;
+  std::vector<double> st(np);
+  for (size_t p = 0; p < np; ++p) st[p] = all[3 * p];
+  const Report agreed = coll.agree_from(st, mine);
+  if (!agreed.ok()) throw Error(agreed.status, agreed.message);
+  static const char *names[3] = {"", "the dimension", "the halo width"};
+  for (size_t p = 1; p < np; ++p)
+    for (int k = 1; k < 3; ++k)
+      if (!(all[3 * p + k] == all[k])) {
+        std::ostringstream s;
+        s.precision(17);
+        s << "ranks disagree on " << names[k] << ": rank 0 passes " << all[k] << ", rank " << p << " passes "
+          << all[3 * p + k] << " (every rank must pass the same)";
+        throw Error(MFREE_ERR_ARG, s.str());
+      }
+  return sys;
+}
+
+void FluidRanks::to_nodes(HVec<double> &a) const {
+  HVec<double> b(a.size());
+  for (size_t p = 0; p < a.size(); ++p) b[node_[p]] = a[p];
+  a.swap(b);
+}
+
+void FluidRanks::rows_done() {
+  const int32_t n = nq();
+  need_.assign(n, 0);
+  for (int32_t k : owned_) {
+    need_[k] = 1;
+    for (int64_t e = rb_[k]; e < re_[k]; ++e) need_[cols_[e]] = 1;
+  }
+  for (int32_t k = 0; k < n; ++k)
+    if (!need_[k]) {
+      re_[k] = rb_[k];
+      site_status_[k] = 0;
+    }
+  const int32_t nch = (n + kChunk - 1) / kChunk;
+  color_ptr_.assign({0, nch});
+  chunk_order_.resize(nch);
+  std::iota(chunk_order_.begin(), chunk_order_.end(), 0);
+  scatter_threads_ = false;
+}
+
+void FluidRanks::load(const double *y) {
+  const int D = dim(), rec = 2 * D + 1;
+  const int32_t n = size();
+  buf_.resize(static_cast<size_t>(n) * rec);
+  const double *x = y, *v = y + static_cast<size_t>(D) * n_own_, *rho = y + 2 * static_cast<size_t>(D) * n_own_;
+  for (int32_t p = 0; p < n_own_; ++p) {
+    double *b = &buf_[static_cast<size_t>(p) * rec];
+    for (int c = 0; c < D; ++c) {
+      b[c] = x[p * D + c];
+      b[D + c] = v[p * D + c];
+    }
+    b[2 * D] = rho[p];
+  }
+  coll_.exchange(rec, buf_.data(), rec);
+  ys_.resize(static_cast<size_t>(rec) * n);
+  double *xs = ys_.data(), *vs = xs + static_cast<size_t>(D) * n, *rs = vs + static_cast<size_t>(D) * n;
+  for (int32_t p = 0; p < n; ++p) {
+    const double *b = &buf_[static_cast<size_t>(p) * rec];
+    const int32_t k = node_[p];
+    for (int c = 0; c < D; ++c) {
+      xs[k * D + c] = b[c];
+      vs[k * D + c] = b[D + c];
+    }
+    rs[k] = b[2 * D];
+  }
+}
+
+void FluidRanks::sync(double *a, int na, double *b, int nb) {
+  const int rec = na + nb;
+  const int32_t n = size();
+  buf_.resize(static_cast<size_t>(n) * rec);
+  for (int32_t p = 0; p < n_own_; ++p) {
+    double *r = &buf_[static_cast<size_t>(p) * rec];
+    const size_t k = owned_[p];
+    std::copy(a + k * na, a + (k + 1) * na, r);
+    if (nb) std::copy(b + k * nb, b + (k + 1) * nb, r + na);
+  }
+  coll_.exchange(rec, buf_.data(), rec);
+  for (int32_t p = n_own_; p < n; ++p) {
+    const double *r = &buf_[static_cast<size_t>(p) * rec];
+    const size_t k = node_[p];
+    std::copy(r, r + na, a + k * na);
+    if (nb) std::copy(r + na, r + rec, b + k * nb);
+  }
+}
+
+Report FluidRanks::owned_accel(const double *v, const double *rho, double *a) {
+  Report r = accel(v, rho, a);
+  ghost_fault_ = false;
+  if (r.status != MFREE_FAIL_SINGULAR || lump_ != MFREE_LUMP_GALERKIN) return r;
+  const int D = dim(), A = 2 * D + 2;
+  for (int32_t k = 0; k < size(); ++k) {
+    const double m = acc_[static_cast<size_t>(k) * A + D + 1];
+    if (is_owned_[k] && !(m > 0.0)) {
+      std::ostringstream s;
+      s << "particle " << k << " (global id " << gid_[k] << ") has a non-positive lumped mass " << m;
+      Report bad;
+      bad.fail(MFREE_FAIL_SINGULAR, s.str());
+      ghost_fault_ = false;
+      return bad;
+    }
+  }
+  return Report();
+}
+
+Report FluidRanks::prepare_accel(const double *ys, bool checked, double *a, double &limit, double &reach) {
+  ghost_fault_ = false;
+  if (dummy_.n || delta_ != 0.0 || vci_ || vsmooth_ != 0.0)
+    throw Error(MFREE_ERR_UNSUPPORTED, "on ranks the fluid has no dummy particles, density diffusion, consistent "
+                                       "integration or velocity smoothing yet");
+  Report r = named(prepare(ys, checked));
+  if (!r.ok()) return r;
+  const int D = dim();
+  const double *x = ys;
+  if (xfirst_.size() != static_cast<size_t>(D) * n_own_ + 1) {  // (one more item: set, also with no owned particle)
+    xfirst_.assign(static_cast<size_t>(D) * n_own_ + 1, 0.0);
+    for (int32_t p = 0; p < n_own_; ++p)
+      for (int c = 0; c < D; ++c) xfirst_[p * D + c] = x[static_cast<size_t>(owned_[p]) * D + c];
+  }
+  double d2 = 0.0;
+  for (int32_t p = 0; p < n_own_; ++p) {
+    double s = 0.0;
+    for (int c = 0; c < D; ++c) {
+      const double dc = x[static_cast<size_t>(owned_[p]) * D + c] - xfirst_[p * D + c];
+      s += dc * dc;
+    }
+    d2 = std::max(d2, s);
+  }
+  // particles within 2 R h of an owned particle now were within 2 R h + 2 d of it at the
+  // first evaluation, when the ghost layer held every particle within the width
+  reach = -2.0 * (kernel_->radius() * h_ + std::sqrt(d2));
+  limit = stable_dt(ys);
+  const size_t nd = static_cast<size_t>(D) * size();
+  return owned_accel(ys + nd, ys + 2 * nd, a);
+}
+
+Report FluidRanks::agree_min(const Report &mine, double *vals, int nv) const {
+  const int rec = 2 + nv;
+  std::vector<double> in(rec);
+  in[0] = static_cast<double>(mine.status);
+  in[1] = !mine.ok() && ghost_fault_;
+  for (int k = 0; k < nv; ++k) in[2 + k] = mine.ok() ? vals[k] : INFINITY;
+  const int np = coll_.size();
+  std::vector<double> all(static_cast<size_t>(np) * rec);
+  coll_.allgather(in.data(), rec, all.data(), static_cast<int64_t>(all.size()));
+  std::vector<double> st(np);
+  bool owner_failed = false;
+  for (int p = 0; p < np; ++p) {
+    st[p] = all[static_cast<size_t>(p) * rec];
+    owner_failed = owner_failed || (st[p] != 0.0 && all[static_cast<size_t>(p) * rec + 1] == 0.0);
+  }
+  for (int k = 0; k < nv; ++k) {
+    vals[k] = INFINITY;
+    for (int p = 0; p < np; ++p) vals[k] = std::min(vals[k], all[static_cast<size_t>(p) * rec + 2 + k]);
+  }
+  // a ghost's fault is its owner's too: the owner's report is the one to keep
+  Report me = mine;
+  if (owner_failed) {
+    for (int p = 0; p < np; ++p)
+      if (all[static_cast<size_t>(p) * rec + 1] != 0.0) st[p] = 0.0;
+    if (in[1] != 0.0) me = Report();
+  }
+  Report agreed = coll_.agree_from(st, me);
+  if (agreed.status < 0) throw Error(agreed.status, agreed.message);
+  return agreed;
+}
+
+Report FluidRanks::named(Report r) const {
+  ghost_fault_ = false;
+  if (r.ok()) return r;
+  for (const char *word : {"particle ", "node "}) {
+    const size_t at = r.message.find(word);
+    if (at == std::string::npos) continue;
+    const char *num = r.message.c_str() + at + std::char_traits<char>::length(word);
+    char *end = nullptr;
+    const long k = std::strtol(num, &end, 10);
+    if (end == num || k < 0 || k >= size()) continue;
+    ghost_fault_ = !is_owned_[k];
+    r.message.insert(static_cast<size_t>(end - r.message.c_str()), " (global id " + std::to_string(gid_[k]) + ")");
+    break;
+  }
+  return r;
+}
+
+Report FluidRanks::rhs(double t, const double *y, double *ydot) {
+  (void)t;
+  const int D = dim();
+  const int32_t n = size();
+  load(y);
+  rate_n_.resize(static_cast<size_t>(D) * n);
+  vh_n_.resize(static_cast<size_t>(D) * n);
+  dr_n_.resize(n);
+  double vals[2] = {INFINITY, INFINITY};
+  const Report mine = guarded([&] {
+    Report r = prepare_accel(ys_.data(), false, rate_n_.data(), vals[0], vals[1]);
+    const size_t nd = static_cast<size_t>(D) * n;
+    if (r.ok()) kinematics(ys_.data() + nd, ys_.data() + 2 * nd, vh_n_.data(), dr_n_.data());
+    return r;
+  });
+  const Report agreed = agree_min(mine, vals, 2);
+  if (!agreed.ok()) return agreed;
+  if (-vals[1] > width_) {
+    std::ostringstream s;
+    s << "the ghost layer (width " << width_ << ") no longer reaches two support radii around every owned particle ("
+      << -vals[1] << " with the particles' displacements): rebuild the halo and the system";
+    throw Error(MFREE_ERR_HALO, s.str());
+  }
+  const size_t no = static_cast<size_t>(D) * n_own_;
+  for (int32_t p = 0; p < n_own_; ++p) {
+    const size_t k = owned_[p];
+    for (int c = 0; c < D; ++c) {
+      ydot[p * D + c] = vh_n_[k * D + c];
+      ydot[no + p * D + c] = rate_n_[k * D + c];
+    }
+    ydot[2 * no + p] = dr_n_[k];
+  }
+  return agreed;
+}
+
+Report FluidRanks::mass(const double *y, bool consistent, SparseMatrix &M) {
+  (void)y, (void)consistent, (void)M;
+  throw Error(MFREE_ERR_UNSUPPORTED, "no mass matrix for the fluid on ranks (its state holds the owned particles "
+                                     "only; integrate its lumped form)");
+}
+
+// Leap-frog (003 Sect. 6.1) as FluidSystem::integrate takes it, with the ghosts' states
+// exchanged where its stages read them: v^{k+1/2} before the kinematics, x and rho at the
+// step's end. Two exchanges and two all-gathers per step.
+Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
+                             mfree_progress_fn progress, void *user, int64_t &nsteps) {
+  nsteps = 0;
+  // the arguments, checked and then agreed: ranks that took different steps would wait
+  // for each other in the exchanges
+  const Report args = guarded([&] {
+    if (scheme == MFREE_INTEGRATOR_PREDICTOR_CORRECTOR)
+      throw Error(MFREE_ERR_UNSUPPORTED, "on ranks the fluid integrates by leap-frog (the predictor-corrector is "
+                                         "not distributed yet)");
+    if (scheme != MFREE_INTEGRATOR_LEAPFROG) throw Error(MFREE_ERR_ARG, "unknown integrator");
+    if (!(std::isfinite(t_end) && std::isfinite(t))) throw Error(MFREE_ERR_ARG, "times must be finite");
+    if (!(std::isfinite(cfl) && cfl <= 1.0)) throw Error(MFREE_ERR_ARG, "cfl must be finite and <= 1");
+    if (!(std::isfinite(dt_max) && dt_max >= 0.0)) throw Error(MFREE_ERR_ARG, "dt_max must be finite and >= 0");
+    if (cfl <= 0.0 && dt_max <= 0.0) throw Error(MFREE_ERR_ARG, "give a CFL number or a fixed step dt_max");
+    check_ready();
+    return Report();
+  });
+  {
+    const double v[5] = {static_cast<double>(args.status), t, t_end, cfl, dt_max};
+    const int np = coll_.size();
+    std::vector<double> all(static_cast<size_t>(np) * 5);
+    coll_.allgather(v, 5, all.data(), static_cast<int64_t>(all.size()));
+    std::vector<double> st(np);
+    for (int p = 0; p < np; ++p) st[p] = all[5 * static_cast<size_t>(p)];
+    const Report agreed = coll_.agree_from(st, args);
+    if (!agreed.ok()) throw Error(agreed.status, agreed.message);
+    static const char *names[5] = {"", "t", "t_end", "cfl", "dt_max"};
+    for (int p = 1; p < np; ++p)
+      for (int k = 1; k < 5; ++k)
+        if (!(all[5 * static_cast<size_t>(p) + k] == all[k])) {
+          std::ostringstream s;
+          s.precision(17);
+          s << "ranks disagree on " << names[k] << ": rank 0 passes " << all[k] << ", rank " << p << " passes "
+            << all[5 * static_cast<size_t>(p) + k] << " (every rank must pass the same)";
+          throw Error(MFREE_ERR_ARG, s.str());
+        }
+  }
+  const int D = dim();
+  const int32_t n = size();
+  const size_t nd = static_cast<size_t>(D) * n;
+  load(y);
+  yn_.resize(ys_.size());
+  rate_n_.resize(nd);
+  vh_n_.resize(nd);
+  dr_n_.resize(n);
+  auto failed = [&](Report r, int64_t step) {
+    r.message = "step " + std::to_string(step) + ": " + r.message;
+    return r;
+  };
+  while (t < t_end) {
+    double vals[2] = {INFINITY, INFINITY};
+    const Report mine = guarded([&] { return prepare_accel(ys_.data(), nsteps > 0, rate_n_.data(), vals[0], vals[1]); });
+    Report agreed = agree_min(mine, vals, 2);
+    if (!agreed.ok()) return failed(agreed, nsteps);
+    if (-vals[1] > width_) {
+      std::ostringstream s;
+      s << "step " << nsteps + 1 << ": the ghost layer (width " << width_
+        << ") no longer reaches two support radii around every owned particle (" << -vals[1]
+        << " with the particles' displacements): rebuild the halo and the system";
+      throw Error(MFREE_ERR_HALO, s.str());
+    }
+    const double limit = vals[0];
+    double dt = cfl > 0.0 ? cfl * limit : dt_max;
+    if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
+    if (cfl <= 0.0 && dt > limit) {
+      std::ostringstream s;
+      s << "step " << nsteps + 1 << ": dt = " << dt << " exceeds the CFL limit " << limit << " (003 eq 120)";
+      agreed.fail(MFREE_FAIL_CFL, s.str());
+      return agreed;
+    }
+    if (!(t + dt > t) && dt < t_end - t) {
+      std::ostringstream s;
+      s << "step " << nsteps + 1 << ": the step dt = " << dt << " no longer advances t = " << t << " (003 eq 120)";
+      agreed.fail(MFREE_FAIL_CFL, s.str());
+      return agreed;
+    }
+    dt = std::min(dt, t_end - t);
+    const double *x = ys_.data(), *v = x + nd, *rho = v + nd;
+    double *xn = yn_.data(), *vn = xn + nd, *rn = vn + nd;
+    const double *rate = rate_n_.data(), *vh = vh_n_.data(), *dr = dr_n_.data();
+    for (int32_t k : owned_)
+      for (int c = 0; c < D; ++c) vn[k * D + c] = v[k * D + c] + dt * rate[k * D + c];
+    sync(vn, D, nullptr, 0);
+    kinematics(vn, rho, vh_n_.data(), dr_n_.data());
+    for (int32_t k : owned_) {
+      for (int c = 0; c < D; ++c) xn[k * D + c] = x[k * D + c] + dt * vh[k * D + c];
+      rn[k] = rho[k] + dt * dr[k];
+    }
+    sync(xn, D, rn, 1);
+    const Report bad = guarded([&] { return named(check_state(yn_.data(), nsteps + 1)); });
+    agreed = agree_min(bad, nullptr, 0);
+    if (!agreed.ok()) return agreed;  // y keeps the last good state
+    ys_.swap(yn_);
+    const size_t no = static_cast<size_t>(D) * n_own_;
+    for (int32_t p = 0; p < n_own_; ++p) {
+      const size_t k = owned_[p];
+      for (int c = 0; c < D; ++c) {
+        y[p * D + c] = ys_[k * D + c];
+        y[no + p * D + c] = ys_[nd + k * D + c];
+      }
+      y[2 * no + p] = ys_[2 * nd + k];
+    }
+    t = (t_end - t <= dt) ? t_end : t + dt;
+    ++nsteps;
+    if (progress && progress(user, nsteps, t, dt)) break;
+  }
+  return Report();
+}
+
+}  // namespace mfree

@@ -1,0 +1,75 @@
+// The fluid of paper 003 on one rank of several: the rank's owned particles and two
+// support radii of ghosts, numbered by global id, so that every owned particle's
+// acceleration, velocity and density rate are bitwise those of one rank (docs/fluid-ranks.md).
+// The state a host sees holds the owned particles only; the ghosts' states come from
+// the host's exchange callback, the reductions (step limit, statuses) from its
+// all-gather.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/systems/collective.hpp"
+#include "core/systems/fluid.hpp"
+
+namespace mfree {
+
+class FluidRanks final : public FluidSystem {
+ public:
+  // Collective: every rank gets the same outcome (a failure on one rank, or ranks that
+  // disagree on dim or width, throws the agreed error on every rank). ids: the global
+  // ids of the n_owned + n_ghost local items, owned first (the host's order, which the
+  // exchange callback uses); width: the depth of the ghost layer around the owned
+  // particles (at least two support radii; checked at every evaluation).
+  static std::unique_ptr<FluidRanks> create(int dim, int32_t n_owned, int32_t n_ghost, const int64_t *ids,
+                                            double width, const Collective &coll);
+
+  bool on_ranks() const override { return true; }
+  int32_t neq() const override { return (2 * dim() + 1) * n_own_; }
+  Report rhs(double t, const double *y, double *ydot) override;
+  Report mass(const double *y, bool consistent, SparseMatrix &M) override;
+  Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
+                   mfree_progress_fn progress, void *user, int64_t &nsteps) override;
+
+ protected:
+  void to_nodes(HVec<double> &per_particle) const override;
+  void rows_done() override;
+
+ private:
+  FluidRanks(int dim, int32_t n_owned, int32_t n_ghost, const int64_t *ids, double width, const Collective &coll);
+  // The owned particles' state y (x, v, rho of the owned items) into the node state ys_,
+  // the ghosts' through one exchange.
+  void load(const double *y);
+  // The owned nodes' values of node arrays a (na per node) and b (nb per node, or none)
+  // to the ghost nodes: one exchange of na + nb values per item.
+  void sync(double *a, int na, double *b, int nb);
+  // The tables at the node state ys (checked: its state check passed), the halo's depth
+  // check, and the accelerations a of the owned nodes (node arrays); limit: this rank's
+  // step limit; reach: twice the largest displacement of an owned particle since the
+  // first evaluation, negated (for the minimum of the all-gather).
+  Report prepare_accel(const double *ys, bool checked, double *a, double &limit, double &reach);
+  // accel, with the mass check restricted to the owned nodes (ghost nodes far out have
+  // no complete rows and no mass).
+  Report owned_accel(const double *v, const double *rho, double *a);
+  // Every rank's status and nv values: the agreed outcome (a failure at an owned particle
+  // before one at a ghost), and vals replaced by their minima over the ranks (exact in
+  // any order).
+  Report agree_min(const Report &mine, double *vals, int nv) const;
+  // A failure's message names the particle's global id; ghost_fault_: the particle is a
+  // ghost (its owner fails alike, and its report is the one every rank returns).
+  Report named(Report r) const;
+  mutable bool ghost_fault_ = false;
+
+  Collective coll_;
+  int32_t n_own_ = 0, n_ghost_ = 0;
+  double width_ = 0.0;
+  std::vector<int32_t> node_;    // host item -> node (nodes in ascending global id)
+  std::vector<int64_t> gid_;     // node -> global id
+  std::vector<int32_t> owned_;   // the owned nodes, in the host's order
+  std::vector<char> is_owned_, need_;  // per node
+  std::vector<double> ys_, yn_, rate_n_, vh_n_, dr_n_, buf_;  // node states and rates
+  std::vector<double> xfirst_;   // owned positions at the first evaluation (the halo's reference)
+};
+
+}  // namespace mfree

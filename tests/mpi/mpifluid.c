@@ -1,0 +1,126 @@
+#include "mpifluid.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const double kRho0 = 1000.0, kGamma = 7.0, kG = 9.81;
+
+static void wall_segment(damb_t *b, double x0, double z0, double x1, double z1, double ds, double nx, double nz,
+                         int skip_first) {
+  const int k = (int)ceil(hypot(x1 - x0, z1 - z0) / ds);
+  for (int i = skip_first; i <= k; ++i) {
+    const double s = (double)i / k;
+    b->wx[2 * b->nwall] = x0 + s * (x1 - x0);
+    b->wx[2 * b->nwall + 1] = z0 + s * (z1 - z0);
+    b->wn[2 * b->nwall] = nx;
+    b->wn[2 * b->nwall + 1] = nz;
+    ++b->nwall;
+  }
+}
+
+void damb_make(damb_t *b, int nx, int nz) {
+  b->n = nx * nz;
+  b->a = 0.05715;
+  b->d = b->a / nx;
+  b->h = 1.5 * b->d;
+  const double H = 2.0 * b->a, L = 5.0 * b->a, d = b->d, top = 1.5 * H, off = 0.5 * d, ds = d / 3.0;
+  b->kappa = 100.0 * kRho0 * 2.0 * kG * H / kGamma;
+  const int n = b->n;
+  b->y = calloc(5 * (size_t)n, sizeof *b->y);
+  b->m = malloc((size_t)n * sizeof *b->m);
+  for (int j = 0, q = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i, ++q) {
+      const double z = (j + 0.5) * d;
+      b->y[2 * q] = (i + 0.5) * d;
+      b->y[2 * q + 1] = z;
+      b->y[4 * (size_t)n + q] = kRho0 * pow(1.0 + kRho0 * kG * (H - z) / b->kappa, 1.0 / kGamma); /* 003 eq 65 */
+      b->m[q] = b->y[4 * (size_t)n + q] * d * d;
+    }
+  const int cap = 2 * (int)ceil((top + off) / ds) + (int)ceil((L + 2 * off) / ds) + 8;
+  b->wx = malloc(2 * sizeof(double) * (size_t)cap);
+  b->wn = malloc(2 * sizeof(double) * (size_t)cap);
+  b->nwall = 0;
+  wall_segment(b, -off, top, -off, -off, ds, 1, 0, 0);         /* left wall */
+  wall_segment(b, -off, -off, L + off, -off, ds, 0, 1, 1);     /* floor */
+  wall_segment(b, L + off, -off, L + off, top, ds, -1, 0, 1);  /* right wall */
+}
+
+void damb_free(damb_t *b) {
+  free(b->y), free(b->m), free(b->wx), free(b->wn);
+  memset(b, 0, sizeof *b);
+}
+
+mfree_status_t damb_configure(const damb_t *b, mfree_system_t *sys) {
+  const double g[2] = {0.0, -kG};
+  mfree_status_t st = mfree_system_set_fluid(sys, &kRho0, 0, b->kappa, kGamma, 0.5);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_smoothing(sys, b->h);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_gravity(sys, g);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_walls(sys, b->nwall, b->wx, b->wn, 0.7 * b->h, 10.0);
+  return st;
+}
+
+mfree_status_t rankfluid_make(rankfluid_t *r, mfree_context_t *ctx, MPI_Comm comm, const damb_t *b,
+                              const int *owner, double width, int reverse) {
+  memset(r, 0, sizeof *r);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const int n = b->n;
+  int no = 0;
+  for (int i = 0; i < n; ++i) no += owner[i] == rank;
+  int64_t *own = malloc(((size_t)no + 1) * sizeof *own);
+  double *x = malloc(2 * ((size_t)no + 1) * sizeof *x);
+  for (int i = 0, k = 0; i < n; ++i)
+    if (owner[i] == rank) own[reverse ? no - 1 - k++ : k++] = i;
+  for (int k = 0; k < no; ++k) memcpy(x + 2 * k, b->y + 2 * own[k], 2 * sizeof(double));
+  mfree_status_t st = mfree_halo_create(ctx, comm, 2, &r->halo);
+  if (st == MFREE_SUCCESS) st = mfree_halo_setup(r->halo, no, x, 2, own, width);
+  int32_t n_owned = 0, n_ghost = 0;
+  if (st == MFREE_SUCCESS) st = mfree_halo_get_size(r->halo, &n_owned, &n_ghost);
+  double *m = NULL;
+  if (st == MFREE_SUCCESS) {
+    r->n_owned = n_owned;
+    r->n_ghost = n_ghost;
+    r->id = malloc(((size_t)n_owned + n_ghost + 1) * sizeof *r->id);
+    m = malloc(((size_t)n_owned + n_ghost + 1) * sizeof *m);
+    st = mfree_halo_get_global_ids(r->halo, r->id);
+  }
+  if (st == MFREE_SUCCESS) {
+    for (int k = 0; k < n_owned; ++k) m[k] = b->m[r->id[k]];
+    st = mfree_halo_exchange(r->halo, 1, m, 1); /* the ghosts' masses from their owners */
+  }
+  if (st == MFREE_SUCCESS) st = mfree_halo_create_fluid(r->halo, 2, width, &r->sys);
+  if (st == MFREE_SUCCESS) st = damb_configure(b, r->sys);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_masses(r->sys, m, 1);
+  if (st == MFREE_SUCCESS) {
+    r->y = malloc(5 * ((size_t)n_owned + 1) * sizeof *r->y);
+    const size_t no2 = 2 * (size_t)n_owned;
+    for (int k = 0; k < n_owned; ++k) {
+      const int64_t q = r->id[k];
+      memcpy(r->y + 2 * k, b->y + 2 * q, 2 * sizeof(double));
+      memcpy(r->y + no2 + 2 * k, b->y + 2 * (size_t)n + 2 * q, 2 * sizeof(double));
+      r->y[2 * no2 + k] = b->y[4 * (size_t)n + q];
+    }
+  }
+  free(own), free(x), free(m);
+  return st;
+}
+
+void rankfluid_free(rankfluid_t *r) {
+  mfree_system_destroy(&r->sys);
+  if (r->halo) mfree_halo_destroy(&r->halo);
+  free(r->id), free(r->y);
+  memset(r, 0, sizeof *r);
+}
+
+int32_t mpifluid_stop_at(void *user, int64_t step, double t, double dt) {
+  (void)t, (void)dt;
+  return step >= *(const int64_t *)user;
+}
+
+const char *mpifluid_error(const mfree_context_t *ctx) {
+  static char msg[1024];
+  msg[0] = 0;
+  mfree_context_get_last_error(ctx, NULL, msg, sizeof msg);
+  return msg;
+}

@@ -1,0 +1,50 @@
+/* The dam break of paper 003 (Martin & Moyce's column, the examples' set-up: water
+ * block a wide and 2a high in a tank 5a long, leap-frog) for the fluid on ranks: every
+ * rank builds the same particles (global id = index), a decomposition gives each its
+ * owned particles, and a halo plan of libmfree_mpi its ghosts and the system's callbacks
+ * (mfree_halo_create_fluid). */
+#ifndef MFREE_MPIFLUID_H
+#define MFREE_MPIFLUID_H
+
+#include <mpi.h>
+#include <stdint.h>
+
+#include "mfree.h"
+#include "mfree_mpi.h"
+
+typedef struct {
+  int n, nwall;
+  double a, d, h, kappa;
+  double *y;        /* 5 n: positions, velocities, densities of every particle */
+  double *m;        /* n masses */
+  double *wx, *wn;  /* wall particles and their normals (2 per wall particle) */
+} damb_t;
+
+/* nx x nz particles at rest, hydrostatic densities (003 eq 65). */
+void damb_make(damb_t *b, int nx, int nz);
+void damb_free(damb_t *b);
+/* Everything but the masses: Tait (rho0 1000, gamma 7, kappa), viscosity, h, gravity,
+ * the walls (003 Sect. 6.2). */
+mfree_status_t damb_configure(const damb_t *b, mfree_system_t *sys);
+
+/* The dam break on the ranks of comm: owner[i] is the rank owning particle i. The owned
+ * items are listed in ascending id order, or descending with reverse (the local order
+ * must not matter). */
+typedef struct {
+  mfree_halo_t *halo;
+  mfree_system_t *sys;
+  int n_owned, n_ghost;
+  int64_t *id; /* owned then ghosts */
+  double *y;   /* the owned particles' state (5 n_owned) */
+} rankfluid_t;
+/* Collective; the status of the system's creation (every rank the same). */
+mfree_status_t rankfluid_make(rankfluid_t *r, mfree_context_t *ctx, MPI_Comm comm, const damb_t *b,
+                              const int *owner, double width, int reverse);
+void rankfluid_free(rankfluid_t *r);
+
+/* Progress callback stopping after *(int64_t *)user steps. */
+int32_t mpifluid_stop_at(void *user, int64_t step, double t, double dt);
+/* The context's last message (a static buffer). */
+const char *mpifluid_error(const mfree_context_t *ctx);
+
+#endif

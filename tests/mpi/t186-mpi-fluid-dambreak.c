@@ -1,0 +1,134 @@
+/* The fluid on ranks (label mpi): the dam break of paper 003 (20 x 40 particles,
+ * leap-frog at CFL 0.5, 150 steps) on 1-4 ranks, for horizontal layers (the ghost layer
+ * is deeper than the rows need: the rows of the ghosts far out are incomplete and must
+ * not count), a scattered partition (owners by a hash of the id: most neighbours are
+ * ghosts) and vertical slabs whose owned items are listed in reverse order: every owned particle's position, velocity and density
+ * after the run, and its right-hand side at the start, are bitwise those of the same
+ * system on one rank (MPI_COMM_SELF), matched by global id, with the same steps and
+ * time; and that one-rank run is bitwise the one-process fluid's
+ * (mfree_system_create_fluid), whose force assembly takes the same order at this size. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpifluid.h"
+#include "mpitest.h"
+
+enum { LAYERS = 0, HASHED = 1, SLAB_REVERSED = 2, NDECOMP = 3 };
+static const char *kName[NDECOMP] = {"layers", "hashed", "slabs, reversed local order"};
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  mfree_context_t *ctx = NULL;
+  mfree_context_create(&ctx);
+  damb_t b;
+  damb_make(&b, 20, 40);
+  const int n = b.n;
+  const double width = 4.0 * b.h + 4.0 * b.d; /* two support radii and a margin for the motion */
+  int64_t steps_wanted = 150;
+  const size_t n2 = 2 * (size_t)n;
+
+  /* ---- the reference: the system on one rank, every particle owned ---- */
+  int *owner = calloc((size_t)n, sizeof *owner);
+  rankfluid_t ref;
+  mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, width, 0);
+  CHECK(st == MFREE_SUCCESS, "one-rank system: status %d: %s", (int)st, mpifluid_error(ctx));
+  double *ref_dot = malloc(5 * (size_t)n * sizeof *ref_dot);
+  st = mfree_system_rhs(ref.sys, 0.0, ref.y, ref_dot);
+  CHECK(st == MFREE_SUCCESS, "one-rank rhs: status %d: %s", (int)st, mpifluid_error(ctx));
+  double t_ref = 0.0;
+  int64_t steps_ref = 0;
+  st = mfree_system_integrate(ref.sys, MFREE_INTEGRATOR_LEAPFROG, ref.y, &t_ref, 1.0, 0.5, 0.0, mpifluid_stop_at,
+                              &steps_wanted, &steps_ref);
+  CHECK(st == MFREE_SUCCESS && steps_ref == steps_wanted, "one-rank run: status %d after %lld steps: %s", (int)st,
+        (long long)steps_ref, mpifluid_error(ctx));
+  /* (ref's owned items are in id order: item q is particle q) */
+
+  /* ---- the one-process fluid ---- */
+  {
+    mfree_system_t *sys = NULL;
+    double *y = malloc(5 * (size_t)n * sizeof *y), t = 0.0;
+    memcpy(y, b.y, 5 * (size_t)n * sizeof *y);
+    int64_t steps = 0;
+    st = mfree_system_create_fluid(ctx, 2, n, &sys);
+    if (st == MFREE_SUCCESS) st = damb_configure(&b, sys);
+    if (st == MFREE_SUCCESS) st = mfree_system_set_masses(sys, b.m, 1);
+    if (st == MFREE_SUCCESS)
+      st = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+                                  &steps_wanted, &steps);
+    CHECK(st == MFREE_SUCCESS && steps == steps_ref && t == t_ref, "one-process run: status %d, %lld steps",
+          (int)st, (long long)steps);
+    CHECK(memcmp(y, ref.y, 5 * (size_t)n * sizeof *y) == 0, "the one-process fluid differs from the one-rank run");
+    mfree_system_destroy(&sys);
+    free(y);
+  }
+
+  /* ---- on the ranks ---- */
+  for (int how = 0; how < NDECOMP; ++how) {
+    for (int i = 0; i < n; ++i) {
+      /* horizontal layers (ghosts far above and below, whose rows are incomplete) or
+         vertical slabs */
+      int p = how == LAYERS ? (int)(b.y[2 * i + 1] / (2.0 * b.a) * size) : (int)(b.y[2 * i] / b.a * size);
+      p = p < 0 ? 0 : p >= size ? size - 1 : p;
+      owner[i] = how == HASHED ? (int)(mpitest_hash((uint64_t)i) % (uint64_t)size) : p;
+    }
+    rankfluid_t r;
+    st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, how == SLAB_REVERSED);
+    CHECK(st == MFREE_SUCCESS, "%s: system: status %d: %s", kName[how], (int)st, mpifluid_error(ctx));
+    if (st != MFREE_SUCCESS) {
+      rankfluid_free(&r);
+      continue;
+    }
+    const int no = r.n_owned;
+    const size_t no2 = 2 * (size_t)no;
+    double *dot = malloc(5 * ((size_t)no + 1) * sizeof *dot);
+    st = mfree_system_rhs(r.sys, 0.0, r.y, dot);
+    CHECK(st == MFREE_SUCCESS, "%s: rhs status %d: %s", kName[how], (int)st, mpifluid_error(ctx));
+    int bad_rhs = 0;
+    for (int k = 0; k < no; ++k) {
+      const int64_t q = r.id[k];
+      bad_rhs += memcmp(dot + 2 * k, ref_dot + 2 * q, 16) || memcmp(dot + no2 + 2 * k, ref_dot + n2 + 2 * q, 16) ||
+                 memcmp(dot + 2 * no2 + k, ref_dot + 2 * n2 + q, 8);
+    }
+    CHECK(bad_rhs == 0, "%s: %d of %d owned particles' rates differ from one rank's", kName[how], bad_rhs, no);
+    double t = 0.0;
+    int64_t steps = 0;
+    st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+                                &steps_wanted, &steps);
+    CHECK(st == MFREE_SUCCESS, "%s: integrate status %d: %s", kName[how], (int)st, mpifluid_error(ctx));
+    CHECK(steps == steps_ref && t == t_ref, "%s: %lld steps to t = %.17g, one rank %lld to %.17g", kName[how],
+          (long long)steps, t, (long long)steps_ref, t_ref);
+    int bad = 0, first = -1, total = 0;
+    for (int k = 0; k < no; ++k) {
+      const int64_t q = r.id[k];
+      const int differs = memcmp(r.y + 2 * k, ref.y + 2 * q, 16) || memcmp(r.y + no2 + 2 * k, ref.y + n2 + 2 * q, 16) ||
+                          memcmp(r.y + 2 * no2 + k, ref.y + 2 * n2 + q, 8);
+      if (differs && first < 0) first = (int)q;
+      bad += differs;
+    }
+    CHECK(bad == 0, "%s: %d of %d owned particles differ from one rank's (first: id %d)", kName[how], bad, no, first);
+    MPI_Allreduce(&no, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    CHECK(total == n, "%s: %d particles owned in all", kName[how], total);
+    if (rank == 0)
+      printf("t186: %s on %d ranks: %lld steps, rank 0 owns %d particles and %d ghosts\n", kName[how], size,
+             (long long)steps, no, r.n_ghost);
+    free(dot);
+    rankfluid_free(&r);
+  }
+  /* the particles moved: the front left the column */
+  double front = 0.0;
+  for (int q = 0; q < n; ++q) front = fmax(front, ref.y[2 * q]);
+  CHECK(front > 1.03 * b.a, "the front is at %.4f m, the column %.4f m wide", front, b.a);
+
+  rankfluid_free(&ref);
+  free(ref_dot), free(owner);
+  damb_free(&b);
+  mfree_context_destroy(&ctx);
+  const int rc = mpitest_finish("t186-mpi-fluid-dambreak");
+  MPI_Finalize();
+  return rc;
+}
