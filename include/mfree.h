@@ -2117,8 +2117,9 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
     mfree_allgather_fn allgather, void *user, mfree_system_t **sys);
 
 /**
- * The Galerkin SPH fluid (mfree_system_create_fluid, paper 003) on one rank of several:
- * the system's particles are this rank's n_owned owned particles and n_ghost ghosts, in
+ * The Galerkin SPH fluid (mfree_system_create_fluid, [CuetoFelgueroso2004]) on one rank
+ * of several: the system's particles are this rank's n_owned owned particles and n_ghost
+ * ghosts, in
  * the host's order (owned first), with their global ids; the ghosts must hold every
  * particle within width of an owned particle, and width must reach two support radii
  * (2 R h: an owned particle's terms come from the rows of its neighbours, which need

@@ -1527,6 +1527,21 @@ module mfree
       type(c_ptr), intent(out) :: sys
     end function mfree_system_create_elastodynamic_ranks_c
 
+    integer(c_int) function mfree_system_create_fluid_ranks_c(ctx, dim, n_owned, n_ghost, global_ids, &
+        width, exchange, allgather, user, sys) bind(C, name="mfree_system_create_fluid_ranks")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: ctx
+      integer(c_int32_t), value :: dim
+      integer(c_int32_t), value :: n_owned
+      integer(c_int32_t), value :: n_ghost
+      integer(c_int64_t), intent(in) :: global_ids(*)
+      real(c_double), value :: width
+      type(c_funptr), value :: exchange
+      type(c_funptr), value :: allgather
+      type(c_ptr), value :: user
+      type(c_ptr), intent(out) :: sys
+    end function mfree_system_create_fluid_ranks_c
+
     integer(c_int) function mfree_system_get_stress_c(sys, t, y, sigma) &
         bind(C, name="mfree_system_get_stress")
       import :: c_int, c_double, c_ptr
@@ -1619,6 +1634,7 @@ module mfree
   public :: mfree_system_create_elastodynamic_galerkin_c
   public :: mfree_system_create_elastodynamic_ranks_c
   public :: mfree_system_create_elastodynamic_ranks
+  public :: mfree_system_create_fluid_ranks_c, mfree_system_create_fluid_ranks
   public :: mfree_system_set_shepard_condition_c
   public :: mfree_system_set_approximation_c
   public :: mfree_system_get_stress_c
@@ -4072,6 +4088,30 @@ contains
     st = mfree_system_create_elastodynamic_ranks_c(ctx%ptr, as%ptr, density, exchange, allgather, &
                                                    user, sys%ptr)
   end function mfree_system_create_elastodynamic_ranks
+
+  !> Typed wrapper of mfree_system_create_fluid_ranks (mfree.h): global_ids holds the
+  !> n_owned + n_ghost ids (checked); exchange and allgather as for
+  !> mfree_system_create_elastodynamic_ranks; module mfree_mpi's mfree_halo_create_fluid
+  !> passes libmfree_mpi's own.
+  integer(c_int) function mfree_system_create_fluid_ranks(ctx, dim, n_owned, n_ghost, global_ids, &
+                                                          width, exchange, allgather, user, sys) result(st)
+    type(mfree_context), intent(in) :: ctx
+    integer(c_int32_t), intent(in) :: dim, n_owned, n_ghost
+    integer(c_int64_t), intent(in) :: global_ids(:)
+    real(c_double), intent(in) :: width
+    type(c_funptr), intent(in) :: exchange, allgather
+    type(c_ptr), intent(in) :: user
+    type(mfree_system), intent(out) :: sys
+    if (n_owned >= 0 .and. n_ghost >= 0 .and. &
+        size(global_ids, kind=c_int64_t) < int(n_owned, c_int64_t) + int(n_ghost, c_int64_t)) then
+      st = wrapper_error(ctx%ptr, MFREE_ERR_ARG, 'mfree_system_create_fluid_ranks: global_ids holds ' // &
+                         int_str(size(global_ids, kind=c_int64_t)) // ' values, n_owned + n_ghost = ' // &
+                         int_str(int(n_owned, c_int64_t) + int(n_ghost, c_int64_t)))
+      return
+    end if
+    st = mfree_system_create_fluid_ranks_c(ctx%ptr, dim, n_owned, n_ghost, global_ids, width, exchange, &
+                                           allgather, user, sys%ptr)
+  end function mfree_system_create_fluid_ranks
 
   !> Condition threshold of the fluid's Shepard fallback (default 100).
   integer(c_int) function mfree_system_set_shepard_condition(sys, max_cond) result(st)

@@ -250,6 +250,15 @@ module mfree_mpi
       real(c_double), value :: density
       type(c_ptr), intent(out) :: sys
     end function mfree_halo_create_elastodynamic_c
+
+    integer(c_int) function mfree_halo_create_fluid_c(halo, dim, width, sys) &
+        bind(C, name="mfree_halo_create_fluid")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int32_t), value :: dim
+      real(c_double), value :: width
+      type(c_ptr), intent(out) :: sys
+    end function mfree_halo_create_fluid_c
   end interface
 
   public :: mfree_halo_create_f_c, mfree_halo_destroy_c, mfree_halo_setup_c
@@ -273,6 +282,7 @@ module mfree_mpi
   public :: mfree_migration_set_pending_error
   public :: mfree_halo_exchange_callback_c, mfree_halo_allgather_c, mfree_halo_create_elastodynamic_c
   public :: mfree_halo_create_elastodynamic
+  public :: mfree_halo_create_fluid_c, mfree_halo_create_fluid
   public :: mfree_halo_exchange_callback, mfree_halo_allgather
 
   real(c_double), target, save :: empty_dbl(0)
@@ -299,6 +309,16 @@ contains
     type(mfree_system), intent(out) :: sys
     st = mfree_halo_create_elastodynamic_c(halo%ptr, as%ptr, density, sys%ptr)
   end function mfree_halo_create_elastodynamic
+
+  !> The fluid over the plan's particles, on ranks (mfree_system_create_fluid_ranks through
+  !> the plan). Collective; the plan must outlive the system.
+  integer(c_int) function mfree_halo_create_fluid(halo, dim, width, sys) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int32_t), intent(in) :: dim
+    real(c_double), intent(in) :: width
+    type(mfree_system), intent(out) :: sys
+    st = mfree_halo_create_fluid_c(halo%ptr, dim, width, sys%ptr)
+  end function mfree_halo_create_fluid
 
   !> The same with the communicator already as integer(c_int32_t).
   integer(c_int) function mfree_halo_create_f(ctx, fcomm, dim, halo) result(st)

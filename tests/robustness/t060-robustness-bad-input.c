@@ -1202,6 +1202,43 @@ static void rows_system(void) {
   ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, one_exchange, NULL, NULL, &s));
   /* a Galerkin assembler */
   ROW(MFREE_ERR_UNSUPPORTED, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, one_exchange, one_allgather, NULL, &s));
+  {
+    /* the fluid on ranks (one rank: the callbacks of one process) */
+    const int64_t ids[3] = {4, 2, 9}, twice[3] = {4, 2, 4}, negative[3] = {4, -1, 9};
+    double ys[10] = {0.0, 0.0, 0.1, 0.0, 0, 0, 0, 0, 1000, 1000}, yd[10], tf = 0.0;
+    mfree_system_t *fr = NULL;
+    mfree_matrix_t *fm = NULL;
+    ROW0(MFREE_ERR_NULL, mfree_system_create_fluid_ranks(NULL, 2, 2, 1, ids, 1.0, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_NULL, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 1, ids, 1.0, one_exchange, one_allgather, NULL, NULL));
+    ROW(MFREE_ERR_NULL, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 1, ids, 1.0, NULL, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_NULL, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 1, ids, 1.0, one_exchange, NULL, NULL, &s));
+    ROW(MFREE_ERR_NULL, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 1, NULL, 1.0, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_ARG, mfree_system_create_fluid_ranks(F.ctx, 4, 2, 1, ids, 1.0, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_ARG, mfree_system_create_fluid_ranks(F.ctx, 2, -1, 1, ids, 1.0, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_ARG, mfree_system_create_fluid_ranks(F.ctx, 2, 2, -1, ids, 1.0, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_ARG, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 1, ids, 0.0, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_ARG, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 1, ids, NAN, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_INPUT, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 1, twice, 1.0, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_ERR_INPUT, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 1, negative, 1.0, one_exchange, one_allgather, NULL, &s));
+    ROW(MFREE_SUCCESS, mfree_system_create_fluid_ranks(F.ctx, 2, 2, 0, ids, 1.0, one_exchange, one_allgather, NULL, &fr));
+    if (fr) {
+      const double m2[2] = {10.0, 10.0};
+      ROW(MFREE_SUCCESS, mfree_system_set_masses(fr, m2, 1));
+      ROW(MFREE_SUCCESS, mfree_system_set_smoothing(fr, 0.1));
+      /* not distributed yet */
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_pressure(fr, ys, yd));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_velocity(fr, ys, yd));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_wall_force(fr, ys, yd, 0, NULL));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_mass(fr, ys, 0, &fm));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_interpolation(fr, ys, &fm));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_integrate(fr, MFREE_INTEGRATOR_PREDICTOR_CORRECTOR, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
+      ys[7] = NAN;
+      ROW(MFREE_FAIL_NONFINITE, mfree_system_rhs(fr, 0.0, ys, yd));
+      ROW(MFREE_FAIL_NONFINITE, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
+      mfree_system_destroy(&fr);
+    }
+    mfree_matrix_destroy(&fm);
+  }
 #if MFREE_T060_GALERKIN_ELASTODYNAMICS
   {
     mfree_assembler_t *mass = NULL;
