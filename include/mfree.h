@@ -2119,11 +2119,10 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
 /**
  * The Galerkin SPH fluid (mfree_system_create_fluid, [CuetoFelgueroso2004]) on one rank
  * of several: the system's particles are this rank's n_owned owned particles and n_ghost
- * ghosts, in
- * the host's order (owned first), with their global ids; the ghosts must hold every
- * particle within width of an owned particle, and width must reach two support radii
- * (2 R h: an owned particle's terms come from the rows of its neighbours, which need
- * their own neighbours). The per-particle setters (mfree_system_set_fluid,
+ * ghosts, in the host's order (owned first), with their global ids; the ghosts must
+ * hold every particle within width of an owned particle, and width must reach two
+ * support radii (2 R h: an owned particle's terms come from the rows of its neighbours,
+ * which need their own neighbours). The per-particle setters (mfree_system_set_fluid,
  * mfree_system_set_masses) take the n_owned + n_ghost items in the host's order; the
  * state y of this rank holds its owned particles only (positions, velocities, densities
  * of the owned items: neq = (2 dim + 1) n_owned). Every right-hand side and native step
