@@ -2135,10 +2135,9 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * since the first: when the layer may miss a particle, every rank returns
  * MFREE_ERR_HALO (rebuild the halo and the system). A failure on one rank (a non-finite
  * state: MFREE_FAIL_NONFINITE) is returned by every rank with that rank's message
- * ("rank R: ..."). Leap-frog only (the predictor-corrector: MFREE_ERR_UNSUPPORTED); no
- * dummy particles, density diffusion, consistent integration or velocity smoothing, and
- * no pressure, velocity, wall-force, mass or interpolation output on ranks yet
- * (MFREE_ERR_UNSUPPORTED). Creation is collective: bad input on one rank, or ranks that
+ * ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
+ * consistent integration or velocity smoothing, and no pressure, velocity, wall-force,
+ * mass or interpolation output on ranks yet (MFREE_ERR_UNSUPPORTED). Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.
  * libmfree_mpi's mfree_halo_create_fluid supplies the callbacks from a halo plan.
  * @param[in]  ctx         context (kept alive); NULL: MFREE_ERR_NULL on this rank alone

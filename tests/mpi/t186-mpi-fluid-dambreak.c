@@ -1,5 +1,5 @@
 /* The fluid on ranks (label mpi): the dam break of paper 003 (24 x 48 particles,
- * leap-frog at CFL 0.5, 150 steps) on 1-4 ranks, for horizontal layers (the ghost layer
+ * leap-frog and predictor-corrector at CFL 0.5, 150 steps) on 1-4 ranks, for horizontal layers (the ghost layer
  * is deeper than the rows need: the rows of the ghosts far out are incomplete and must
  * not count), a scattered partition (owners by a hash of the id: most neighbours are
  * ghosts) and vertical slabs whose owned items are listed in reverse order: every owned particle's position, velocity and density
@@ -21,7 +21,7 @@ static const char *kName[NDECOMP] = {"layers", "hashed", "slabs, reversed local 
 
 /* The one-process fluid (mfree_system_create_fluid) and the system on one rank take the
    same steps to the same bits on nx x nz particles; 0 when they do. */
-static int one_process_differs(mfree_context_t *ctx, int nx, int nz, int64_t steps_wanted) {
+static int one_process_differs(mfree_context_t *ctx, int nx, int nz, int64_t steps_wanted, mfree_integrator_t scheme) {
   damb_t b;
   damb_make(&b, nx, nz);
   const int n = b.n;
@@ -33,13 +33,13 @@ static int one_process_differs(mfree_context_t *ctx, int nx, int nz, int64_t ste
   int64_t steps = 0, steps_r = 0;
   mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_SELF, &b, owner, 4.0 * b.h + 4.0 * b.d, 0);
   if (st == MFREE_SUCCESS)
-    st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &tr, 1.0, 0.5, 0.0, mpifluid_stop_at,
+    st = mfree_system_integrate(r.sys, scheme, r.y, &tr, 1.0, 0.5, 0.0, mpifluid_stop_at,
                                 &steps_wanted, &steps_r);
   if (st == MFREE_SUCCESS) st = mfree_system_create_fluid(ctx, 2, n, &sys);
   if (st == MFREE_SUCCESS) st = damb_configure(&b, sys);
   if (st == MFREE_SUCCESS) st = mfree_system_set_masses(sys, b.m, 1);
   if (st == MFREE_SUCCESS)
-    st = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+    st = mfree_system_integrate(sys, scheme, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
                                 &steps_wanted, &steps);
   CHECK(st == MFREE_SUCCESS && steps == steps_r && t == tr, "one process vs one rank: status %d, %lld and %lld steps",
         (int)st, (long long)steps, (long long)steps_r);
@@ -73,16 +73,30 @@ int main(int argc, char **argv) {
   double *ref_dot = malloc(5 * (size_t)n * sizeof *ref_dot);
   st = mfree_system_rhs(ref.sys, 0.0, ref.y, ref_dot);
   CHECK(st == MFREE_SUCCESS, "one-rank rhs: status %d: %s", (int)st, mpifluid_error(ctx));
-  double t_ref = 0.0;
-  int64_t steps_ref = 0;
-  st = mfree_system_integrate(ref.sys, MFREE_INTEGRATOR_LEAPFROG, ref.y, &t_ref, 1.0, 0.5, 0.0, mpifluid_stop_at,
-                              &steps_wanted, &steps_ref);
-  CHECK(st == MFREE_SUCCESS && steps_ref == steps_wanted, "one-rank run: status %d after %lld steps: %s", (int)st,
-        (long long)steps_ref, mpifluid_error(ctx));
-  /* (ref's owned items are in id order: item q is particle q) */
+  /* leap-frog, then the predictor-corrector (ref's owned items are in id order: item q
+     is particle q) */
+  const mfree_integrator_t schemes[2] = {MFREE_INTEGRATOR_LEAPFROG, MFREE_INTEGRATOR_PREDICTOR_CORRECTOR};
+  static const char *kScheme[2] = {"leap-frog", "predictor-corrector"};
+  double t_refs[2] = {0.0, 0.0}, *ref_ys[2];
+  int64_t steps_refs[2] = {0, 0};
+  for (int sch = 0; sch < 2; ++sch) {
+    rankfluid_t r1;
+    st = rankfluid_make(&r1, ctx, MPI_COMM_SELF, &b, owner, width, 0);
+    if (st == MFREE_SUCCESS)
+      st = mfree_system_integrate(r1.sys, schemes[sch], r1.y, &t_refs[sch], 1.0, 0.5, 0.0, mpifluid_stop_at,
+                                  &steps_wanted, &steps_refs[sch]);
+    CHECK(st == MFREE_SUCCESS && steps_refs[sch] == steps_wanted, "one-rank %s: status %d after %lld steps: %s",
+          kScheme[sch], (int)st, (long long)steps_refs[sch], mpifluid_error(ctx));
+    ref_ys[sch] = malloc(5 * (size_t)n * sizeof(double));
+    memcpy(ref_ys[sch], r1.y, 5 * (size_t)n * sizeof(double));
+    rankfluid_free(&r1);
+  }
 
   /* ---- on the ranks ---- */
+  for (int sch = 0; sch < 2; ++sch)
   for (int how = 0; how < NDECOMP; ++how) {
+    const double t_ref = t_refs[sch], *ref_y = ref_ys[sch];
+    const int64_t steps_ref = steps_refs[sch];
     for (int i = 0; i < n; ++i) {
       /* horizontal layers (ghosts far above and below, whose rows are incomplete) or
          vertical slabs */
@@ -111,37 +125,40 @@ int main(int argc, char **argv) {
     CHECK(bad_rhs == 0, "%s: %d of %d owned particles' rates differ from one rank's", kName[how], bad_rhs, no);
     double t = 0.0;
     int64_t steps = 0;
-    st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
-                                &steps_wanted, &steps);
-    CHECK(st == MFREE_SUCCESS, "%s: integrate status %d: %s", kName[how], (int)st, mpifluid_error(ctx));
-    CHECK(steps == steps_ref && t == t_ref, "%s: %lld steps to t = %.17g, one rank %lld to %.17g", kName[how],
-          (long long)steps, t, (long long)steps_ref, t_ref);
+    st = mfree_system_integrate(r.sys, schemes[sch], r.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &steps_wanted, &steps);
+    CHECK(st == MFREE_SUCCESS, "%s, %s: integrate status %d: %s", kScheme[sch], kName[how], (int)st,
+          mpifluid_error(ctx));
+    CHECK(steps == steps_ref && t == t_ref, "%s, %s: %lld steps to t = %.17g, one rank %lld to %.17g", kScheme[sch],
+          kName[how], (long long)steps, t, (long long)steps_ref, t_ref);
     int bad = 0, first = -1, total = 0;
     for (int k = 0; k < no; ++k) {
       const int64_t q = r.id[k];
-      const int differs = memcmp(r.y + 2 * k, ref.y + 2 * q, 16) || memcmp(r.y + no2 + 2 * k, ref.y + n2 + 2 * q, 16) ||
-                          memcmp(r.y + 2 * no2 + k, ref.y + 2 * n2 + q, 8);
+      const int differs = memcmp(r.y + 2 * k, ref_y + 2 * q, 16) || memcmp(r.y + no2 + 2 * k, ref_y + n2 + 2 * q, 16) ||
+                          memcmp(r.y + 2 * no2 + k, ref_y + 2 * n2 + q, 8);
       if (differs && first < 0) first = (int)q;
       bad += differs;
     }
-    CHECK(bad == 0, "%s: %d of %d owned particles differ from one rank's (first: id %d)", kName[how], bad, no, first);
+    CHECK(bad == 0, "%s, %s: %d of %d owned particles differ from one rank's (first: id %d)", kScheme[sch], kName[how],
+          bad, no, first);
     MPI_Allreduce(&no, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
     CHECK(total == n, "%s: %d particles owned in all", kName[how], total);
     if (rank == 0)
-      printf("t186: %s on %d ranks: %lld steps, rank 0 owns %d particles and %d ghosts\n", kName[how], size,
-             (long long)steps, no, r.n_ghost);
+      printf("t186: %s, %s on %d ranks: %lld steps, rank 0 owns %d particles and %d ghosts\n", kScheme[sch],
+             kName[how], size, (long long)steps, no, r.n_ghost);
     free(dot);
     rankfluid_free(&r);
   }
   /* (at two chunks, 800 particles, the coloured scatter keeps the rows' order) */
-  CHECK(!one_process_differs(ctx, 20, 40, steps_wanted), "the one-process fluid differs from the one-rank run");
+  for (int sch = 0; sch < 2; ++sch)
+    CHECK(!one_process_differs(ctx, 20, 40, steps_wanted, schemes[sch]), "%s: the one-process fluid differs from the "
+          "one-rank run", kScheme[sch]);
   /* the particles moved: the front left the column */
   double front = 0.0;
-  for (int q = 0; q < n; ++q) front = fmax(front, ref.y[2 * q]);
+  for (int q = 0; q < n; ++q) front = fmax(front, ref_ys[0][2 * q]);
   CHECK(front > 1.03 * b.a, "the front is at %.4f m, the column %.4f m wide", front, b.a);
 
   rankfluid_free(&ref);
-  free(ref_dot), free(owner);
+  free(ref_dot), free(owner), free(ref_ys[0]), free(ref_ys[1]);
   damb_free(&b);
   mfree_context_destroy(&ctx);
   const int rc = mpitest_finish("t186-mpi-fluid-dambreak");

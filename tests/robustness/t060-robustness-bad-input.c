@@ -1231,10 +1231,12 @@ static void rows_system(void) {
       ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_wall_force(fr, ys, yd, 0, NULL));
       ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_mass(fr, ys, 0, &fm));
       ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_interpolation(fr, ys, &fm));
-      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_integrate(fr, MFREE_INTEGRATOR_PREDICTOR_CORRECTOR, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
+      ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, (mfree_integrator_t)0, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
+      ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, NAN, 0.2, 0, NULL, NULL, &steps));
       ys[7] = NAN;
       ROW(MFREE_FAIL_NONFINITE, mfree_system_rhs(fr, 0.0, ys, yd));
       ROW(MFREE_FAIL_NONFINITE, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
+      ROW(MFREE_FAIL_NONFINITE, mfree_system_integrate(fr, MFREE_INTEGRATOR_PREDICTOR_CORRECTOR, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
       mfree_system_destroy(&fr);
     }
     mfree_matrix_destroy(&fm);

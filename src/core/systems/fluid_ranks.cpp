@@ -161,8 +161,8 @@ void FluidRanks::load(const double *y) {
   }
 }
 
-void FluidRanks::sync(double *a, int na, double *b, int nb) {
-  const int rec = na + nb;
+void FluidRanks::sync(double *a, int na, double *b, int nb, double *c, int nc) {
+  const int rec = na + nb + nc;
   const int32_t n = size();
   buf_.resize(static_cast<size_t>(n) * rec);
   for (int32_t p = 0; p < n_own_; ++p) {
@@ -170,13 +170,15 @@ void FluidRanks::sync(double *a, int na, double *b, int nb) {
     const size_t k = owned_[p];
     std::copy(a + k * na, a + (k + 1) * na, r);
     if (nb) std::copy(b + k * nb, b + (k + 1) * nb, r + na);
+    if (nc) std::copy(c + k * nc, c + (k + 1) * nc, r + na + nb);
   }
   coll_.exchange(rec, buf_.data(), rec);
   for (int32_t p = n_own_; p < n; ++p) {
     const double *r = &buf_[static_cast<size_t>(p) * rec];
     const size_t k = node_[p];
     std::copy(r, r + na, a + k * na);
-    if (nb) std::copy(r + na, r + rec, b + k * nb);
+    if (nb) std::copy(r + na, r + na + nb, b + k * nb);
+    if (nc) std::copy(r + na + nb, r + rec, c + k * nc);
   }
 }
 
@@ -319,19 +321,19 @@ Report FluidRanks::mass(const double *y, bool consistent, SparseMatrix &M) {
                                      "only; integrate its lumped form)");
 }
 
-// Leap-frog (003 Sect. 6.1) as FluidSystem::integrate takes it, with the ghosts' states
-// exchanged where its stages read them: v^{k+1/2} before the kinematics, x and rho at the
-// step's end. Two exchanges and two all-gathers per step.
+// Leap-frog (003 Sect. 6.1) and the predictor-corrector as FluidSystem::integrate takes
+// them, with the ghosts' states exchanged where their stages read them. Leap-frog:
+// v^{k+1/2} before the kinematics, x and rho at the step's end, two all-gathers per
+// step; the predictor-corrector: the predicted state and v_hat^k, v^C, the corrected
+// state, three all-gathers.
 Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                              mfree_progress_fn progress, void *user, int64_t &nsteps) {
   nsteps = 0;
   // the arguments, checked and then agreed: ranks that took different steps would wait
   // for each other in the exchanges
   const Report args = guarded([&] {
-    if (scheme == MFREE_INTEGRATOR_PREDICTOR_CORRECTOR)
-      throw Error(MFREE_ERR_UNSUPPORTED, "on ranks the fluid integrates by leap-frog (the predictor-corrector is "
-                                         "not distributed yet)");
-    if (scheme != MFREE_INTEGRATOR_LEAPFROG) throw Error(MFREE_ERR_ARG, "unknown integrator");
+    if (scheme != MFREE_INTEGRATOR_LEAPFROG && scheme != MFREE_INTEGRATOR_PREDICTOR_CORRECTOR)
+      throw Error(MFREE_ERR_ARG, "unknown integrator");
     if (!(std::isfinite(t_end) && std::isfinite(t))) throw Error(MFREE_ERR_ARG, "times must be finite");
     if (!(std::isfinite(cfl) && cfl <= 1.0)) throw Error(MFREE_ERR_ARG, "cfl must be finite and <= 1");
     if (!(std::isfinite(dt_max) && dt_max >= 0.0)) throw Error(MFREE_ERR_ARG, "dt_max must be finite and >= 0");
@@ -402,15 +404,63 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
     const double *x = ys_.data(), *v = x + nd, *rho = v + nd;
     double *xn = yn_.data(), *vn = xn + nd, *rn = vn + nd;
     const double *rate = rate_n_.data(), *vh = vh_n_.data(), *dr = dr_n_.data();
-    for (int32_t k : owned_)
-      for (int c = 0; c < D; ++c) vn[k * D + c] = v[k * D + c] + dt * rate[k * D + c];
-    sync(vn, D, nullptr, 0);
-    kinematics(vn, rho, vh_n_.data(), dr_n_.data());
-    for (int32_t k : owned_) {
-      for (int c = 0; c < D; ++c) xn[k * D + c] = x[k * D + c] + dt * vh[k * D + c];
-      rn[k] = rho[k] + dt * dr[k];
+    if (scheme == MFREE_INTEGRATOR_LEAPFROG) {
+      for (int32_t k : owned_)
+        for (int c = 0; c < D; ++c) vn[k * D + c] = v[k * D + c] + dt * rate[k * D + c];
+      sync(vn, D);
+      kinematics(vn, rho, vh_n_.data(), dr_n_.data());
+      for (int32_t k : owned_) {
+        for (int c = 0; c < D; ++c) xn[k * D + c] = x[k * D + c] + dt * vh[k * D + c];
+        rn[k] = rho[k] + dt * dr[k];
+      }
+      sync(xn, D, rn, 1);
+    } else {
+      // 003 eqs 111-119 as FluidSystem::integrate takes them: the predicted state (from
+      // the rates at x^k), its tables and accelerations with the wall switch of v_hat^k,
+      // the corrected state
+      vh0_.resize(nd);
+      dr0_.resize(n);
+      a2_.resize(nd);
+      yp_.resize(ys_.size());
+      kinematics(v, rho, vh0_.data(), dr0_.data());
+      double *xp = yp_.data(), *vp = xp + nd, *rp = vp + nd;
+      for (int32_t k : owned_) {
+        for (int c = 0; c < D; ++c) {
+          xp[k * D + c] = x[k * D + c] + 0.5 * dt * vh0_[k * D + c];
+          vp[k * D + c] = v[k * D + c] + 0.5 * dt * rate[k * D + c];
+        }
+        rp[k] = rho[k] + 0.5 * dt * dr0_[k];
+      }
+      sync(xp, D, vp, D, rp, 1);
+      // (the switch velocities too: a row the predicted state needs may have been dropped
+      // at x^k, its v_hat^k left incomplete here)
+      sync(vh0_.data(), D);
+      double pvals[2] = {INFINITY, INFINITY};
+      const Report pred = guarded([&] {
+        struct Reset {  // also when accel throws
+          const double *&p;
+          ~Reset() { p = nullptr; }
+        } reset{wall_switch_v_};
+        wall_switch_v_ = vh0_.data();
+        return prepare_accel(yp_.data(), false, a2_.data(), pvals[0], pvals[1]);
+      });
+      agreed = agree_min(pred, pvals, 2);
+      if (!agreed.ok()) return failed(agreed, nsteps + 1);
+      for (int32_t k : owned_)
+        for (int c = 0; c < D; ++c) vn[k * D + c] = v[k * D + c] + 0.5 * dt * a2_[k * D + c];  // v^C
+      sync(vn, D);
+      kinematics(vn, rp, vh_n_.data(), dr_n_.data());
+      for (int32_t k : owned_) {
+        rn[k] = rho[k] + 0.5 * dt * dr[k];                                                     // rho^C
+        for (int c = 0; c < D; ++c) xn[k * D + c] = x[k * D + c] + 0.5 * dt * vh[k * D + c];  // x^C
+        for (int c = 0; c < D; ++c) {                                                          // eqs 117-119
+          xn[k * D + c] = 2.0 * xn[k * D + c] - x[k * D + c];
+          vn[k * D + c] = 2.0 * vn[k * D + c] - v[k * D + c];
+        }
+        rn[k] = 2.0 * rn[k] - rho[k];
+      }
+      sync(xn, D, vn, D, rn, 1);
     }
-    sync(xn, D, rn, 1);
     const Report bad = guarded([&] { return named(check_state(yn_.data(), nsteps + 1)); });
     agreed = agree_min(bad, nullptr, 0);
     if (!agreed.ok()) return agreed;  // y keeps the last good state

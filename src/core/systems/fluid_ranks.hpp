@@ -41,9 +41,9 @@ class FluidRanks final : public FluidSystem {
   // The owned particles' state y (x, v, rho of the owned items) into the node state ys_,
   // the ghosts' through one exchange.
   void load(const double *y);
-  // The owned nodes' values of node arrays a (na per node) and b (nb per node, or none)
-  // to the ghost nodes: one exchange of na + nb values per item.
-  void sync(double *a, int na, double *b, int nb);
+  // The owned nodes' values of node arrays a (na per node), b and c (nb, nc per node, or
+  // none) to the ghost nodes: one exchange of na + nb + nc values per item.
+  void sync(double *a, int na, double *b = nullptr, int nb = 0, double *c = nullptr, int nc = 0);
   // The tables at the node state ys (checked: its state check passed), the halo's depth
   // check, and the accelerations a of the owned nodes (node arrays); limit: this rank's
   // step limit; reach: twice the largest displacement of an owned particle since the
@@ -69,6 +69,7 @@ class FluidRanks final : public FluidSystem {
   std::vector<int32_t> owned_;   // the owned nodes, in the host's order
   std::vector<char> is_owned_, need_;  // per node
   std::vector<double> ys_, yn_, rate_n_, vh_n_, dr_n_, buf_;  // node states and rates
+  std::vector<double> yp_, vh0_, dr0_, a2_;  // the predictor-corrector's predicted stage
   std::vector<double> xfirst_;   // owned positions at the first evaluation (the halo's reference)
 };
 
