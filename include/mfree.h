@@ -2136,8 +2136,8 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * MFREE_ERR_HALO (rebuild the halo and the system). A failure on one rank (a non-finite
  * state: MFREE_FAIL_NONFINITE) is returned by every rank with that rank's message
  * ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
- * consistent integration or velocity smoothing, and no pressure, velocity, wall-force,
- * mass or interpolation output on ranks yet (MFREE_ERR_UNSUPPORTED). Creation is collective: bad input on one rank, or ranks that
+ * consistent integration, velocity smoothing or open boundaries, and no pressure,
+ * velocity, wall-force, mass or interpolation output on ranks yet (MFREE_ERR_UNSUPPORTED). Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.
  * libmfree_mpi's mfree_halo_create_fluid supplies the callbacks from a halo plan.
  * @param[in]  ctx         context (kept alive); NULL: MFREE_ERR_NULL on this rank alone
