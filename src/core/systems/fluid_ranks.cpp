@@ -321,6 +321,67 @@ Report FluidRanks::mass(const double *y, bool consistent, SparseMatrix &M) {
                                      "only; integrate its lumped form)");
 }
 
+// The predictor-corrector's step dt from the node state ys_ (its tables, accelerations
+// rate_n_ prepared) into yn_, 003 eqs 111-119 as FluidSystem::integrate takes them.
+Report FluidRanks::corrected_state(double dt, int64_t step) {
+  const int D = dim();
+  const int32_t n = size();
+  const size_t nd = static_cast<size_t>(D) * n;
+  const double *x = ys_.data(), *v = x + nd, *rho = v + nd;
+  double *xn = yn_.data(), *vn = xn + nd, *rn = vn + nd;
+  const double *rate = rate_n_.data(), *vh = vh_n_.data(), *dr = dr_n_.data();
+  Report agreed;
+  // 003 eqs 111-119 as FluidSystem::integrate takes them: the predicted state (from
+  // the rates at x^k), its tables and accelerations with the wall switch of v_hat^k,
+  // the corrected state
+  vh0_.resize(nd);
+  dr0_.resize(n);
+  a2_.resize(nd);
+  yp_.resize(ys_.size());
+  kinematics(v, rho, vh0_.data(), dr0_.data());
+  double *xp = yp_.data(), *vp = xp + nd, *rp = vp + nd;
+  for (int32_t k : owned_) {
+    for (int c = 0; c < D; ++c) {
+      xp[k * D + c] = x[k * D + c] + 0.5 * dt * vh0_[k * D + c];
+      vp[k * D + c] = v[k * D + c] + 0.5 * dt * rate[k * D + c];
+    }
+    rp[k] = rho[k] + 0.5 * dt * dr0_[k];
+  }
+  sync(xp, D, vp, D, rp, 1);
+  // (the switch velocities too: a row the predicted state needs may have been dropped
+  // at x^k, its v_hat^k left incomplete here)
+  sync(vh0_.data(), D);
+  double pvals[2] = {INFINITY, INFINITY};
+  const Report pred = guarded([&] {
+    struct Reset {  // also when accel throws
+      const double *&p;
+      ~Reset() { p = nullptr; }
+    } reset{wall_switch_v_};
+    wall_switch_v_ = vh0_.data();
+    return prepare_accel(yp_.data(), false, a2_.data(), pvals[0], pvals[1]);
+  });
+  agreed = agree_min(pred, pvals, 2);
+  if (!agreed.ok()) {
+    agreed.message = "step " + std::to_string(step) + ": " + agreed.message;
+    return agreed;
+  }
+  for (int32_t k : owned_)
+    for (int c = 0; c < D; ++c) vn[k * D + c] = v[k * D + c] + 0.5 * dt * a2_[k * D + c];  // v^C
+  sync(vn, D);
+  kinematics(vn, rp, vh_n_.data(), dr_n_.data());
+  for (int32_t k : owned_) {
+    rn[k] = rho[k] + 0.5 * dt * dr[k];                                                     // rho^C
+    for (int c = 0; c < D; ++c) xn[k * D + c] = x[k * D + c] + 0.5 * dt * vh[k * D + c];  // x^C
+    for (int c = 0; c < D; ++c) {                                                          // eqs 117-119
+      xn[k * D + c] = 2.0 * xn[k * D + c] - x[k * D + c];
+      vn[k * D + c] = 2.0 * vn[k * D + c] - v[k * D + c];
+    }
+    rn[k] = 2.0 * rn[k] - rho[k];
+  }
+  sync(xn, D, vn, D, rn, 1);
+  return agreed;
+}
+
 // Leap-frog (003 Sect. 6.1) and the predictor-corrector as FluidSystem::integrate takes
 // them, with the ghosts' states exchanged where their stages read them. Leap-frog:
 // v^{k+1/2} before the kinematics, x and rho at the step's end, two all-gathers per
@@ -415,51 +476,8 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
       }
       sync(xn, D, rn, 1);
     } else {
-      // 003 eqs 111-119 as FluidSystem::integrate takes them: the predicted state (from
-      // the rates at x^k), its tables and accelerations with the wall switch of v_hat^k,
-      // the corrected state
-      vh0_.resize(nd);
-      dr0_.resize(n);
-      a2_.resize(nd);
-      yp_.resize(ys_.size());
-      kinematics(v, rho, vh0_.data(), dr0_.data());
-      double *xp = yp_.data(), *vp = xp + nd, *rp = vp + nd;
-      for (int32_t k : owned_) {
-        for (int c = 0; c < D; ++c) {
-          xp[k * D + c] = x[k * D + c] + 0.5 * dt * vh0_[k * D + c];
-          vp[k * D + c] = v[k * D + c] + 0.5 * dt * rate[k * D + c];
-        }
-        rp[k] = rho[k] + 0.5 * dt * dr0_[k];
-      }
-      sync(xp, D, vp, D, rp, 1);
-      // (the switch velocities too: a row the predicted state needs may have been dropped
-      // at x^k, its v_hat^k left incomplete here)
-      sync(vh0_.data(), D);
-      double pvals[2] = {INFINITY, INFINITY};
-      const Report pred = guarded([&] {
-        struct Reset {  // also when accel throws
-          const double *&p;
-          ~Reset() { p = nullptr; }
-        } reset{wall_switch_v_};
-        wall_switch_v_ = vh0_.data();
-        return prepare_accel(yp_.data(), false, a2_.data(), pvals[0], pvals[1]);
-      });
-      agreed = agree_min(pred, pvals, 2);
-      if (!agreed.ok()) return failed(agreed, nsteps + 1);
-      for (int32_t k : owned_)
-        for (int c = 0; c < D; ++c) vn[k * D + c] = v[k * D + c] + 0.5 * dt * a2_[k * D + c];  // v^C
-      sync(vn, D);
-      kinematics(vn, rp, vh_n_.data(), dr_n_.data());
-      for (int32_t k : owned_) {
-        rn[k] = rho[k] + 0.5 * dt * dr[k];                                                     // rho^C
-        for (int c = 0; c < D; ++c) xn[k * D + c] = x[k * D + c] + 0.5 * dt * vh[k * D + c];  // x^C
-        for (int c = 0; c < D; ++c) {                                                          // eqs 117-119
-          xn[k * D + c] = 2.0 * xn[k * D + c] - x[k * D + c];
-          vn[k * D + c] = 2.0 * vn[k * D + c] - v[k * D + c];
-        }
-        rn[k] = 2.0 * rn[k] - rho[k];
-      }
-      sync(xn, D, vn, D, rn, 1);
+      const Report pred = corrected_state(dt, nsteps + 1);
+      if (!pred.ok()) return pred;
     }
     const Report bad = guarded([&] { return named(check_state(yn_.data(), nsteps + 1)); });
     agreed = agree_min(bad, nullptr, 0);

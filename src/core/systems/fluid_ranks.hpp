@@ -49,6 +49,8 @@ class FluidRanks final : public FluidSystem {
   // step limit; reach: twice the largest displacement of an owned particle since the
   // first evaluation, negated (for the minimum of the all-gather).
   Report prepare_accel(const double *ys, bool checked, double *a, double &limit, double &reach);
+  // The predictor-corrector's corrected state in yn_ (integrate's step number step).
+  Report corrected_state(double dt, int64_t step);
   // accel, with the mass check restricted to the owned nodes (ghost nodes far out have
   // no complete rows and no mass).
   Report owned_accel(const double *v, const double *rho, double *a);
