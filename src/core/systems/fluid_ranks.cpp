@@ -122,11 +122,14 @@ void FluidRanks::rows_done() {
     need_[k] = 1;
     for (int64_t e = rb_[k]; e < re_[k]; ++e) need_[cols_[e]] = 1;
   }
-  for (int32_t k = 0; k < n; ++k)
-    if (!need_[k]) {
-      re_[k] = rb_[k];
-      site_status_[k] = 0;
-    }
+  // The rows are the particle set's lists (re_ points into them): the emptied rows go
+  // to a copy of the row ends, which the next candidates() replaces.
+  re_need_.resize(n);
+  for (int32_t k = 0; k < n; ++k) {
+    re_need_[k] = need_[k] ? re_[k] : rb_[k];
+    if (!need_[k]) site_status_[k] = 0;
+  }
+  re_ = re_need_.data();
   const int32_t nch = (n + kChunk - 1) / kChunk;
   color_ptr_.assign({0, nch});
   chunk_order_.resize(nch);

@@ -70,6 +70,7 @@ class FluidRanks final : public FluidSystem {
   std::vector<int64_t> gid_;     // node -> global id
   std::vector<int32_t> owned_;   // the owned nodes, in the host's order
   std::vector<char> is_owned_, need_;  // per node
+  std::vector<int64_t> re_need_;         // row ends with the rows not needed emptied (rows_done)
   std::vector<double> ys_, yn_, rate_n_, vh_n_, dr_n_, buf_;  // node states and rates
   std::vector<double> yp_, vh0_, dr0_, a2_;  // the predictor-corrector's predicted stage
   std::vector<double> xfirst_;   // owned positions at the first evaluation (the halo's reference)
