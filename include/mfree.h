@@ -1802,6 +1802,20 @@ MFREE_API mfree_status_t mfree_system_set_consistent_integration(mfree_system_t 
  */
 MFREE_API mfree_status_t mfree_system_set_velocity_smoothing(mfree_system_t *sys,
                                                              double beta);
+/**
+ * The fluid's CFL step with the Galerkin lumped masses (not in [CuetoFelgueroso2004]; a
+ * time-step control, the scheme is unchanged): mfree_system_integrate's step becomes
+ * cfl h / max_i (c_i + |v_i|) sqrt(M_i / m_i), the square root taken only where a
+ * particle's lumped mass m_i (eq 56) is below its particle mass M_i. Next to
+ * ill-conditioned linear MLS rows m_i falls to a third of M_i, the local acoustic
+ * frequency grows as sqrt(M_i / m_i), and the step of eq 120 crosses the explicit
+ * schemes' stability limit (docs/time-integration.md). No effect with
+ * MFREE_LUMP_PHYSICAL.
+ * @param[in] sys  a fluid system
+ * @param[in] on   0 (default: the step of eq 120) or 1; else MFREE_ERR_ARG
+ * @return MFREE_SUCCESS, or a failure named with the parameters
+ */
+MFREE_API mfree_status_t mfree_system_set_lumped_mass_step(mfree_system_t *sys, int32_t on);
 
 /** Length of the state vector.
  * @param[in] sys the system @param[out] neq the length

@@ -1327,6 +1327,13 @@ module mfree
       real(c_double), value :: beta
     end function mfree_system_set_velocity_smoothing_c
 
+    integer(c_int) function mfree_system_set_lumped_mass_step_c(sys, on) &
+        bind(C, name="mfree_system_set_lumped_mass_step")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: on
+    end function mfree_system_set_lumped_mass_step_c
+
     integer(c_int) function mfree_system_set_box_c(sys, lo, hi) &
         bind(C, name="mfree_system_set_box")
       import :: c_int, c_double, c_ptr
@@ -1623,6 +1630,7 @@ module mfree
   public :: mfree_system_set_walls_c, mfree_system_set_box_c, mfree_system_get_size_c
   public :: mfree_system_set_dummy_particles_c, mfree_system_set_density_diffusion_c
   public :: mfree_system_set_consistent_integration_c, mfree_system_set_velocity_smoothing_c
+  public :: mfree_system_set_lumped_mass_step_c
   public :: mfree_system_rhs_c, mfree_system_assemble_mass_c
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
@@ -1747,6 +1755,7 @@ module mfree
   public :: mfree_system_set_lumping, mfree_system_set_walls, mfree_system_set_box
   public :: mfree_system_set_dummy_particles, mfree_system_set_density_diffusion
   public :: mfree_system_set_consistent_integration, mfree_system_set_velocity_smoothing
+  public :: mfree_system_set_lumped_mass_step
   public :: mfree_system_get_size, mfree_system_rhs, mfree_system_assemble_mass
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_get_velocity, mfree_system_integrate
@@ -3803,6 +3812,13 @@ contains
     real(c_double), intent(in) :: beta
     st = mfree_system_set_velocity_smoothing_c(sys%ptr, beta)
   end function mfree_system_set_velocity_smoothing
+
+  !> The fluid's CFL step with the Galerkin lumped masses: 0 off (default, eq 120), 1 on.
+  integer(c_int) function mfree_system_set_lumped_mass_step(sys, on) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: on
+    st = mfree_system_set_lumped_mass_step_c(sys%ptr, on)
+  end function mfree_system_set_lumped_mass_step
 
   !> Typed wrapper of mfree_system_set_box (mfree.h).
   integer(c_int) function mfree_system_set_box(sys, lo, hi) result(st)

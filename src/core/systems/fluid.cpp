@@ -110,6 +110,11 @@ void FluidSystem::set_shepard_condition(double max_cond) {
   shepard_cond_ = max_cond;
 }
 
+void FluidSystem::set_lumped_mass_step(int on) {
+  if (on != 0 && on != 1) throw Error(MFREE_ERR_ARG, "lumped-mass step: 0 or 1, not " + std::to_string(on));
+  lumped_step_ = on != 0;
+}
+
 void FluidSystem::check_ready() const {
   if (mass_.size() != static_cast<size_t>(n_)) throw Error(MFREE_ERR_STATE, "particle masses are not set");
   if (!(h_ > 0.0)) throw Error(MFREE_ERR_STATE, "the smoothing length is not set");
@@ -325,7 +330,7 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   return rep;
 }
 
-double FluidSystem::stable_dt(const double *y) const {
+double FluidSystem::stable_dt(const double *y) {
   const size_t nd = static_cast<size_t>(dim_) * n_;
   const double *v = y + nd, *rho = y + 2 * nd;
   double tmax[64] = {};  // per thread (parallel_blocks runs at most 64): a maximum is exact in any order
@@ -356,7 +361,26 @@ double FluidSystem::stable_dt(const double *y) const {
     }
     tmax[t] = cm;
   });
-  const double cmax = *std::max_element(tmax, tmax + 64);
+  double cmax = *std::max_element(tmax, tmax + 64);
+  if (lumped_step_ && lump_ == MFREE_LUMP_GALERKIN) {
+    // Eq 120 takes a particle's inertia to be its mass M_i; the Galerkin lumped mass m_i
+    // (eq 56, as accel sums it) is what the acceleration divides by, and next to rows
+    // that extrapolate (ill-conditioned linear MLS at a wall or a sheet, whose N_i(x_k) < 0)
+    // it falls to a third of M_i: the local acoustic frequency grows as sqrt(M_i / m_i)
+    // and leap-frog's limit dt omega = 2 is crossed (docs/time-integration.md).
+    lumped_.assign(n_, 0.0);
+    for (int32_t k = 0; k < nq(); ++k)
+      for (int64_t q = rb(k); q < re(k); ++q)
+        if (cols_[q] < n_) lumped_[cols_[q]] += N_[q] * (k < n_ ? mass_[k] / share(k) : 0.0);
+    for (int32_t i = 0; i < n_; ++i) {
+      if (!(lumped_[i] < mass_[i])) continue;
+      double vv = 0.0;
+      for (int c = 0; c < dim_; ++c) vv += v[i * dim_ + c] * v[i * dim_ + c];
+      const double s = std::sqrt(gamma_ * kappa_ / rho[i]) + std::sqrt(vv);
+      // (a non-positive lumped mass stops accel with MFREE_FAIL_SINGULAR)
+      if (lumped_[i] > 0.0) cmax = std::max(cmax, s * std::sqrt(mass_[i] / lumped_[i]));
+    }
+  }
   return cmax > 0.0 ? h_ / cmax : INFINITY;
 }
 

@@ -42,6 +42,9 @@ class FluidSystem : public System {
   void set_density_diffusion(double delta);
   void set_consistent_integration(int on);  // 0 (default) or 1: constant VCI correction
   void set_velocity_smoothing(double beta);  // 0 (default): off
+  // The CFL step with each particle's speed scaled by sqrt(M_i / m_i) where its Galerkin
+  // lumped mass m_i is below its particle mass M_i (fluid.cpp, stable_dt); 0 (default): eq 120.
+  void set_lumped_mass_step(int on);
 
   int dim() const { return dim_; }
   int32_t size() const { return n_; }
@@ -145,7 +148,7 @@ class FluidSystem : public System {
   Report accel_end(const AccelArgs &aa, double *a);
   // Interpolated velocities and density rates for velocity parameters v.
   void kinematics(const double *v, const double *rho, double *vhat, double *drho) const;
-  double stable_dt(const double *y) const;  // h / max(c_i + |v_i|)
+  double stable_dt(const double *y);  // h / max(c_i + |v_i|), or with lumped_step_ (on the prepared tables)
   std::string fastest(const double *y) const;  // message part naming the particle of max c_i + |v_i|
   // The first invalid particle of y, if any; step >= 0 prefixes the message with it.
   Report check_state(const double *y, int64_t step) const;
@@ -229,6 +232,8 @@ class FluidSystem : public System {
   // 123) in accel instead of v_hat at the point, or nullptr: the predictor-corrector's
   // corrector stage decides it with the step's starting v_hat (fluid.cpp, integrate).
   const double *wall_switch_v_ = nullptr;
+  bool lumped_step_ = false;           // set_lumped_mass_step
+  std::vector<double> lumped_;         // stable_dt's lumped masses (with lumped_step_)
   // accel scatters row k's contributions to the nodes of the row; rows go in chunks of
   // kChunk, chunk_order_[color_ptr_[c] .. color_ptr_[c + 1]) are the chunks of colour c,
   // which no two of touch a common node. Colours run one after another, so every node
