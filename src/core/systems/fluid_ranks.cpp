@@ -206,9 +206,9 @@ Report FluidRanks::owned_accel(const double *v, const double *rho, double *a) {
 
 Report FluidRanks::prepare_accel(const double *ys, bool checked, double *a, double &limit, double &reach) {
   ghost_fault_ = false;
-  if (dummy_.n || delta_ != 0.0 || vci_ || vsmooth_ != 0.0 || open_)
+  if (dummy_.n || delta_ != 0.0 || vci_ || vsmooth_ != 0.0 || open_ || lumped_step_)
     throw Error(MFREE_ERR_UNSUPPORTED, "on ranks the fluid has no dummy particles, density diffusion, consistent "
-                                       "integration, velocity smoothing or open boundaries yet");
+                                       "integration, velocity smoothing, open boundaries or lumped-mass step yet");
   Report r = named(prepare(ys, checked));
   if (!r.ok()) return r;
   const int D = dim();
