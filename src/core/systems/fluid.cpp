@@ -434,24 +434,9 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
       rep.message = "step " + std::to_string(nsteps) + ": " + rep.message;
       return rep;
     }
-    const double limit = stable_dt(y);
-    double dt = cfl > 0.0 ? cfl * limit : dt_max;
-    if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
-    if (cfl <= 0.0 && dt > limit) {
-      std::ostringstream s;
-      s << "step " << nsteps + 1 << ": dt = " << dt << " exceeds the CFL limit " << limit << " (003 eq 120)";
-      rep.fail(MFREE_FAIL_CFL, s.str());
-      return rep;
-    }
-    if (!(t + dt > t) && dt < t_end - t) {
-      // speeds so large that h / max(c + |v|) is 0 (|v|^2 or gamma kappa / rho overflow)
-      // or a step below t's resolution: the loop would never end
-      std::ostringstream s;
-      s << "step " << nsteps + 1 << ": the step dt = " << dt << " no longer advances t = " << t;
-      if (cfl > 0.0) s << fastest(y) << " (003 eq 120)";
-      rep.fail(MFREE_FAIL_CFL, s.str());
-      return rep;
-    }
+    double dt = 0.0;
+    rep = step_size(stable_dt(y), cfl, dt_max, t, t_end, nsteps, y, dt);
+    if (!rep.ok()) return rep;
     dt = std::min(dt, t_end - t);
     double *yn = work_state_.data();
     const double *x = y, *v = y + nd, *rho = y + 2 * nd;
@@ -508,6 +493,30 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
     ++nsteps;
     if (progress && progress(user, nsteps, t, dt)) break;
   }
+  return rep;
+}
+
+Report FluidSystem::step_size(double limit, double cfl, double dt_max, double t, double t_end, int64_t nsteps,
+                              const double *y, double &dt) const {
+  Report rep;
+  dt = cfl > 0.0 ? cfl * limit : dt_max;
+  if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
+  if (cfl <= 0.0 && dt > limit) {
+    std::ostringstream s;
+    s << "step " << nsteps + 1 << ": dt = " << dt << " exceeds the CFL limit " << limit << " (003 eq 120)";
+    rep.fail(MFREE_FAIL_CFL, s.str());
+    return rep;
+  }
+  if (!(t + dt > t) && dt < t_end - t) {
+    // speeds so large that h / max(c + |v|) is 0 (|v|^2 or gamma kappa / rho overflow)
+    // or a step below t's resolution: the loop would never end
+    std::ostringstream s;
+    s << "step " << nsteps + 1 << ": the step dt = " << dt << " no longer advances t = " << t;
+    if (cfl > 0.0) s << (y ? fastest(y) : std::string()) << " (003 eq 120)";
+    rep.fail(MFREE_FAIL_CFL, s.str());
+    return rep;
+  }
+  dt = std::min(dt, t_end - t);
   return rep;
 }
 

@@ -149,6 +149,11 @@ class FluidSystem : public System {
   // Interpolated velocities and density rates for velocity parameters v.
   void kinematics(const double *v, const double *rho, double *vhat, double *drho) const;
   double stable_dt(const double *y);  // h / max(c_i + |v_i|), or with lumped_step_ (on the prepared tables)
+  // integrate's step from the stable limit (003 eq 120): cfl * limit capped by dt_max (cfl
+  // > 0) or dt_max checked against the limit, then cut at t_end; a failure if it no longer
+  // advances t (y, if not NULL, names the fastest particle in the message).
+  Report step_size(double limit, double cfl, double dt_max, double t, double t_end, int64_t nsteps,
+                   const double *y, double &dt) const;
   std::string fastest(const double *y) const;  // message part naming the particle of max c_i + |v_i|
   // The first invalid particle of y, if any; step >= 0 prefixes the message with it.
   Report check_state(const double *y, int64_t step) const;

@@ -449,22 +449,9 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
         << " with the particles' displacements): rebuild the halo and the system";
       throw Error(MFREE_ERR_HALO, s.str());
     }
-    const double limit = vals[0];
-    double dt = cfl > 0.0 ? cfl * limit : dt_max;
-    if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
-    if (cfl <= 0.0 && dt > limit) {
-      std::ostringstream s;
-      s << "step " << nsteps + 1 << ": dt = " << dt << " exceeds the CFL limit " << limit << " (003 eq 120)";
-      agreed.fail(MFREE_FAIL_CFL, s.str());
-      return agreed;
-    }
-    if (!(t + dt > t) && dt < t_end - t) {
-      std::ostringstream s;
-      s << "step " << nsteps + 1 << ": the step dt = " << dt << " no longer advances t = " << t << " (003 eq 120)";
-      agreed.fail(MFREE_FAIL_CFL, s.str());
-      return agreed;
-    }
-    dt = std::min(dt, t_end - t);
+    double dt = 0.0;
+    agreed = step_size(vals[0], cfl, dt_max, t, t_end, nsteps, nullptr, dt);
+    if (!agreed.ok()) return agreed;
     const double *x = ys_.data(), *v = x + nd, *rho = v + nd;
     double *xn = yn_.data(), *vn = xn + nd, *rn = vn + nd;
     const double *rate = rate_n_.data(), *vh = vh_n_.data(), *dr = dr_n_.data();
