@@ -78,6 +78,21 @@ mfree_system_t *elastic_handle(mfree_context_t *ctx, std::unique_ptr<mfree::Elas
   return s;
 }
 
+// The totals of an open boundary k (an inflow gate or an outflow line); either output
+// may be NULL.
+template <class Totals>
+mfree_status_t open_boundary_totals(const mfree_system_t *sys, const char *fn, const char *what, Totals totals,
+                                    int32_t k, int64_t *count, double *mass) {
+  return mfree::with_handle(sys, fn, [&](const mfree::System &base) {
+    const auto &f = kind<mfree::FluidSystem>(base, what);
+    int64_t c = 0;
+    double m = 0.0;
+    (f.*totals)(k, c, m);
+    if (count) *count = c;
+    if (mass) *mass = m;
+    return MFREE_SUCCESS;
+  });
+}
 }  // namespace
 
 extern "C" {
@@ -275,27 +290,13 @@ mfree_status_t mfree_system_get_active(const mfree_system_t *sys, int32_t *nacti
 }
 
 mfree_status_t mfree_system_get_inflow(const mfree_system_t *sys, int32_t gate, int64_t *count, double *mass) {
-  return mfree::with_handle(sys, "mfree_system_get_inflow", [&](const mfree::System &base) {
-    const auto &f = kind<mfree::FluidSystem>(base, "inflow (not a fluid)");
-    int64_t c = 0;
-    double m = 0.0;
-    f.inflow_totals(gate, c, m);
-    if (count) *count = c;
-    if (mass) *mass = m;
-    return MFREE_SUCCESS;
-  });
+  return open_boundary_totals(sys, "mfree_system_get_inflow", "inflow (not a fluid)",
+                              &mfree::FluidSystem::inflow_totals, gate, count, mass);
 }
 
 mfree_status_t mfree_system_get_outflow(const mfree_system_t *sys, int32_t k, int64_t *count, double *mass) {
-  return mfree::with_handle(sys, "mfree_system_get_outflow", [&](const mfree::System &base) {
-    const auto &f = kind<mfree::FluidSystem>(base, "outflow (not a fluid)");
-    int64_t c = 0;
-    double m = 0.0;
-    f.outflow_totals(k, c, m);
-    if (count) *count = c;
-    if (mass) *mass = m;
-    return MFREE_SUCCESS;
-  });
+  return open_boundary_totals(sys, "mfree_system_get_outflow", "outflow (not a fluid)",
+                              &mfree::FluidSystem::outflow_totals, k, count, mass);
 }
 
 mfree_status_t mfree_system_create_elastodynamic(mfree_context_t *ctx, mfree_assembler_t *as, double density,
