@@ -1,12 +1,13 @@
-/* The Galerkin-SPH fluid's own shape-function tables (src/core/systems/fluid.cpp: linear MLS
- * with the cubic spline, rebuilt at every evaluation on Verlet candidate lists that are
+/* The Galerkin-SPH fluid's shape-function tables (src/core/systems/fluid_tables.cpp: linear
+ * MLS with the cubic spline by the approximants' row kernels, rebuilt at every evaluation on
+ * the rows of the particle set's search with a Verlet skin, whose candidate lists are
  * reused while no particle has moved more than half the skin) against independent
  * references, on a jittered patch in a shear flow that moves the particles by about
  * 0.05 h per step and neighbours relative to each other by up to about 0.1 h per step
  * (more than the skin, 0.25 h, within the test), so that the candidate lists are both
  * reused and rebuilt and a missed rebuild would lose pairs:
  * - the pattern of the interpolation matrix S_kj = N_j(x_k) is exactly the O(N^2) set
- *   of pairs closer than 2h, after every step;
+ *   of pairs at most 2h apart (the closed support of every approximant), after every step;
  * - S and the density rates -rho_k sum_j v_j . grad N_j(x_k) equal the tables of the
  *   library's MLS approximant (order 1, cubic spline, same support) to round-off at
  *   every well-conditioned site (condition number < 50; the fluid switches to Shepard
@@ -80,7 +81,7 @@ static double dist2(const double *y, int a, int b) {
   return r2;
 }
 
-/* Neighbours of every particle closer than 2h, by brute force, in column order (cols
+/* Neighbours of every particle at most 2h away (closed support), by brute force, in column order (cols
  * holds MAXROW per particle: ~30 neighbours in 2D and ~115 in 3D). */
 enum { MAXROW = 256 };
 static int64_t brute_pairs(const double *y, int64_t *rp, int32_t *cols) {
@@ -89,7 +90,7 @@ static int64_t brute_pairs(const double *y, int64_t *rp, int32_t *cols) {
   for (int k = 0; k < N; ++k) {
     rp[k] = nnz;
     for (int j = 0; j < N; ++j)
-      if (dist2(y, j, k) < R2) cols[nnz++] = j;
+      if (dist2(y, j, k) <= R2) cols[nnz++] = j;
     assert_true(nnz - rp[k] <= MAXROW);
   }
   rp[N] = nnz;
@@ -166,7 +167,7 @@ static void tables_against_references(int dim, int steps) {
                                             NULL, &done));
       assert_int_equal(done, 1);
     }
-    /* pattern: exactly the pairs closer than 2h (Verlet lists reused or rebuilt) */
+    /* pattern: exactly the pairs at most 2h apart (Verlet lists reused or rebuilt) */
     mfree_matrix_t *S = NULL;
     assert_ok(ctx, mfree_system_assemble_interpolation(sys, y, &S));
     const int64_t *rp;
