@@ -1,7 +1,9 @@
 /**
  * @file mfree_mpi.h
- * @brief Ghost layers and halo exchange over MPI for mfree particle sets (libmfree_mpi,
- * pkg-config mfree-mpi, CMake mfree::mfree_mpi).
+ * @brief mfree over MPI (libmfree_mpi, pkg-config mfree-mpi, CMake mfree::mfree_mpi): ghost
+ * layers and halo exchange for particle sets, migration of particles between ranks with
+ * Zoltan partitions (mfree_migration_*), and the elastodynamic and fluid systems on ranks
+ * (mfree_halo_create_elastodynamic, mfree_halo_create_fluid).
  *
  * For hosts without halo code of their own. Each rank gives its owned particles
  * (positions, optional global ids) and a halo width; the plan finds the ghosts (every
