@@ -17,6 +17,15 @@
  * the first kick throws the layer off (see tests/t702). The fluid's edge x = 0 is the
  * column's far face (Martin & Moyce's origin) and z = 0 the floor.
  *
+ * Options beyond the paper. --no-slip 1: the experiment's tank has no-slip walls; four
+ * layers of dummy particles at spacing d past the floor and both end walls
+ * (mfree_system_set_dummy_particles: zero velocity parameters, so the interpolated velocity
+ * vanishes at the walls), the wall force kept. --diffusion D: density diffusion (delta-SPH),
+ * which a run with water's viscosity (--mu 0.001) needs to reach T = 3. --lumped-step 1: the
+ * CFL step with the lumped masses (mfree_system_set_lumped_mass_step), which holds the 16a
+ * tank to T = 8 at CFL 0.5 with the library's Shepard condition. docs/fluid.md gives the
+ * fronts each setting measures against the experiment.
+ *
  * Front. Z = (max_i x_i + d/2) / a over all fluid particles (a particle stands for the
  * cell of width d around it, so Z = 1 at t = 0), against T = t sqrt(2 g / a). The front
  * of the particles touching the floor (z_i < 1.5 d) is written to the CSV too.
@@ -25,11 +34,15 @@
  * on PATH, not --no-plot) and the JSON summary dam_break.json (--json: on stdout too):
  * {"front":[[T,Z],...],"front_floor":[[T,Z_floor],...],"max_rel_dev":..,"compared":..,
  * "particles":..,"steps":..,"wall_seconds":..,"mass_rel_error":..,"status":..,"error":..,
- * "t_end":..}, where max_rel_dev is the largest |Z - Z_exp| / Z_exp over the data points
- * with 1 <= T <= 3 (Z linearly interpolated in T; -1 when no data file) and t_end the T
- * reached; "max_rel_dev_wide" and "compared_wide" the same over 0.5 <= T <= 3, and
- * "time_offset":[mean,min,max] the lag of the experiment there: T_exp minus the T at
- * which the simulated front reaches Z_exp, point by point. With --vtu DIR (or --vtu-every T): dam_break.pvd indexing dam_break_NNNN.vtu
+ * "t_end":..,"density_range":[min,max]}, where max_rel_dev is the largest
+ * |Z - Z_exp| / Z_exp over the data points with 1 <= T <= 3 (Z linearly interpolated in
+ * T; -1 when no data file), t_end the T reached and density_range the densities' extremes
+ * at the output times (every 0.05 in T); "max_rel_dev_wide" and "compared_wide" the same
+ * over 0.5 <= T <= 3, and "time_offset":[mean,min,max] the lag of the experiment there:
+ * T_exp minus the T at which the simulated front reaches Z_exp, point by point; the
+ * settings as "a", "nx", "cfl", "mu", "shepard_condition", "lumped_mass_step", "no_slip",
+ * "diffusion", "scheme".
+ * With --vtu DIR (or --vtu-every T): dam_break.pvd indexing dam_break_NNNN.vtu
  * (position, velocity = interpolated v_hat, pressure, density) every 0.25 in T. A run that
  * stops on an error (a particle leaving the tank, a non-finite state) says so on stderr
  * and exits with status 3. */
@@ -50,8 +63,8 @@
 static const double kG = 9.81, kRho0 = 1000.0, kGamma = 7.0;
 
 typedef struct {
-  double a, tank, t_end, cfl, mu, strength, offset, out_dt, shepard;
-  int nx, scheme, lumping;
+  double a, tank, t_end, cfl, mu, strength, offset, out_dt, shepard, diffusion;
+  int nx, scheme, lumping, lumped_step, no_slip;
   const char *data;
   fc_run_t run;
 } options_t;
@@ -71,6 +84,10 @@ static void usage(FILE *f) {
           "                  (default 100, the library's; 20 runs the 16a tank to T = 8 at CFL 0.5)\n"
           "  --scheme S      leapfrog (default) | pc (predictor-corrector)\n"
           "  --lumping L     galerkin (default, 003 eq 56) | physical (eq 58)\n"
+          "  --lumped-step 0|1  CFL step with the lumped masses (mfree_system_set_lumped_mass_step;\n"
+          "                  default 0, eq 120 as in the paper; 1 runs the 16a tank to T = 8 at CFL 0.5)\n"
+          "  --no-slip 0|1   no-slip floor and end walls: dummy particles past them (default 0)\n"
+          "  --diffusion D   density diffusion delta (mfree_system_set_density_diffusion; default 0)\n"
           "  --data PATH     Martin & Moyce CSV (default: the repository's data/martin_moyce_1952.csv)\n"
           "  (--vtu-every in units of T, default 0.25)\n");
   fc_run_usage(f);
@@ -85,7 +102,8 @@ static int parse(int argc, char **argv, options_t *o) {
                               {"--strength", 'd', &o->strength}, {"--offset", 'd', &o->offset},
                               {"--data", 's', &o->data},       {"--scheme", 's', &scheme},
                               {"--lumping", 's', &lumping},    {"--shepard-cond", 'd', &o->shepard},
-                              {NULL, 0, NULL}};
+                              {"--lumped-step", 'i', &o->lumped_step}, {"--no-slip", 'i', &o->no_slip},
+                              {"--diffusion", 'd', &o->diffusion}, {NULL, 0, NULL}};
   const int parsed = fc_parse(argc, argv, &o->run, opts, usage);
   if (parsed) return parsed;
   if (!strcmp(scheme, "leapfrog")) o->scheme = MFREE_INTEGRATOR_LEAPFROG;
@@ -96,7 +114,8 @@ static int parse(int argc, char **argv, options_t *o) {
   else o->lumping = -1;
   const int ok = o->scheme >= 0 && o->lumping >= 0 && o->nx >= 2 && o->a > 0 && o->tank > 1 && o->t_end > 0 &&
                  o->cfl > 0 && o->cfl <= 1 && o->mu >= 0 && o->strength >= 0 && o->offset >= 0 &&
-                 o->shepard >= 1;
+                 o->shepard >= 1 && (o->lumped_step == 0 || o->lumped_step == 1) &&
+                 (o->no_slip == 0 || o->no_slip == 1) && o->diffusion >= 0;
   if (!ok) usage(stderr);
   return ok ? 0 : 2;
 }
@@ -127,8 +146,8 @@ static int read_data(const char *path, double *T, double *Z, int cap) {
   } while (0)
 
 int main(int argc, char **argv) {
-  options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 0.05, 100.0, 24, MFREE_INTEGRATOR_LEAPFROG,
-                 MFREE_LUMP_GALERKIN, MFREE_DATA_DIR "/martin_moyce_1952.csv", {0}};
+  options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 0.05, 100.0, 0.0, 24, MFREE_INTEGRATOR_LEAPFROG,
+                 MFREE_LUMP_GALERKIN, 0, 0, MFREE_DATA_DIR "/martin_moyce_1952.csv", {0}};
   fc_run_init(&o.run, "dam_break", 0.25);
   const int parsed = parse(argc, argv, &o);
   if (parsed) return parsed < 0 ? 0 : parsed;
@@ -170,6 +189,9 @@ int main(int argc, char **argv) {
   CHECK(fc_fluid_create(ctx, n, m, &kRho0, 0, kappa, kGamma, o.mu, h, kG, &walls, o.strength, &sys));
   CHECK(mfree_system_set_lumping(sys, (mfree_lumping_t)o.lumping));
   CHECK(mfree_system_set_shepard_condition(sys, o.shepard));
+  CHECK(mfree_system_set_lumped_mass_step(sys, o.lumped_step));
+  CHECK(mfree_system_set_density_diffusion(sys, o.diffusion));
+  if (o.no_slip) CHECK(fc_dummy_tank(sys, (int)lround(L / d), top, d));
   const double lo[2] = {-off, -off}, hi[2] = {L + off, 10.0 * H}; /* crossing a wall fails */
   CHECK(mfree_system_set_box(sys, lo, hi));
   double mass0 = 0.0;
@@ -192,7 +214,7 @@ int main(int argc, char **argv) {
   double *fT = malloc((size_t)(nout + 1) * sizeof *fT), *fZ = malloc((size_t)(nout + 1) * sizeof *fZ);
   double *fZf = malloc((size_t)(nout + 1) * sizeof *fZf);
   int nf = 0;
-  double t = 0.0;
+  double t = 0.0, rho_lo = INFINITY, rho_hi = -INFINITY; /* densities at the output times */
   int64_t steps = 0;
   mfree_status_t run = MFREE_SUCCESS;
   ex_progress_t prog;
@@ -208,6 +230,8 @@ int main(int argc, char **argv) {
     for (int q = 0; q < n; ++q) {
       if (y[2 * q] > xmax) xmax = y[2 * q];
       if (y[2 * q + 1] < 1.5 * d && y[2 * q] > xfloor) xfloor = y[2 * q];
+      rho_lo = fmin(rho_lo, y[4 * (size_t)n + q]);
+      rho_hi = fmax(rho_hi, y[4 * (size_t)n + q]);
     }
     const double T = t * tscale, Z = (xmax + 0.5 * d) / a, Zf = (xfloor + 0.5 * d) / a;
     fT[nf] = T;
@@ -305,10 +329,16 @@ int main(int argc, char **argv) {
   fc_json_int(&js, "steps", steps);
   fc_json_num(&js, "wall_seconds", wall);
   fc_json_num(&js, "mass_rel_error", mass_err);
+  const double rho_range[2] = {rho_lo, rho_hi};
+  fc_json_table(&js, "density_range", 2, 1, rho_range);
   fc_json_num(&js, "a", a);
   fc_json_int(&js, "nx", nx);
   fc_json_num(&js, "cfl", o.cfl);
   fc_json_num(&js, "shepard_condition", o.shepard);
+  fc_json_int(&js, "lumped_mass_step", o.lumped_step);
+  fc_json_int(&js, "no_slip", o.no_slip);
+  fc_json_num(&js, "diffusion", o.diffusion);
+  fc_json_num(&js, "mu", o.mu);
   fc_json_str(&js, "scheme", o.scheme == MFREE_INTEGRATOR_LEAPFROG ? "leapfrog" : "pc");
   fc_json_int(&js, "status", (int)run);
   fc_json_str(&js, "error", run == MFREE_SUCCESS ? NULL : msg);
@@ -321,7 +351,8 @@ int main(int argc, char **argv) {
     if (compared_wide)
       printf("over 0.5 <= T <= 3: %.3f (%d points); the experiment lags by T = %.3f (%.3f to %.3f)\n", maxdev_wide,
              compared_wide, offsets[0], offsets[1], offsets[2]);
-    printf("mass: relative error %.2e; output in %s\n", mass_err, out_dir);
+    printf("mass: relative error %.2e; densities %.1f to %.1f at the output times; output in %s\n", mass_err,
+           rho_lo, rho_hi, out_dir);
   }
   mfree_system_destroy(&sys);
   mfree_context_destroy(&ctx);

@@ -42,6 +42,26 @@ int fc_walls_tank(fc_walls_t *w, double x0, double x1, double top, double off, d
   return bad;
 }
 
+mfree_status_t fc_dummy_tank(mfree_system_t *sys, int ncol, double top, double d) {
+  const int nl = 4, nrow = (int)ceil(top / d), ndum = nl * (ncol + 2 * nl) + 2 * nl * nrow;
+  const double L = ncol * d;
+  double *xd = malloc(2 * (size_t)ndum * sizeof *xd);
+  if (!xd) return MFREE_ERR_ALLOC;
+  int k = 0;
+  for (int l = 0; l < nl; ++l)
+    for (int i = -nl; i < ncol + nl; ++i, ++k) xd[2 * k] = (i + 0.5) * d, xd[2 * k + 1] = -(l + 0.5) * d;
+  for (int l = 0; l < nl; ++l)
+    for (int j = 0; j < nrow; ++j)
+      for (int side = 0; side < 2; ++side, ++k) {
+        xd[2 * k] = side ? L + (l + 0.5) * d : -(l + 0.5) * d;
+        xd[2 * k + 1] = (j + 0.5) * d;
+      }
+  const double vol = d * d;
+  const mfree_status_t st = mfree_system_set_dummy_particles(sys, ndum, xd, &vol, 0);
+  free(xd);
+  return st;
+}
+
 int fc_water_block(double *y, double *m, int n, int q0, double x0, int ni, int nj, double d, double H,
                    double rho0, double kappa, double gamma, double g) {
   int q = q0;

@@ -41,6 +41,11 @@ int fc_walls_segment(fc_walls_t *w, double x0, double z0, double x1, double z1, 
  * 1 when out of memory. */
 int fc_walls_tank(fc_walls_t *w, double x0, double x1, double top, double off, double ds);
 void fc_walls_free(fc_walls_t *w);
+/* No-slip walls for the tank whose fluid fills 0 <= x <= ncol d above z = 0: four layers
+ * of dummy particles (mfree_system_set_dummy_particles, volume d^2) at spacing d continuing
+ * the fluid's lattice past the floor and both side walls, the side layers up to height
+ * top. Returns the library's status (MFREE_ERR_ALLOC when out of memory). */
+mfree_status_t fc_dummy_tank(mfree_system_t *sys, int ncol, double top, double d);
 
 /* Particles q0, q0 + 1, ... of a block of water at rest: nj rows of ni particles at the
  * centres of lattice cells of spacing d, the lower-left cell's corner at (x0, 0), row by

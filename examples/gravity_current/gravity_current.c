@@ -144,24 +144,7 @@ int main(int argc, char **argv) {
   CHECK(fc_fluid_create(ctx, n, m, rho0, 1, kappa, kGamma, mu, h, kG, &w, 10.0, &sys));
   const double lo[2] = {-off, -off}, hi[2] = {L + off, 10.0 * kD};
   CHECK(mfree_system_set_box(sys, lo, hi));
-  if (noslip) { /* four layers of dummy particles past the floor and the side walls */
-    const int nl = 4, ncol = nx + 2 * nl, nrow = (int)ceil(top / d);
-    const int ndum = nl * ncol + 2 * nl * nrow;
-    double *xd = malloc(2 * (size_t)ndum * sizeof *xd);
-    if (!xd) return 1;
-    int k = 0;
-    for (int l = 0; l < nl; ++l)
-      for (int i = -nl; i < nx + nl; ++i, ++k) xd[2 * k] = (i + 0.5) * d, xd[2 * k + 1] = -(l + 0.5) * d;
-    for (int l = 0; l < nl; ++l)
-      for (int j = 0; j < nrow; ++j)
-        for (int side = 0; side < 2; ++side, ++k) {
-          xd[2 * k] = side ? L + (l + 0.5) * d : -(l + 0.5) * d;
-          xd[2 * k + 1] = (j + 0.5) * d;
-        }
-    const double vol = d * d;
-    CHECK(mfree_system_set_dummy_particles(sys, ndum, xd, &vol, 0));
-    free(xd);
-  }
+  if (noslip) CHECK(fc_dummy_tank(sys, nx, top, d)); /* four layers past the floor and the side walls */
   double mass0 = 0.0;
   for (int q = 0; q < n; ++q) mass0 += m[q];
 
