@@ -32,7 +32,9 @@
  *
  * Output in DIR (--out, default dam_break_out): front.csv, front.gp and front.png (gnuplot
  * on PATH, not --no-plot) and the JSON summary dam_break.json (--json: on stdout too):
- * {"front":[[T,Z],...],"front_floor":[[T,Z_floor],...],"max_rel_dev":..,"compared":..,
+ * {"front":[[T,Z],...],"front_floor":[[T,Z_floor],...],"time_digest":..,"front_digest":..,
+ * "front_floor_digest":.. (fc_digest of the T, Z and Z_floor samples: equal digests, equal
+ * bits),"max_rel_dev":..,"compared":..,
  * "particles":..,"steps":..,"wall_seconds":..,"mass_rel_error":..,"status":..,"error":..,
  * "t_end":..,"density_range":[min,max]}, where max_rel_dev is the largest
  * |Z - Z_exp| / Z_exp over the data points with 1 <= T <= 3 (Z linearly interpolated in
@@ -60,8 +62,6 @@
 #include "fluid_common.h"
 #include "util.h"
 
-static const double kG = 9.81, kRho0 = 1000.0, kGamma = 7.0;
-
 typedef struct {
   double a, tank, t_end, cfl, mu, strength, offset, out_dt, shepard, diffusion;
   int nx, scheme, lumping, lumped_step, no_slip;
@@ -70,26 +70,12 @@ typedef struct {
 } options_t;
 
 static void usage(FILE *f) {
-  fprintf(f,
-          "usage: mfree_dam_break [options]\n"
-          "  --nx N          particles across the column width a (default 24; 2N up its height)\n"
-          "  --a A           column width in m (default 0.05715, Martin & Moyce's 2.25 in)\n"
-          "  --tank L        tank length in units of a (default 5)\n"
-          "  --tend T        end time in units of sqrt(a / (2 g)) (default 3.2)\n"
-          "  --cfl C         CFL number of 003 eq 120 (default 0.5)\n"
-          "  --mu MU         dynamic viscosity (default 0.5, paper 003)\n"
-          "  --strength A    wall-force constant A (default 10, paper 003)\n"
-          "  --offset F      walls set back by F d from the fluid's edge (default 0.5)\n"
-          "  --shepard-cond C  Shepard functions where the MLS moment matrix's condition exceeds C\n"
-          "                  (default 100, the library's; 20 runs the 16a tank to T = 8 at CFL 0.5)\n"
-          "  --scheme S      leapfrog (default) | pc (predictor-corrector)\n"
-          "  --lumping L     galerkin (default, 003 eq 56) | physical (eq 58)\n"
-          "  --lumped-step 0|1  CFL step with the lumped masses (mfree_system_set_lumped_mass_step;\n"
-          "                  default 0, eq 120 as in the paper; 1 runs the 16a tank to T = 8 at CFL 0.5)\n"
-          "  --no-slip 0|1   no-slip floor and end walls: dummy particles past them (default 0)\n"
-          "  --diffusion D   density diffusion delta (mfree_system_set_density_diffusion; default 0)\n"
-          "  --data PATH     Martin & Moyce CSV (default: the repository's data/martin_moyce_1952.csv)\n"
-          "  (--vtu-every in units of T, default 0.25)\n");
+  fprintf(f, "usage: mfree_dam_break [options]\n");
+  fc_dam_usage(f);
+  fprintf(f, "  --lumped-step 0|1  CFL step with the lumped masses (mfree_system_set_lumped_mass_step;\n"
+             "                  default 0, eq 120 as in the paper; 1 runs the 16a tank to T = 8 at CFL 0.5)\n"
+             "  --no-slip 0|1   no-slip floor and end walls: dummy particles past them (default 0)\n"
+             "  --diffusion D   density diffusion delta (mfree_system_set_density_diffusion; default 0)\n");
   fc_run_usage(f);
 }
 
@@ -120,25 +106,6 @@ static int parse(int argc, char **argv, options_t *o) {
   return ok ? 0 : 2;
 }
 
-/* Martin & Moyce points (T, Z); returns the count, 0 if the file is missing. */
-static int read_data(const char *path, double *T, double *Z, int cap) {
-  FILE *f = path ? fopen(path, "r") : NULL;
-  if (!f) return 0;
-  char line[512];
-  int n = 0;
-  while (fgets(line, sizeof line, f) && n < cap) {
-    double t, z;
-    if (line[0] == '#') continue;
-    if (sscanf(line, "%lf,%lf", &t, &z) == 2) {
-      T[n] = t;
-      Z[n] = z;
-      ++n;
-    }
-  }
-  fclose(f);
-  return n;
-}
-
 #define CHECK(call)                                                               \
   do {                                                                            \
     const mfree_status_t st_ = (call);                                            \
@@ -155,61 +122,34 @@ int main(int argc, char **argv) {
   const char *out_dir = o.run.out;
 
   /* ---- geometry and initial state (003 Sect. 7.1; docs/papers.md, paper 003, choices 1) */
-  const double a = o.a, H = 2.0 * a, L = o.tank * a, d = a / o.nx, h = 1.5 * d;
-  const double kappa = 100.0 * kRho0 * 2.0 * kG * H / kGamma; /* 003 eq 125 */
-  const double tscale = sqrt(2.0 * kG / a);                   /* T = t sqrt(2 g / a) */
-  const int nx = o.nx, nz = 2 * o.nx, n = nx * nz;
+  fc_dam_t dam;
+  if (fc_dam_init(&dam, o.a, o.nx, o.tank, o.offset)) return 1;
+  const double a = dam.a, L = dam.L, d = dam.d, tscale = dam.tscale;
+  const int nx = dam.nx, n = dam.n;
   double *y = calloc(5 * (size_t)n, sizeof *y), *m = malloc((size_t)n * sizeof *m);
   if (!y || !m) return 1;
-  fc_water_block(y, m, n, 0, 0.0, nx, nz, d, H, kRho0, kappa, kGamma, kG);
-  /* walls: floor and both ends, spacing d/3, set back by offset * d, up to 1.5 H */
-  const double off = o.offset * d, ws = d / 3.0, top = 1.5 * H;
-  const int nb = (int)ceil((L + 2 * off) / ws) + 1, ns = (int)ceil((top + off) / ws);
-  const int nw = nb + 2 * ns;
-  double *wx = malloc(2 * (size_t)nw * sizeof *wx), *wn = malloc(2 * (size_t)nw * sizeof *wn);
-  int k = 0;
-  for (int q = 0; q < nb; ++q, ++k) {
-    wx[2 * k] = -off + q * (L + 2 * off) / (nb - 1);
-    wx[2 * k + 1] = -off;
-    wn[2 * k] = 0.0;
-    wn[2 * k + 1] = 1.0;
-  }
-  for (int q = 1; q <= ns; ++q)
-    for (int side = 0; side < 2; ++side, ++k) {
-      wx[2 * k] = side ? L + off : -off;
-      wx[2 * k + 1] = -off + q * (top + off) / ns;
-      wn[2 * k] = side ? -1.0 : 1.0;
-      wn[2 * k + 1] = 0.0;
-    }
+  fc_water_block(y, m, n, 0, 0.0, nx, dam.nz, d, dam.H, dam.rho0, dam.kappa, dam.gamma, dam.g);
 
   mfree_context_t *ctx = NULL;
   if (mfree_context_create(&ctx) != MFREE_SUCCESS) return 1;
   mfree_system_t *sys = NULL;
-  const fc_walls_t walls = {nw, nw, wx, wn};
-  CHECK(fc_fluid_create(ctx, n, m, &kRho0, 0, kappa, kGamma, o.mu, h, kG, &walls, o.strength, &sys));
-  CHECK(mfree_system_set_lumping(sys, (mfree_lumping_t)o.lumping));
-  CHECK(mfree_system_set_shepard_condition(sys, o.shepard));
+  CHECK(mfree_system_create_fluid(ctx, 2, n, &sys));
+  CHECK(fc_dam_configure(&dam, sys, m, o.mu, o.strength, (mfree_lumping_t)o.lumping, o.shepard));
   CHECK(mfree_system_set_lumped_mass_step(sys, o.lumped_step));
   CHECK(mfree_system_set_density_diffusion(sys, o.diffusion));
-  if (o.no_slip) CHECK(fc_dummy_tank(sys, (int)lround(L / d), top, d));
-  const double lo[2] = {-off, -off}, hi[2] = {L + off, 10.0 * H}; /* crossing a wall fails */
-  CHECK(mfree_system_set_box(sys, lo, hi));
+  if (o.no_slip) CHECK(fc_dummy_tank(sys, (int)lround(L / d), 1.5 * dam.H, d));
   double mass0 = 0.0;
   for (int q = 0; q < n; ++q) mass0 += m[q];
 
   /* ---- run ---- */
   double dT[64], dZ[64];
-  const int ndata = read_data(o.data, dT, dZ, 64);
+  const int ndata = fc_read_pairs(o.data, dT, dZ, 64);
   if (!ndata && !o.run.quiet)
     fprintf(stderr, "mfree_dam_break: no Martin & Moyce data at %s; the comparison is skipped\n", o.data);
-  FILE *csv = fc_open_csv(&o.run, "front.csv");
+  FILE *csv = fc_dam_csv(&o.run, &dam);
   if (!csv) return 1;
   fc_vtu_t vtu;
   if (fc_vtu_open(&vtu, fc_run_vtu_dir(&o.run), "dam_break", o.run.vtu_every)) return 1;
-  fprintf(csv, "# Martin & Moyce dam break, a = %g m, nx = %d, %d particles\n"
-               "# T = t sqrt(2 g / a), Z = (max x + d/2) / a, Z_floor: particles with z < 1.5 d\n"
-               "T,Z,Z_floor,t,steps\n", a, nx, n);
-
   const int nout = (int)floor(o.t_end / o.out_dt + 1e-9);
   double *fT = malloc((size_t)(nout + 1) * sizeof *fT), *fZ = malloc((size_t)(nout + 1) * sizeof *fZ);
   double *fZf = malloc((size_t)(nout + 1) * sizeof *fZf);
@@ -253,104 +193,25 @@ int main(int argc, char **argv) {
   double mass_err = 0.0;
   CHECK(fc_mass_error(sys, y, n, m, mass0, &mass_err));
 
-  /* ---- comparison with Martin & Moyce (1 <= T <= 3) ---- */
-  double maxdev = -1.0;
-  int compared = 0;
-  for (int q = 0; q < ndata; ++q) {
-    if (dT[q] < 1.0 || dT[q] > 3.0) continue;
-    for (int r = 0; r + 1 < nf; ++r)
-      if (fT[r] <= dT[q] && fT[r + 1] >= dT[q]) {
-        const double w = (dT[q] - fT[r]) / (fT[r + 1] - fT[r]);
-        const double Zs = (1 - w) * fZ[r] + w * fZ[r + 1];
-        maxdev = fmax(maxdev, fabs(Zs - dZ[q]) / dZ[q]);
-        ++compared;
-        break;
-      }
-  }
-  if (ndata && !compared) maxdev = -1.0;
-  /* the issue's range 0.5 <= T <= 3, and the time offset of each point there: T_exp - T
-   * where the simulated front reaches Z_exp (the front only advances until it hits the
-   * far wall, so the first crossing is taken) */
-  double maxdev_wide = -1.0, off_sum = 0.0, off_min = INFINITY, off_max = -INFINITY;
-  int compared_wide = 0, noff = 0;
-  for (int q = 0; q < ndata; ++q) {
-    if (dT[q] < 0.5 || dT[q] > 3.0) continue;
-    for (int r = 0; r + 1 < nf; ++r)
-      if (fT[r] <= dT[q] && fT[r + 1] >= dT[q]) {
-        const double w = (dT[q] - fT[r]) / (fT[r + 1] - fT[r]);
-        maxdev_wide = fmax(maxdev_wide, fabs((1 - w) * fZ[r] + w * fZ[r + 1] - dZ[q]) / dZ[q]);
-        ++compared_wide;
-        break;
-      }
-    for (int r = 0; r + 1 < nf; ++r)
-      if (fZ[r] <= dZ[q] && fZ[r + 1] >= dZ[q] && fZ[r + 1] > fZ[r]) {
-        const double off = dT[q] - (fT[r] + (dZ[q] - fZ[r]) / (fZ[r + 1] - fZ[r]) * (fT[r + 1] - fT[r]));
-        off_sum += off;
-        off_min = fmin(off_min, off);
-        off_max = fmax(off_max, off);
-        ++noff;
-        break;
-      }
-  }
-  const double offsets[3] = {noff ? off_sum / noff : NAN, noff ? off_min : NAN, noff ? off_max : NAN};
-
-  /* ---- plot: the front against the experiment ---- */
-  char csv_path[4096];
-  FILE *gp = ex_plot_path_ok(o.data) ? fc_plot_begin(&o.run, "front", 800, 560, "T = t (2g/a)^{1/2}", "Z = z/a",
-                                                     csv_path, sizeof csv_path)
-                                     : NULL;
-  if (gp) {
-    fprintf(gp, "set key top left\n"
-                "set title 'Dam break, n^2 = 2: Galerkin SPH (Cueto-Felgueroso et al. 2004) vs Martin and Moyce (1952)'\n"
-                "set xrange [0:%g]\n"
-                "plot '%s' using 1:2 with lines lw 2 title 'front, all particles (%d)', "
-                "'%s' using 1:3 with lines dt 2 title 'front, particles on the floor'",
-            o.t_end + 0.5, csv_path, n, csv_path);
-    if (ndata) fprintf(gp, ", '%s' using 1:2 with points pt 7 title 'Martin and Moyce (1952), n^2 = 2'", o.data);
-    fprintf(gp, "\n");
-    fc_plot_end(gp, &o.run, "front");
-  }
+  /* ---- comparison with Martin & Moyce, plot ---- */
+  fc_front_cmp_t cmp;
+  fc_front_compare(nf, fT, fZ, ndata, dT, dZ, &cmp);
+  fc_dam_plot(&o.run, &dam, o.data, ndata, o.t_end);
 
   fc_json_t js;
   fc_json_init(&js);
-  double *rows = malloc(2 * (size_t)(nf + 1) * sizeof *rows);
-  if (!rows) return 1;
-  for (int q = 0; q < nf; ++q) rows[2 * q] = fT[q], rows[2 * q + 1] = fZ[q];
-  fc_json_table(&js, "front", nf, 2, rows);
-  for (int q = 0; q < nf; ++q) rows[2 * q + 1] = fZf[q];
-  fc_json_table(&js, "front_floor", nf, 2, rows);
-  free(rows);
-  fc_json_num(&js, "max_rel_dev", maxdev);
-  fc_json_int(&js, "compared", compared);
-  fc_json_num(&js, "max_rel_dev_wide", compared_wide ? maxdev_wide : NAN);
-  fc_json_int(&js, "compared_wide", compared_wide);
-  fc_json_table(&js, "time_offset", 3, 1, offsets);
-  fc_json_int(&js, "particles", n);
-  fc_json_int(&js, "steps", steps);
-  fc_json_num(&js, "wall_seconds", wall);
+  const fc_dam_run_t info = {steps, wall, o.cfl, o.shepard, o.mu, t * tscale, o.scheme, run, msg};
+  fc_dam_json(&js, &dam, nf, fT, fZ, fZf, &cmp, &info);
   fc_json_num(&js, "mass_rel_error", mass_err);
   const double rho_range[2] = {rho_lo, rho_hi};
   fc_json_table(&js, "density_range", 2, 1, rho_range);
-  fc_json_num(&js, "a", a);
-  fc_json_int(&js, "nx", nx);
-  fc_json_num(&js, "cfl", o.cfl);
-  fc_json_num(&js, "shepard_condition", o.shepard);
   fc_json_int(&js, "lumped_mass_step", o.lumped_step);
   fc_json_int(&js, "no_slip", o.no_slip);
   fc_json_num(&js, "diffusion", o.diffusion);
-  fc_json_num(&js, "mu", o.mu);
-  fc_json_str(&js, "scheme", o.scheme == MFREE_INTEGRATOR_LEAPFROG ? "leapfrog" : "pc");
-  fc_json_int(&js, "status", (int)run);
-  fc_json_str(&js, "error", run == MFREE_SUCCESS ? NULL : msg);
-  fc_json_num(&js, "t_end", t * tscale);
   if (fc_json_finish(&js, &o.run)) return 1;
   if (!o.run.json_stdout) {
     printf("dam break: a = %g m, %d particles, %lld steps, %.1f s\n", a, n, (long long)steps, wall);
-    for (int q = 0; q < nf; q += 4) printf("  T = %5.2f  Z = %6.3f\n", fT[q], fZ[q]);
-    if (maxdev >= 0) printf("max |Z - Z_exp| / Z_exp over 1 <= T <= 3: %.3f (%d points)\n", maxdev, compared);
-    if (compared_wide)
-      printf("over 0.5 <= T <= 3: %.3f (%d points); the experiment lags by T = %.3f (%.3f to %.3f)\n", maxdev_wide,
-             compared_wide, offsets[0], offsets[1], offsets[2]);
+    fc_dam_print(nf, fT, fZ, &cmp);
     printf("mass: relative error %.2e; densities %.1f to %.1f at the output times; output in %s\n", mass_err,
            rho_lo, rho_hi, out_dir);
   }
@@ -358,8 +219,7 @@ int main(int argc, char **argv) {
   mfree_context_destroy(&ctx);
   free(y);
   free(m);
-  free(wx);
-  free(wn);
+  fc_dam_free(&dam);
   free(fT);
   free(fZ);
   free(fZf);

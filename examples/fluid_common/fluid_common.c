@@ -66,14 +66,18 @@ int fc_water_block(double *y, double *m, int n, int q0, double x0, int ni, int n
                    double rho0, double kappa, double gamma, double g) {
   int q = q0;
   for (int j = 0; j < nj; ++j)
-    for (int i = 0; i < ni; ++i, ++q) {
-      const double z = (j + 0.5) * d;
-      y[2 * q] = x0 + (i + 0.5) * d;
-      y[2 * q + 1] = z;
-      y[4 * (size_t)n + q] = rho0 * pow(1.0 + rho0 * g * (H - z) / kappa, 1.0 / gamma); /* 003 eq 65 */
-      m[q] = y[4 * (size_t)n + q] * d * d;
-    }
+    for (int i = 0; i < ni; ++i, ++q)
+      fc_water_cell(x0, i, j, d, H, rho0, kappa, gamma, g, y + 2 * q, y + 4 * (size_t)n + q, m + q);
   return q;
+}
+
+void fc_water_cell(double x0, int i, int j, double d, double H, double rho0, double kappa, double gamma, double g,
+                   double *x, double *rho, double *m) {
+  const double z = (j + 0.5) * d;
+  x[0] = x0 + (i + 0.5) * d;
+  x[1] = z;
+  *rho = rho0 * pow(1.0 + rho0 * g * (H - z) / kappa, 1.0 / gamma); /* 003 eq 65 */
+  *m = *rho * d * d;
 }
 
 int fc_water_drop(double *y, double *m, int n, int q0, double xc, double zc, double R, double d, double rho0,
@@ -404,15 +408,22 @@ int fc_run_error(mfree_context_t *ctx, const fc_run_t *r, mfree_status_t st, con
 mfree_status_t fc_fluid_create(mfree_context_t *ctx, int n, const double *m, const double *rho0, int64_t stride,
                                double kappa, double gamma, double mu, double h, double g, const fc_walls_t *walls,
                                double strength, mfree_system_t **sys) {
-  const double gv[2] = {0.0, -g};
   mfree_status_t st = mfree_system_create_fluid(ctx, 2, n, sys);
-  if (st == MFREE_SUCCESS) st = mfree_system_set_fluid(*sys, rho0, stride, kappa, gamma, mu);
-  if (st == MFREE_SUCCESS) st = mfree_system_set_masses(*sys, m, 1);
-  if (st == MFREE_SUCCESS) st = mfree_system_set_smoothing(*sys, h);
-  if (st == MFREE_SUCCESS) st = mfree_system_set_gravity(*sys, gv);
-  if (st == MFREE_SUCCESS && walls)
-    st = mfree_system_set_walls(*sys, walls->n, walls->x, walls->nrm, 0.7 * h, strength); /* 003 Sect. 6.2 */
+  if (st == MFREE_SUCCESS) st = fc_fluid_configure(*sys, m, rho0, stride, kappa, gamma, mu, h, g, walls, strength);
   if (st != MFREE_SUCCESS) mfree_system_destroy(sys);
+  return st;
+}
+
+mfree_status_t fc_fluid_configure(mfree_system_t *sys, const double *m, const double *rho0, int64_t stride,
+                                  double kappa, double gamma, double mu, double h, double g, const fc_walls_t *walls,
+                                  double strength) {
+  const double gv[2] = {0.0, -g};
+  mfree_status_t st = mfree_system_set_fluid(sys, rho0, stride, kappa, gamma, mu);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_masses(sys, m, 1);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_smoothing(sys, h);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_gravity(sys, gv);
+  if (st == MFREE_SUCCESS && walls)
+    st = mfree_system_set_walls(sys, walls->n, walls->x, walls->nrm, 0.7 * h, strength); /* 003 Sect. 6.2 */
   return st;
 }
 
@@ -493,6 +504,234 @@ mfree_status_t fc_mass_error(mfree_system_t *sys, const double *y, int n, const 
   free(lumped);
   *err = fmax(fabs(sum_m - mass0), fabs(sum_l - mass0)) / mass0;
   return st;
+}
+
+/* ---- the dam break ---- */
+
+void fc_dam_usage(FILE *f) {
+  fprintf(f, "  --nx N          particles across the column width a (default 24; 2N up its height)\n"
+             "  --a A           column width in m (default 0.05715, Martin & Moyce's 2.25 in)\n"
+             "  --tank L        tank length in units of a (default 5)\n"
+             "  --tend T        end time in units of sqrt(a / (2 g)) (default 3.2)\n"
+             "  --cfl C         CFL number of 003 eq 120 (default 0.5)\n"
+             "  --mu MU         dynamic viscosity (default 0.5, paper 003)\n"
+             "  --strength A    wall-force constant A (default 10, paper 003)\n"
+             "  --offset F      walls set back by F d from the fluid's edge (default 0.5)\n"
+             "  --shepard-cond C  Shepard functions where the MLS moment matrix's condition exceeds C\n"
+             "                  (default 100, the library's; 20 runs the 16a tank to T = 8 at CFL 0.5)\n"
+             "  --scheme S      leapfrog (default) | pc (predictor-corrector)\n"
+             "  --lumping L     galerkin (default, 003 eq 56) | physical (eq 58)\n"
+             "  --data PATH     Martin & Moyce CSV (default: the repository's data/martin_moyce_1952.csv)\n"
+             "  (--vtu-every in units of T, default 0.25)\n");
+}
+
+int fc_dam_init(fc_dam_t *b, double a, int nx, double tank, double offset) {
+  memset(b, 0, sizeof *b);
+  b->a = a;
+  b->nx = nx;
+  b->nz = 2 * nx;
+  b->n = b->nx * b->nz;
+  b->H = 2.0 * a;
+  b->L = tank * a;
+  b->d = a / nx;
+  b->h = 1.5 * b->d;
+  b->rho0 = 1000.0;
+  b->gamma = 7.0;
+  b->g = 9.81;
+  b->kappa = 100.0 * b->rho0 * 2.0 * b->g * b->H / b->gamma; /* 003 eq 125 */
+  b->tscale = sqrt(2.0 * b->g / a);                          /* T = t sqrt(2 g / a) */
+  /* walls: the floor, then both ends pairwise upwards, spacing d/3, up to 1.5 H */
+  const double off = offset * b->d, ws = b->d / 3.0, top = 1.5 * b->H, L = b->L;
+  const int nb = (int)ceil((L + 2 * off) / ws) + 1, ns = (int)ceil((top + off) / ws);
+  const int nw = nb + 2 * ns;
+  fc_walls_t *w = &b->walls;
+  w->x = malloc(2 * (size_t)nw * sizeof *w->x);
+  w->nrm = malloc(2 * (size_t)nw * sizeof *w->nrm);
+  if (!w->x || !w->nrm) {
+    fc_walls_free(w);
+    return 1;
+  }
+  w->n = w->cap = nw;
+  int k = 0;
+  for (int q = 0; q < nb; ++q, ++k) {
+    w->x[2 * k] = -off + q * (L + 2 * off) / (nb - 1);
+    w->x[2 * k + 1] = -off;
+    w->nrm[2 * k] = 0.0;
+    w->nrm[2 * k + 1] = 1.0;
+  }
+  for (int q = 1; q <= ns; ++q)
+    for (int side = 0; side < 2; ++side, ++k) {
+      w->x[2 * k] = side ? L + off : -off;
+      w->x[2 * k + 1] = -off + q * (top + off) / ns;
+      w->nrm[2 * k] = side ? -1.0 : 1.0;
+      w->nrm[2 * k + 1] = 0.0;
+    }
+  b->off = off;
+  b->lo[0] = b->lo[1] = -off;
+  b->hi[0] = L + off;
+  b->hi[1] = 10.0 * b->H;
+  return 0;
+}
+
+void fc_dam_free(fc_dam_t *b) { fc_walls_free(&b->walls); }
+
+void fc_dam_particle(const fc_dam_t *b, int64_t q, double *x, double *rho, double *m) {
+  fc_water_cell(0.0, (int)(q % b->nx), (int)(q / b->nx), b->d, b->H, b->rho0, b->kappa, b->gamma, b->g, x, rho, m);
+}
+
+mfree_status_t fc_dam_configure(const fc_dam_t *b, mfree_system_t *sys, const double *m, double mu,
+                                double strength, mfree_lumping_t lumping, double shepard) {
+  mfree_status_t st =
+      fc_fluid_configure(sys, m, &b->rho0, 0, b->kappa, b->gamma, mu, b->h, b->g, &b->walls, strength);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_lumping(sys, lumping);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_shepard_condition(sys, shepard);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_box(sys, b->lo, b->hi);
+  return st;
+}
+
+int fc_read_pairs(const char *path, double *T, double *Z, int cap) {
+  FILE *f = path ? fopen(path, "r") : NULL;
+  if (!f) return 0;
+  char line[512];
+  int n = 0;
+  while (fgets(line, sizeof line, f) && n < cap) {
+    double t, z;
+    if (line[0] == '#') continue;
+    if (sscanf(line, "%lf,%lf", &t, &z) == 2) {
+      T[n] = t;
+      Z[n] = z;
+      ++n;
+    }
+  }
+  fclose(f);
+  return n;
+}
+
+/* The front at time T, linear in T between the samples; 0 when T is outside them. */
+static int front_at(int nf, const double *fT, const double *fZ, double T, double *Z) {
+  for (int r = 0; r + 1 < nf; ++r)
+    if (fT[r] <= T && fT[r + 1] >= T) {
+      const double w = (T - fT[r]) / (fT[r + 1] - fT[r]);
+      *Z = (1 - w) * fZ[r] + w * fZ[r + 1];
+      return 1;
+    }
+  return 0;
+}
+
+void fc_front_compare(int nf, const double *fT, const double *fZ, int ndata, const double *dT, const double *dZ,
+                      fc_front_cmp_t *c) {
+  double maxdev = -1.0, maxdev_wide = -1.0, off_sum = 0.0, off_min = INFINITY, off_max = -INFINITY, Zs = 0.0;
+  int compared = 0, compared_wide = 0, noff = 0;
+  for (int q = 0; q < ndata; ++q) {
+    if (dT[q] < 0.5 || dT[q] > 3.0) continue;
+    if (front_at(nf, fT, fZ, dT[q], &Zs)) {
+      const double dev = fabs(Zs - dZ[q]) / dZ[q];
+      maxdev_wide = fmax(maxdev_wide, dev);
+      ++compared_wide;
+      if (dT[q] >= 1.0) {
+        maxdev = fmax(maxdev, dev);
+        ++compared;
+      }
+    }
+    /* the lag: the front only advances until it hits the far wall, so the first
+       crossing of Z_exp is taken */
+    for (int r = 0; r + 1 < nf; ++r)
+      if (fZ[r] <= dZ[q] && fZ[r + 1] >= dZ[q] && fZ[r + 1] > fZ[r]) {
+        const double lag = dT[q] - (fT[r] + (dZ[q] - fZ[r]) / (fZ[r + 1] - fZ[r]) * (fT[r + 1] - fT[r]));
+        off_sum += lag;
+        off_min = fmin(off_min, lag);
+        off_max = fmax(off_max, lag);
+        ++noff;
+        break;
+      }
+  }
+  c->max_rel_dev = compared ? maxdev : -1.0;
+  c->compared = compared;
+  c->max_rel_dev_wide = compared_wide ? maxdev_wide : NAN;
+  c->compared_wide = compared_wide;
+  c->offset[0] = noff ? off_sum / noff : NAN;
+  c->offset[1] = noff ? off_min : NAN;
+  c->offset[2] = noff ? off_max : NAN;
+}
+
+FILE *fc_dam_csv(const fc_run_t *r, const fc_dam_t *b) {
+  FILE *csv = fc_open_csv(r, "front.csv");
+  if (csv)
+    fprintf(csv, "# Martin & Moyce dam break, a = %g m, nx = %d, %d particles\n"
+                 "# T = t sqrt(2 g / a), Z = (max x + d/2) / a, Z_floor: particles with z < 1.5 d\n"
+                 "T,Z,Z_floor,t,steps\n", b->a, b->nx, b->n);
+  return csv;
+}
+
+void fc_dam_plot(const fc_run_t *r, const fc_dam_t *b, const char *data, int ndata, double t_end) {
+  char csv_path[4096];
+  FILE *gp = ex_plot_path_ok(data) ? fc_plot_begin(r, "front", 800, 560, "T = t (2g/a)^{1/2}", "Z = z/a", csv_path,
+                                                   sizeof csv_path)
+                                   : NULL;
+  if (!gp) return;
+  fprintf(gp, "set key top left\n"
+              "set title 'Dam break, n^2 = 2: Galerkin SPH (Cueto-Felgueroso et al. 2004) vs Martin and Moyce (1952)'\n"
+              "set xrange [0:%g]\n"
+              "plot '%s' using 1:2 with lines lw 2 title 'front, all particles (%d)', "
+              "'%s' using 1:3 with lines dt 2 title 'front, particles on the floor'",
+          t_end + 0.5, csv_path, b->n, csv_path);
+  if (ndata) fprintf(gp, ", '%s' using 1:2 with points pt 7 title 'Martin and Moyce (1952), n^2 = 2'", data);
+  fprintf(gp, "\n");
+  fc_plot_end(gp, r, "front");
+}
+
+void fc_dam_json(fc_json_t *j, const fc_dam_t *b, int nf, const double *fT, const double *fZ, const double *fZf,
+                 const fc_front_cmp_t *c, const fc_dam_run_t *r) {
+  double *rows = calloc(2 * (size_t)(nf + 1), sizeof *rows);
+  if (!rows) {
+    j->err = 1;
+    return;
+  }
+  for (int q = 0; q < nf; ++q) rows[2 * q] = fT[q], rows[2 * q + 1] = fZ[q];
+  fc_json_table(j, "front", nf, 2, rows);
+  for (int q = 0; q < nf; ++q) rows[2 * q + 1] = fZf[q];
+  fc_json_table(j, "front_floor", nf, 2, rows);
+  free(rows);
+  char digest[17];
+  fc_digest(fT, (size_t)nf, digest);
+  fc_json_str(j, "time_digest", digest);
+  fc_digest(fZ, (size_t)nf, digest);
+  fc_json_str(j, "front_digest", digest);
+  fc_digest(fZf, (size_t)nf, digest);
+  fc_json_str(j, "front_floor_digest", digest);
+  fc_json_num(j, "max_rel_dev", c->max_rel_dev);
+  fc_json_int(j, "compared", c->compared);
+  fc_json_num(j, "max_rel_dev_wide", c->max_rel_dev_wide);
+  fc_json_int(j, "compared_wide", c->compared_wide);
+  fc_json_table(j, "time_offset", 3, 1, c->offset);
+  fc_json_int(j, "particles", b->n);
+  fc_json_int(j, "steps", r->steps);
+  fc_json_num(j, "wall_seconds", r->wall_seconds);
+  fc_json_num(j, "a", b->a);
+  fc_json_int(j, "nx", b->nx);
+  fc_json_num(j, "cfl", r->cfl);
+  fc_json_num(j, "shepard_condition", r->shepard);
+  fc_json_num(j, "mu", r->mu);
+  fc_json_str(j, "scheme", r->scheme == MFREE_INTEGRATOR_LEAPFROG ? "leapfrog" : "pc");
+  fc_json_int(j, "status", (int)r->status);
+  fc_json_str(j, "error", r->status == MFREE_SUCCESS ? NULL : r->error);
+  fc_json_num(j, "t_end", r->T_end);
+}
+
+void fc_dam_print(int nf, const double *fT, const double *fZ, const fc_front_cmp_t *c) {
+  for (int q = 0; q < nf; q += 4) printf("  T = %5.2f  Z = %6.3f\n", fT[q], fZ[q]);
+  if (c->max_rel_dev >= 0)
+    printf("max |Z - Z_exp| / Z_exp over 1 <= T <= 3: %.3f (%d points)\n", c->max_rel_dev, c->compared);
+  if (c->compared_wide)
+    printf("over 0.5 <= T <= 3: %.3f (%d points); the experiment lags by T = %.3f (%.3f to %.3f)\n",
+           c->max_rel_dev_wide, c->compared_wide, c->offset[0], c->offset[1], c->offset[2]);
+}
+
+void fc_digest(const double *v, size_t n, char *hex) {
+  uint64_t h = 0xcbf29ce484222325ULL; /* FNV-1a over the bytes */
+  const unsigned char *p = (const unsigned char *)v;
+  for (size_t k = 0; k < n * sizeof *v; ++k) h = (h ^ p[k]) * 0x100000001b3ULL;
+  snprintf(hex, 17, "%016llx", (unsigned long long)h);
 }
 
 void fc_fit_add(fc_fit_t *f, double x, double y) {

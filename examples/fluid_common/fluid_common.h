@@ -54,6 +54,11 @@ mfree_status_t fc_dummy_tank(mfree_system_t *sys, int ncol, double top, double d
  * next index, q0 + ni nj. */
 int fc_water_block(double *y, double *m, int n, int q0, double x0, int ni, int nj, double d, double H,
                    double rho0, double kappa, double gamma, double g);
+/* Cell (i, j) of such a block alone: its particle's position x (2), hydrostatic density
+ * *rho and mass *m, the bits fc_water_block writes (hosts that hold a share of the
+ * particles, e.g. on MPI ranks). */
+void fc_water_cell(double x0, int i, int j, double d, double H, double rho0, double kappa, double gamma, double g,
+                   double *x, double *rho, double *m);
 
 /* Particles q0, q0 + 1, ... of a circular drop of radius R at rest density rho0, falling
  * at speed v0: the points (xc + i d, zc + j d) of the lattice of spacing d inside the
@@ -161,6 +166,11 @@ int fc_run_error(mfree_context_t *ctx, const fc_run_t *r, mfree_status_t st, con
 mfree_status_t fc_fluid_create(mfree_context_t *ctx, int n, const double *m, const double *rho0, int64_t stride,
                                double kappa, double gamma, double mu, double h, double g, const fc_walls_t *walls,
                                double strength, mfree_system_t **sys);
+/* The same settings on a fluid system created otherwise (e.g. on MPI ranks, where m holds
+ * the owned particles' and the ghosts' masses). */
+mfree_status_t fc_fluid_configure(mfree_system_t *sys, const double *m, const double *rho0, int64_t stride,
+                                  double kappa, double gamma, double mu, double h, double g, const fc_walls_t *walls,
+                                  double strength);
 /* The head of every summary: "status", "error" (the message, null without a failure),
  * "t", "steps", "particles". */
 void fc_json_run(fc_json_t *j, mfree_status_t run, const char *msg, double t, long long steps, int n);
@@ -192,6 +202,79 @@ mfree_status_t fc_lumped_masses(mfree_system_t *sys, const double *y, int n, dou
  * none lost) and |sum of the lumped masses - mass0| (003 eq 57), over mass0. */
 mfree_status_t fc_mass_error(mfree_system_t *sys, const double *y, int n, const double *m, double mass0,
                              double *err);
+
+/* ---- the dam break of paper 003 against Martin & Moyce (1952): examples/dam_break and
+ * examples/mpi/dam_break ---- */
+
+/* A column of width a and height H = 2a (n^2 = 2) of nx x nz = 2 nx particles (particle
+ * q = j nx + i: cell (i, j) of a water block at x0 = 0, spacing d = a / nx, h = 1.5 d,
+ * rho0 1000, gamma 7, g 9.81, kappa = 100 rho0 (2 g H) / gamma, 003 eq 125) at the left
+ * end of a tank of length L = tank a; walls (floor and both ends, spacing d/3) set back
+ * by off = offset d from the fluid's edge up to 1.5 H; the box a particle must stay in
+ * (crossing a wall fails); T = t tscale, tscale = sqrt(2 g / a). */
+typedef struct {
+  double a, H, L, d, h, off, rho0, gamma, g, kappa, tscale;
+  int nx, nz, n;
+  fc_walls_t walls;
+  double lo[2], hi[2];
+} fc_dam_t;
+/* The usage lines of the options both dam-break examples take: --nx, --a, --tank,
+ * --tend, --cfl, --mu, --strength, --offset, --shepard-cond, --scheme, --lumping, --data. */
+void fc_dam_usage(FILE *f);
+/* Returns 0, or 1 when out of memory. */
+int fc_dam_init(fc_dam_t *b, double a, int nx, double tank, double offset);
+void fc_dam_free(fc_dam_t *b);
+/* Particle q's position x (2), density and mass at rest (fc_water_cell). */
+void fc_dam_particle(const fc_dam_t *b, int64_t q, double *x, double *rho, double *m);
+/* fc_fluid_configure with the dam break's fluid (m: the system's per-particle masses),
+ * viscosity mu, wall strength A, lumping, Shepard condition and box. */
+mfree_status_t fc_dam_configure(const fc_dam_t *b, mfree_system_t *sys, const double *m, double mu,
+                                double strength, mfree_lumping_t lumping, double shepard);
+
+/* The Martin & Moyce points (T, Z) of a CSV file ("T,Z" lines, # comments): the count
+ * (at most cap), 0 when path is NULL or the file cannot be read. */
+int fc_read_pairs(const char *path, double *T, double *Z, int cap);
+
+/* A front history Z(T) (nf samples, T ascending) against the experiment's ndata points:
+ * max_rel_dev the largest |Z - Z_exp| / Z_exp over the points with 1 <= T <= 3 (Z
+ * linearly interpolated in T; -1 without a compared point), max_rel_dev_wide the same
+ * over 0.5 <= T <= 3 (NaN without one), and offset[3] = mean, min, max of T_exp minus the
+ * T at which the front first reaches Z_exp over 0.5 <= T <= 3 (NaN without one). */
+typedef struct {
+  double max_rel_dev, max_rel_dev_wide, offset[3];
+  int compared, compared_wide;
+} fc_front_cmp_t;
+void fc_front_compare(int nf, const double *fT, const double *fZ, int ndata, const double *dT, const double *dZ,
+                      fc_front_cmp_t *c);
+
+/* front.csv in r's out directory with its header (the columns T, Z, Z_floor, t, steps);
+ * NULL after a message when it cannot be written. */
+FILE *fc_dam_csv(const fc_run_t *r, const fc_dam_t *b);
+/* The gnuplot script and PNG "front" of the CSV against the experiment's points in data
+ * (ndata of them), over 0 <= T <= t_end + 0.5 (nothing with --no-plot). */
+void fc_dam_plot(const fc_run_t *r, const fc_dam_t *b, const char *data, int ndata, double t_end);
+/* What a dam-break run reports besides its front. */
+typedef struct {
+  long long steps;
+  double wall_seconds, cfl, shepard, mu, T_end; /* T_end: the T reached */
+  int scheme;                               /* an mfree_integrator_t */
+  mfree_status_t status;
+  const char *error; /* the message of a failed run */
+} fc_dam_run_t;
+/* The summary's keys of both dam-break examples: "front" and "front_floor" ([T, Z] rows),
+ * their digests "time_digest", "front_digest", "front_floor_digest" (fc_digest),
+ * "max_rel_dev", "compared", "max_rel_dev_wide", "compared_wide", "time_offset",
+ * "particles", "steps", "wall_seconds", "a", "nx", "cfl", "shepard_condition", "mu",
+ * "scheme", "status", "error" (null after a success), "t_end". */
+void fc_dam_json(fc_json_t *j, const fc_dam_t *b, int nf, const double *fT, const double *fZ, const double *fZf,
+                 const fc_front_cmp_t *c, const fc_dam_run_t *r);
+/* Z every fourth sample and the comparison, on stdout. */
+void fc_dam_print(int nf, const double *fT, const double *fZ, const fc_front_cmp_t *c);
+
+/* A digest of n doubles' bits (16 hex digits and a NUL in hex[17]): equal digests of
+ * two runs' histories say that they agree bit for bit, which the JSON's 10 digits do
+ * not. */
+void fc_digest(const double *v, size_t n, char *hex);
 
 /* ---- least-squares line y = a + b x through samples added one at a time ---- */
 typedef struct {
