@@ -51,6 +51,7 @@ static void usage(FILE *f) {
   fprintf(f, "usage: mfree_mould [--nw N (10)] [--radius R (0.05 m)] [--core R (0.015 m)] [--gate W (0.01 m)]\n"
              "                   [--tend T (0.008 s)] [--cfl C (0.5)] [--mu MU (0.01)] [--strength A (4)]\n"
              "                   [--shepard-cond K (20)] [--delta D (0)] [--smoothing B (0.1)]\n"
+             "                   [--lumped-step 0|1 (0): mfree_system_set_lumped_mass_step]\n"
              "                   [run options; --vtu-every in s, default 0.0005]\n");
   fc_run_usage(f);
 }
@@ -72,19 +73,21 @@ int main(int argc, char **argv) {
   int nw = 10;
   double Rm = 0.05, Rc = 0.015, W = 0.01, t_end = 0.008, cfl = 0.5, mu = 0.01, strength = 4.0, shepard = 20.0;
   double delta = 0.0, beta = 0.1;
+  int lumped_step = 0;
   fc_run_t ro;
   fc_run_init(&ro, "mould", 0.0005);
   const fc_option_t opts[] = {{"--nw", 'i', &nw},          {"--radius", 'd', &Rm}, {"--core", 'd', &Rc},
                               {"--gate", 'd', &W},         {"--tend", 'd', &t_end}, {"--cfl", 'd', &cfl},
                               {"--mu", 'd', &mu},          {"--strength", 'd', &strength},
                               {"--shepard-cond", 'd', &shepard}, {"--delta", 'd', &delta},
-                              {"--smoothing", 'd', &beta},
+                              {"--smoothing", 'd', &beta}, {"--lumped-step", 'i', &lumped_step},
                               {NULL, 0, NULL}};
   const int parsed = fc_parse(argc, argv, &ro, opts, usage);
   if (parsed) return parsed < 0 ? 0 : parsed;
   const double d = W / (nw > 0 ? nw : 1);
   if (nw < 3 || !(Rc > 0) || !(Rm >= Rc + 10 * d) || !(W > 0 && W < Rc) || !(t_end > 0) ||
-      !(cfl > 0 && cfl <= 1) || !(mu >= 0) || !(strength >= 0) || !(shepard >= 1) || !(delta >= 0) || !(beta >= 0)) {
+      !(cfl > 0 && cfl <= 1) || !(mu >= 0) || !(strength >= 0) || !(shepard >= 1) || !(delta >= 0) || !(beta >= 0) ||
+      (lumped_step != 0 && lumped_step != 1)) {
     usage(stderr);
     return 2;
   }
@@ -127,6 +130,7 @@ int main(int argc, char **argv) {
   CHECK(mfree_system_set_shepard_condition(sys, shepard));
   CHECK(mfree_system_set_density_diffusion(sys, delta));
   CHECK(mfree_system_set_velocity_smoothing(sys, beta));
+  CHECK(mfree_system_set_lumped_mass_step(sys, lumped_step));
   CHECK(mfree_system_set_active(sys, 0));
   const double go[2] = {-0.5 * W, zgate}, ge[2] = {W, 0.0}, gn[2] = {0.0, 1.0};
   CHECK(mfree_system_set_inflow(sys, 0, go, ge, gn, kU, kRho0, d));
@@ -242,6 +246,9 @@ int main(int argc, char **argv) {
   fc_json_table(&js, "fronts", fr_s.n / 3, 3, fr_s.v);
   fc_json_num(&js, "sound_speed", kC);
   fc_json_num(&js, "cfl", cfl);
+  fc_json_num(&js, "shepard_condition", shepard);
+  fc_json_num(&js, "smoothing", beta);
+  fc_json_int(&js, "lumped_mass_step", lumped_step);
   fc_json_num(&js, "wall_seconds", wall);
   if (fc_json_finish(&js, &ro)) return 1;
   if (!ro.json_stdout) {
