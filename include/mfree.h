@@ -1835,7 +1835,7 @@ MFREE_API mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, i
 MFREE_API mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y,
                                           double *ydot);
 /** Mass matrix of the state: the identity except the velocity block, which holds the
- * lumped or consistent Galerkin mass, so that M y' = M f(t, y) is the mass-matrix form.
+ * lumped or consistent Galerkin mass: M y' = M f(t, y) (fluid on ranks: owned rows, lumped only).
  * @param[in]     sys         the system
  * @param[in]     y           state
  * @param[in]     consistent  0 lumped, nonzero consistent
@@ -1852,11 +1852,11 @@ MFREE_API mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys
                                                              const double *y,
                                                              mfree_matrix_t **S);
 /** Pressure at the particles from the state's densities.
- * @param[in] sys a fluid system @param[in] y state @param[out] p n values
+ * @param[in] sys a fluid system @param[in] y state @param[out] p n values (on ranks: n_owned)
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
 MFREE_API mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys,
                                                    const double *y, double *p);
-/** Interpolated velocities v_hat(x_k).
+/** Interpolated velocities v_hat(x_k) (on ranks: of the owned particles; collective).
  * @param[in] sys a fluid system @param[in] y state
  * @param[out] vhat dim values per particle (AoS)
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
@@ -1872,7 +1872,7 @@ MFREE_API mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const do
  * consistent integration it includes that integration's momentum error. A leap-frog step
  * of length dt from y changes sum_i m_i v_i by dt (M g + total). per_wall: each wall
  * particle's share of the eqs 122-124 force, in the order of mfree_system_set_walls (its
- * sum is total when there are no dummy particles and no consistent integration).
+ * sum is total with neither dummy particles nor consistent integration; ranks: see create_fluid_ranks).
  * @param[in]  sys       a fluid system
  * @param[in]  y         state
  * @param[out] total     dim values, or NULL
@@ -2150,8 +2150,8 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * MFREE_ERR_HALO (rebuild the halo and the system). A failure on one rank (a non-finite
  * state: MFREE_FAIL_NONFINITE) is returned by every rank with that rank's message
  * ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
- * consistent integration, velocity smoothing or open boundaries, and no pressure,
- * velocity, wall-force, mass or interpolation output on ranks yet (MFREE_ERR_UNSUPPORTED). Creation is collective: bad input on one rank, or ranks that
+ * consistent integration, velocity smoothing or open boundaries (MFREE_ERR_UNSUPPORTED). Outputs: the owned
+ * particles' (docs/fluid-ranks.md); no consistent mass, interpolation or per_wall force. Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.
  * libmfree_mpi's mfree_halo_create_fluid supplies the callbacks from a halo plan.
  * @param[in]  ctx         context (kept alive); NULL: MFREE_ERR_NULL on this rank alone

@@ -204,7 +204,8 @@ mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y, 
 
 mfree_status_t mfree_system_assemble_mass(mfree_system_t *sys, const double *y, int32_t consistent,
                                           mfree_matrix_t **M) {
-  if (sys && !y && sys->sys->neq() > 0)
+  const auto *fr = sys ? dynamic_cast<const mfree::FluidSystem *>(sys->sys.get()) : nullptr;
+  if (sys && !y && sys->sys->neq() > 0 && !(fr && fr->on_ranks()))
     return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_mass", "y is NULL");
   return fill_matrix(sys, "mfree_system_assemble_mass", M, [&](mfree::System &f, mfree::SparseMatrix &m) {
     return f.mass(y, consistent != 0, m);
@@ -222,8 +223,8 @@ mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys, const do
 
 mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double *y, double *p) {
   return mfree::with_handle(sys, "mfree_system_get_pressure", [&](const mfree::System &base) {
-    const auto &f = one_process(kind<mfree::FluidSystem>(base, "pressure (not a fluid)"), "pressure output");
-    MFREE_REQUIRE((y && p) || f.size() == 0, MFREE_ERR_NULL, "y or p is NULL");
+    const auto &f = kind<mfree::FluidSystem>(base, "pressure (not a fluid)");
+    MFREE_REQUIRE((y && p) || f.neq() == 0, MFREE_ERR_NULL, "y or p is NULL");
     f.pressure(y, p);
     return MFREE_SUCCESS;
   });
@@ -231,8 +232,10 @@ mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double
 
 mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, double *vhat) {
   return mfree::with_handle(sys, "mfree_system_get_velocity", [&](mfree::System &base) {
-    auto &f = one_process(kind<mfree::FluidSystem>(base, "interpolated velocity (not a fluid)"), "velocity output");
-    MFREE_REQUIRE((y && vhat) || f.size() == 0, MFREE_ERR_NULL, "y or vhat is NULL");
+    auto &f = kind<mfree::FluidSystem>(base, "interpolated velocity (not a fluid)");
+    // (on ranks the system agrees on its arguments: a rank that returned here alone
+    // would leave the others waiting in its exchanges)
+    MFREE_REQUIRE((y && vhat) || f.size() == 0 || f.on_ranks(), MFREE_ERR_NULL, "y or vhat is NULL");
     return mfree::finish(sys->ctx, "mfree_system_get_velocity", f.velocity(y, vhat));
   });
 }
@@ -240,9 +243,9 @@ mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, d
 mfree_status_t mfree_system_get_wall_force(mfree_system_t *sys, const double *y, double *total, int32_t nwall,
                                           double *per_wall) {
   return mfree::with_handle(sys, "mfree_system_get_wall_force", [&](mfree::System &base) {
-    auto &f = one_process(kind<mfree::FluidSystem>(base, "wall force (not a fluid)"), "wall force output");
-    MFREE_REQUIRE(total || per_wall, MFREE_ERR_NULL, "total and per_wall are both NULL");
-    MFREE_REQUIRE(y || f.size() == 0, MFREE_ERR_NULL, "y is NULL");
+    auto &f = kind<mfree::FluidSystem>(base, "wall force (not a fluid)");
+    MFREE_REQUIRE(total || per_wall || f.on_ranks(), MFREE_ERR_NULL, "total and per_wall are both NULL");
+    MFREE_REQUIRE(y || f.size() == 0 || f.on_ranks(), MFREE_ERR_NULL, "y is NULL");
     return mfree::finish(sys->ctx, "mfree_system_get_wall_force", f.wall_force(y, total, nwall, per_wall));
   });
 }

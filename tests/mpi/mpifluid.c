@@ -113,6 +113,37 @@ void rankfluid_free(rankfluid_t *r) {
   memset(r, 0, sizeof *r);
 }
 
+void mpifluid_collect(MPI_Comm comm, int n_owned, const int64_t *id, const double *vals, int per, double *out) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  int *counts = malloc(sizeof(int) * (size_t)size), *displs = malloc(sizeof(int) * (size_t)size);
+  MPI_Allgather(&n_owned, 1, MPI_INT, counts, 1, MPI_INT, comm);
+  int total = 0;
+  for (int p = 0; p < size; ++p) displs[p] = total, total += counts[p];
+  int64_t *ids = malloc(((size_t)total + 1) * sizeof *ids);
+  MPI_Allgatherv(id, n_owned, MPI_INT64_T, ids, counts, displs, MPI_INT64_T, comm);
+  for (int p = 0; p < size; ++p) counts[p] *= per, displs[p] *= per;
+  double *all = malloc(((size_t)total * per + 1) * sizeof *all);
+  MPI_Allgatherv(vals, n_owned * per, MPI_DOUBLE, all, counts, displs, MPI_DOUBLE, comm);
+  for (int k = 0; k < total; ++k) memcpy(out + (size_t)per * ids[k], all + (size_t)per * k, (size_t)per * sizeof(double));
+  free(counts), free(displs), free(ids), free(all);
+}
+
+void mpifluid_state(MPI_Comm comm, const rankfluid_t *r, const double *y, int n, double *out) {
+  const size_t no = (size_t)r->n_owned;
+  mpifluid_collect(comm, r->n_owned, r->id, y, 2, out);
+  mpifluid_collect(comm, r->n_owned, r->id, y + 2 * no, 2, out + 2 * (size_t)n);
+  mpifluid_collect(comm, r->n_owned, r->id, y + 4 * no, 1, out + 4 * (size_t)n);
+}
+
+void mpifluid_tolerances(const damb_t *b, int no, double *atol) {
+  for (int k = 0; k < no; ++k) {
+    atol[2 * k] = atol[2 * k + 1] = 1e-2 * b->d;              /* positions */
+    atol[2 * no + 2 * k] = atol[2 * no + 2 * k + 1] = 1e-2; /* velocities (m/s) */
+    atol[4 * no + k] = 1.0;                                 /* densities (kg/m3) */
+  }
+}
+
 int32_t mpifluid_stop_at(void *user, int64_t step, double t, double dt) {
   (void)t, (void)dt;
   return step >= *(const int64_t *)user;

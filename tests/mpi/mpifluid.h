@@ -42,6 +42,17 @@ mfree_status_t rankfluid_make(rankfluid_t *r, mfree_context_t *ctx, MPI_Comm com
                               const int *owner, double width, int reverse);
 void rankfluid_free(rankfluid_t *r);
 
+/* Every owned item's per values (vals: per values per owned item, in the items' order),
+ * gathered on every rank of comm by global id: out holds per values per particle. */
+void mpifluid_collect(MPI_Comm comm, int n_owned, const int64_t *id, const double *vals, int per, double *out);
+/* The owned state y (positions, velocities, densities of the owned items) gathered by
+ * global id into out, the state of all n particles in the system's layout. */
+void mpifluid_state(MPI_Comm comm, const rankfluid_t *r, const double *y, int n, double *out);
+
+/* Absolute tolerances of the ARKODE tests for no owned particles' state: 1e-2 d for
+ * positions, 1e-2 m/s for velocities, 1 kg/m3 for densities. */
+void mpifluid_tolerances(const damb_t *b, int no, double *atol);
+
 /* Progress callback stopping after *(int64_t *)user steps. */
 int32_t mpifluid_stop_at(void *user, int64_t step, double t, double dt);
 /* The context's last message (a static buffer). */

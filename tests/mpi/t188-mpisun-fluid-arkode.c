@@ -37,12 +37,7 @@ static long run(mfree_context_t *ctx, SUNContext sunctx, MPI_Comm comm, const da
   memcpy(N_VGetArrayPointer(y), r.y, 5 * (size_t)no * sizeof(double));
   void *mem = ERKStepCreate(mfree_sundials_rhs, 0.0, y, sunctx);
   N_Vector atol = N_VClone(y);
-  double *pa = N_VGetArrayPointer(atol);
-  for (int k = 0; k < no; ++k) {
-    pa[2 * k] = pa[2 * k + 1] = 1e-2 * b->d;        /* positions */
-    pa[2 * no + 2 * k] = pa[2 * no + 2 * k + 1] = 1e-2; /* velocities (m/s) */
-    pa[4 * no + k] = 1.0;                             /* densities (kg/m3) */
-  }
+  mpifluid_tolerances(b, no, N_VGetArrayPointer(atol));
   flag(ERKStepSVtolerances(mem, RTOL, atol), "tolerances");
   flag(ERKStepSetUserData(mem, ad), "user data");
   flag(ERKStepSetMaxNumSteps(mem, 100000), "max steps");
@@ -52,32 +47,7 @@ static long run(mfree_context_t *ctx, SUNContext sunctx, MPI_Comm comm, const da
   long steps = -1;
   ERKStepGetNumSteps(mem, &steps);
   CHECK(t == T_END, "t %.17g", t);
-  /* every rank's owned states, by global id */
-  const double *py = N_VGetArrayPointer(y);
-  const int n = b->n;
-  double *mine = malloc(((size_t)6 * no + 1) * sizeof *mine);
-  for (int k = 0; k < no; ++k) {
-    mine[6 * k] = (double)r.id[k];
-    for (int c = 0; c < 2; ++c) {
-      mine[6 * k + 1 + c] = py[2 * k + c];
-      mine[6 * k + 3 + c] = py[2 * no + 2 * k + c];
-    }
-    mine[6 * k + 5] = py[4 * no + k];
-  }
-  int size = 1;
-  MPI_Comm_size(comm, &size);
-  int *counts = malloc(sizeof(int) * (size_t)size), *displs = malloc(sizeof(int) * (size_t)size), cnt = 6 * no;
-  MPI_Allgather(&cnt, 1, MPI_INT, counts, 1, MPI_INT, comm);
-  for (int p = 0, o = 0; p < size; ++p) displs[p] = o, o += counts[p];
-  double *all = malloc(6 * (size_t)n * sizeof *all);
-  MPI_Allgatherv(mine, cnt, MPI_DOUBLE, all, counts, displs, MPI_DOUBLE, comm);
-  for (int k = 0; k < n; ++k) {
-    const int q = (int)all[6 * k];
-    memcpy(out + 2 * q, all + 6 * k + 1, 16);
-    memcpy(out + 2 * (size_t)n + 2 * q, all + 6 * k + 3, 16);
-    out[4 * (size_t)n + q] = all[6 * k + 5];
-  }
-  free(mine), free(counts), free(displs), free(all);
+  mpifluid_state(comm, &r, N_VGetArrayPointer(y), b->n, out); /* every rank's owned states, by global id */
   ERKStepFree(&mem);
   N_VDestroy(atol);
   N_VDestroy(y);

@@ -1228,11 +1228,15 @@ static void rows_system(void) {
       const double m2[2] = {10.0, 10.0};
       ROW(MFREE_SUCCESS, mfree_system_set_masses(fr, m2, 1));
       ROW(MFREE_SUCCESS, mfree_system_set_smoothing(fr, 0.1));
-      /* not distributed yet */
-      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_pressure(fr, ys, yd));
-      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_velocity(fr, ys, yd));
-      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_wall_force(fr, ys, yd, 0, NULL));
-      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_mass(fr, ys, 0, &fm));
+      /* the outputs on ranks: NULL arguments agreed by the ranks; not distributed yet */
+      ROW(MFREE_ERR_NULL, mfree_system_get_pressure(fr, ys, NULL));
+      ROW(MFREE_ERR_NULL, mfree_system_get_velocity(fr, NULL, yd));
+      ROW(MFREE_ERR_NULL, mfree_system_get_velocity(fr, ys, NULL));
+      ROW(MFREE_ERR_NULL, mfree_system_get_wall_force(fr, NULL, yd, 0, NULL));
+      ROW(MFREE_ERR_NULL, mfree_system_get_wall_force(fr, ys, NULL, 0, NULL));
+      ROW(MFREE_ERR_NULL, mfree_system_assemble_mass(fr, NULL, 0, &fm));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_wall_force(fr, ys, yd, 0, yd));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_mass(fr, ys, 1, &fm));
       ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_interpolation(fr, ys, &fm));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, (mfree_integrator_t)0, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, NAN, 0.2, 0, NULL, NULL, &steps));

@@ -32,6 +32,12 @@ struct mfree_sundials {
   bool has_state = false;
   bool state_timed = false;  // from a right-hand side: state_t and rate are meaningful
   double state_t = 0.0;
+  int64_t state_gen = 0;     // states kept so far
+  // mass_at's last assembly (state_gen, t and kind), reused at the same point: a mass
+  // solver's products within one solve ask for the same mass (-1: none to reuse)
+  int64_t mass_gen = -1;
+  double mass_t = 0.0;
+  bool mass_consistent = false;
 
   // mfree matrices refilled at every call (created at the first)
   mfree_matrix_t *lumped = nullptr;  // M_L: the mass form's force, the lumped residual
@@ -101,6 +107,7 @@ mfree_status_t vector_data(mfree_sundials_t *ad, const char *fn, const char *nam
 // Remember y (and, from a right-hand side, its time and rate y') for the mass function.
 void keep_state(mfree_sundials_t *ad, const double *y, const double *rate, double t) {
   ad->state.assign(y, y + ad->neq);
+  ++ad->state_gen;
   ad->has_state = true;
   ad->state_timed = rate != nullptr;
   ad->state_t = t;
@@ -133,7 +140,17 @@ mfree_status_t mass_at(mfree_sundials_t *ad, const char *fn, double t) {
     for (int32_t q = 0; q < ad->neq; ++q) ad->predicted[q] = ad->state[q] + dt * ad->rate[q];
     at = ad->predicted.data();
   }
-  return mfree_system_assemble_mass(ad->sys, at, ad->consistent ? 1 : 0, &ad->mass);
+  // (the same decision on every rank of a system on ranks: the states kept and t are)
+  if (ad->mass && ad->mass_gen == ad->state_gen && ad->mass_t == t && ad->mass_consistent == ad->consistent)
+    return MFREE_SUCCESS;
+  ad->mass_gen = -1;
+  const mfree_status_t st = mfree_system_assemble_mass(ad->sys, at, ad->consistent ? 1 : 0, &ad->mass);
+  if (st == MFREE_SUCCESS) {
+    ad->mass_gen = ad->state_gen;
+    ad->mass_t = t;
+    ad->mass_consistent = ad->consistent;
+  }
+  return st;
 }
 
 // Copy an mfree matrix (CSR view or its CSC view) into the host's SUNSparseMatrix.
@@ -286,6 +303,7 @@ mfree_status_t mfree_sundials_create_mass_matrix(mfree_sundials_t *ad, SUNContex
     double *py = nullptr;
     mfree_status_t st = vector_data(ad, fn, "y", y, &py);
     if (st != MFREE_SUCCESS) return st;
+    ad->mass_gen = -1;
     st = mfree_system_assemble_mass(ad->sys, py, ad->consistent ? 1 : 0, &ad->mass);
     if (st != MFREE_SUCCESS) return st;
     int32_t nr = 0, nc = 0;
@@ -401,6 +419,7 @@ int mfree_sundials_residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r,
       ad->force.resize(static_cast<size_t>(ad->neq));
       st = mass_form(ad, t, py, ad->force.data());
       if (st != MFREE_SUCCESS) return st;
+      ad->mass_gen = -1;
       st = mfree_system_assemble_mass(ad->sys, py, 1, &ad->mass);
       if (st != MFREE_SUCCESS) return st;
       st = mfree_matrix_apply(ad->mass, pp, pr);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <numeric>
 #include <sstream>
 
 #include "core/base/parallel.hpp"
@@ -242,7 +243,7 @@ Report FluidSystem::velocity(const double *y, double *vhat) {
 void FluidSystem::pressure(const double *y, double *p) const {
   if (open_) return open_pressure(y, p);
   const double *rho = y + 2 * static_cast<size_t>(dim_) * n_;
-  for (int32_t i = 0; i < n_; ++i) p[i] = kappa_ * (std::pow(rho[i] / rho0_[i], gamma_) - 1.0);
+  for (int32_t i = 0; i < n_; ++i) p[i] = pressure_at(rho[i], rho0_[i]);
 }
 
 Report FluidSystem::interpolation(const double *y, SparseMatrix &S) {
@@ -275,27 +276,39 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   if (open_) return open_mass(y, consistent, M);
   Report rep = prepare(y);
   if (!rep.ok()) return rep;
+  std::vector<int32_t> part(n_);
+  std::iota(part.begin(), part.end(), 0);
+  mass_matrix(n_, part.data(), part.data(), consistent, M);
+  return rep;
+}
+
+void FluidSystem::mass_matrix(int32_t np, const int32_t *node, const int32_t *part, bool consistent,
+                              SparseMatrix &M) const {
   const int dim = dim_;
-  const size_t nd = static_cast<size_t>(dim) * n_;
+  const size_t nd = static_cast<size_t>(dim) * np;
   const auto &cols = cols_;
   const auto &N = N_;
   // node-level velocity block: consistent m_ij = sum_k N_i(x_k) N_j(x_k) M_k (003 eq 42),
-  // or the lumped row sums
-  std::vector<std::vector<std::pair<int32_t, double>>> rows(n_);
+  // or the lumped row sums; each entry sums its terms sorted by value, an order that
+  // does not depend on the nodes' numbering
+  std::vector<std::vector<std::pair<int32_t, double>>> rows(np);
   // with dummies: fluid rows and columns only, lumped masses as in accel (fluid_wall.hpp)
   for (int32_t k = 0; k < n_; ++k)
     for (int64_t a = rb(k); a < re(k); ++a) {
-      if (cols[a] >= n_) continue;
+      const int32_t i = cols[a] < n_ ? part[cols[a]] : -1;
+      if (i < 0) continue;
       for (int64_t b = rb(k); b < re(k); ++b) {
         const double m = N[a] * N[b] * mass_[k];
         if (consistent) {
-          if (cols[b] < n_) rows[cols[a]].push_back({cols[b], m});
+          const int32_t j = cols[b] < n_ ? part[cols[b]] : -1;
+          if (j >= 0) rows[i].push_back({j, m});
         } else {
-          rows[cols[a]].push_back({cols[a], m / share(k)});
+          rows[i].push_back({i, m / share(k)});
         }
       }
     }
-  std::vector<int64_t> rowptr(static_cast<size_t>(neq()) + 1, 0);
+  const int32_t neq = (2 * dim + 1) * np;
+  std::vector<int64_t> rowptr(static_cast<size_t>(neq) + 1, 0);
   std::vector<int32_t> ci;
   std::vector<double> vals;
   int32_t r = 0;
@@ -306,7 +319,7 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
     ++r;
   };
   for (size_t q = 0; q < nd; ++q) identity_row();
-  for (int32_t i = 0; i < n_; ++i) {
+  for (int32_t i = 0; i < np; ++i) {
     auto &row = rows[i];
     std::sort(row.begin(), row.end());
     std::vector<std::pair<int32_t, double>> merged;
@@ -314,7 +327,7 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
       if (!merged.empty() && merged.back().first == e.first) merged.back().second += e.second;
       else merged.push_back(e);
     }
-    if (lump_ == MFREE_LUMP_PHYSICAL && !consistent) merged.assign(1, {i, mass_[i]});
+    if (lump_ == MFREE_LUMP_PHYSICAL && !consistent) merged.assign(1, {i, mass_[node[i]]});
     for (int c = 0; c < dim; ++c) {
       for (auto &e : merged) {
         ci.push_back(static_cast<int32_t>(nd) + e.first * dim + c);
@@ -324,10 +337,9 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
       ++r;
     }
   }
-  for (int32_t i = 0; i < n_; ++i) identity_row();
-  M.set_pattern(neq(), neq(), std::move(rowptr), std::move(ci));
+  for (int32_t i = 0; i < np; ++i) identity_row();
+  M.set_pattern(neq, neq, std::move(rowptr), std::move(ci));
   std::copy(vals.begin(), vals.end(), M.values_mut().begin());
-  return rep;
 }
 
 double FluidSystem::stable_dt(const double *y) {

@@ -3,6 +3,7 @@
 // leap-frog and predictor-corrector integrators.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -53,12 +54,12 @@ class FluidSystem : public System {
   Report rhs(double t, const double *y, double *ydot) override;
   Report mass(const double *y, bool consistent, SparseMatrix &M) override;
   Report interpolation(const double *y, SparseMatrix &S);
-  void pressure(const double *y, double *p) const;
-  Report velocity(const double *y, double *vhat);
+  virtual void pressure(const double *y, double *p) const;
+  virtual Report velocity(const double *y, double *vhat);
   // The walls' force on the fluid at state y (fluid_wall.cpp): total (dim values, or
   // NULL) and each wall particle's share of the eqs 122-124 force (per_wall: dim values
   // for each of the nwall wall particles, or NULL).
-  Report wall_force(const double *y, double *total, int32_t nwall, double *per_wall);
+  virtual Report wall_force(const double *y, double *total, int32_t nwall, double *per_wall);
   Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                    mfree_progress_fn progress, void *user, int64_t &nsteps) override;
 
@@ -87,6 +88,12 @@ class FluidSystem : public System {
   // After the rows of a prepare, before their statuses are checked: the rows a rank does
   // not need are dropped there, and its scatter runs in node order.
   virtual void rows_done() {}
+  // The mass matrix of mass() from the prepared tables, for np particles: the state's
+  // particle i at node node[i], node k the state's particle part[k] (-1: none, its
+  // terms dropped; nodes < n_).
+  void mass_matrix(int32_t np, const int32_t *node, const int32_t *part, bool consistent, SparseMatrix &M) const;
+  // The Tait pressure at density rho, rest density rho0.
+  double pressure_at(double rho, double rho0) const { return kappa_ * (std::pow(rho / rho0, gamma_) - 1.0); }
 
  private:
   friend class FluidRanks;

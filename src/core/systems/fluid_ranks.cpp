@@ -17,6 +17,8 @@
 #include <numeric>
 #include <sstream>
 
+#include "core/base/exact_sum.hpp"
+
 namespace mfree {
 
 namespace {
@@ -205,6 +207,13 @@ Report FluidRanks::owned_accel(const double *v, const double *rho, double *a) {
 }
 
 Report FluidRanks::prepare_accel(const double *ys, bool checked, double *a, double &limit, double &reach) {
+  Report r = prepare_rows(ys, checked, limit, reach);
+  if (!r.ok()) return r;
+  const size_t nd = static_cast<size_t>(dim()) * size();
+  return owned_accel(ys + nd, ys + 2 * nd, a);
+}
+
+Report FluidRanks::prepare_rows(const double *ys, bool checked, double &limit, double &reach) {
   ghost_fault_ = false;
   if (dummy_.n || delta_ != 0.0 || vci_ || vsmooth_ != 0.0 || open_ || lumped_step_)
     throw Error(MFREE_ERR_UNSUPPORTED, "on ranks the fluid has no dummy particles, density diffusion, consistent "
@@ -231,8 +240,16 @@ Report FluidRanks::prepare_accel(const double *ys, bool checked, double *a, doub
   // first evaluation, when the ghost layer held every particle within the width
   reach = -2.0 * (kernel_->radius() * h_ + std::sqrt(d2));
   limit = stable_dt(ys);
-  const size_t nd = static_cast<size_t>(D) * size();
-  return owned_accel(ys + nd, ys + 2 * nd, a);
+  return r;
+}
+
+void FluidRanks::check_reach(double reach, int64_t step) const {
+  if (!(-reach > width_)) return;
+  std::ostringstream s;
+  if (step > 0) s << "step " << step << ": ";
+  s << "the ghost layer (width " << width_ << ") no longer reaches two support radii around every owned particle ("
+    << -reach << " with the particles' displacements): rebuild the halo and the system";
+  throw Error(MFREE_ERR_HALO, s.str());
 }
 
 Report FluidRanks::agree_min(const Report &mine, double *vals, int nv) const {
@@ -300,12 +317,7 @@ Report FluidRanks::rhs(double t, const double *y, double *ydot) {
   });
   const Report agreed = agree_min(mine, vals, 2);
   if (!agreed.ok()) return agreed;
-  if (-vals[1] > width_) {
-    std::ostringstream s;
-    s << "the ghost layer (width " << width_ << ") no longer reaches two support radii around every owned particle ("
-      << -vals[1] << " with the particles' displacements): rebuild the halo and the system";
-    throw Error(MFREE_ERR_HALO, s.str());
-  }
+  check_reach(vals[1], 0);
   const size_t no = static_cast<size_t>(D) * n_own_;
   for (int32_t p = 0; p < n_own_; ++p) {
     const size_t k = owned_[p];
@@ -316,12 +328,6 @@ Report FluidRanks::rhs(double t, const double *y, double *ydot) {
     ydot[2 * no + p] = dr_n_[k];
   }
   return agreed;
-}
-
-Report FluidRanks::mass(const double *y, bool consistent, SparseMatrix &M) {
-  (void)y, (void)consistent, (void)M;
-  throw Error(MFREE_ERR_UNSUPPORTED, "no mass matrix for the fluid on ranks (its state holds the owned particles "
-                                     "only; integrate its lumped form)");
 }
 
 // The predictor-corrector's step dt from the node state ys_ (its tables, accelerations
@@ -442,13 +448,7 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
     const Report mine = guarded([&] { return prepare_accel(ys_.data(), nsteps > 0, rate_n_.data(), vals[0], vals[1]); });
     Report agreed = agree_min(mine, vals, 2);
     if (!agreed.ok()) return failed(agreed, nsteps);
-    if (-vals[1] > width_) {
-      std::ostringstream s;
-      s << "step " << nsteps + 1 << ": the ghost layer (width " << width_
-        << ") no longer reaches two support radii around every owned particle (" << -vals[1]
-        << " with the particles' displacements): rebuild the halo and the system";
-      throw Error(MFREE_ERR_HALO, s.str());
-    }
+    check_reach(vals[1], nsteps + 1);
     double dt = 0.0;
     agreed = step_size(vals[0], cfl, dt_max, t, t_end, nsteps, nullptr, dt);
     if (!agreed.ok()) return agreed;
@@ -487,6 +487,109 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
     if (progress && progress(user, nsteps, t, dt)) break;
   }
   return Report();
+}
+
+// ---- Outputs on ranks: the owned particles' values, or totals agreed by every rank ----
+
+Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why) {
+  // (a rank without a state still takes part in the exchange and the agreement)
+  if (!y) stand_in_.assign(static_cast<size_t>(neq()) + 1, 1.0);
+  load(y ? y : stand_in_.data());
+  double vals[2] = {INFINITY, INFINITY};
+  const Report mine = guarded([&] {
+    if (refuse != MFREE_SUCCESS) throw Error(refuse, why);
+    check_ready();
+    return a ? prepare_accel(ys_.data(), false, a, vals[0], vals[1]) : prepare_rows(ys_.data(), false, vals[0], vals[1]);
+  });
+  const Report agreed = agree_min(mine, vals, 2);
+  if (agreed.ok()) check_reach(vals[1], 0);
+  return agreed;
+}
+
+// The velocity block on the owned rows: the lumped masses (003 eq 56) of the owned
+// particles sum the terms of every row that holds them, the owned rows' and the kept
+// ghost rows' (rows_done), sorted by value as on one process: bitwise the one-process
+// fluid's. The consistent mass couples owned particles to ghosts, which the rank's
+// state does not hold.
+Report FluidRanks::mass(const double *y, bool consistent, SparseMatrix &M) {
+  const Report agreed = output_prepare(
+      y, nullptr, consistent ? MFREE_ERR_UNSUPPORTED : (!y && n_own_ > 0 ? MFREE_ERR_NULL : MFREE_SUCCESS),
+      consistent ? "no consistent mass for the fluid on ranks (its rows couple owned particles to ghosts): use the "
+                   "lumped mass"
+                 : "y is NULL");
+  if (!agreed.ok()) return agreed;
+  std::vector<int32_t> part(size(), -1);
+  for (int32_t p = 0; p < n_own_; ++p) part[owned_[p]] = p;
+  mass_matrix(n_own_, owned_.data(), part.data(), false, M);
+  return agreed;
+}
+
+// Local: the owned particles' densities and rest densities.
+void FluidRanks::pressure(const double *y, double *p) const {
+  const double *rho = y + 2 * static_cast<size_t>(dim()) * n_own_;
+  for (int32_t i = 0; i < n_own_; ++i) p[i] = pressure_at(rho[i], rho0_[owned_[i]]);
+}
+
+Report FluidRanks::velocity(const double *y, double *vhat) {
+  const bool null = (!y || !vhat) && n_own_ > 0;
+  const Report agreed = output_prepare(y, nullptr, null ? MFREE_ERR_NULL : MFREE_SUCCESS, "y or vhat is NULL");
+  if (!agreed.ok()) return agreed;
+  const int D = dim();
+  const size_t nd = static_cast<size_t>(D) * size();
+  vh_n_.resize(nd);
+  kinematics(ys_.data() + nd, ys_.data() + 2 * nd, vh_n_.data(), nullptr);
+  for (int32_t p = 0; p < n_own_; ++p)
+    for (int c = 0; c < D; ++c) vhat[p * D + c] = vh_n_[static_cast<size_t>(owned_[p]) * D + c];
+  return agreed;
+}
+
+// The total: sum_i m_i a_i - M g over every rank's owned particles (FluidSystem::
+// wall_force), each sum exact (every rank's accumulator all-gathered and added as
+// integers), so that every rank gets the same bits, whatever the partition.
+Report FluidRanks::wall_force(const double *y, double *total, int32_t nwall, double *per_wall) {
+  (void)nwall;
+  const int D = dim();
+  const size_t nd = static_cast<size_t>(D) * size();
+  rate_n_.resize(nd);
+  mfree_status_t refuse = MFREE_SUCCESS;
+  const char *why = "";
+  if (per_wall) {
+    refuse = MFREE_ERR_UNSUPPORTED;
+    why = "no force per wall particle for the fluid on ranks yet (only the total)";
+  } else if (!total || (!y && n_own_ > 0)) {
+    refuse = MFREE_ERR_NULL;
+    why = total ? "y is NULL" : "total and per_wall are both NULL";
+  }
+  const Report agreed = output_prepare(y, rate_n_.data(), refuse, why);
+  if (!agreed.ok()) return agreed;
+  const int A = 2 * D + 2;  // acc_ per node: force, mass sum, lumped mass, wall force
+  const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
+  std::vector<ExactSum> sums(D + 1);
+  for (int32_t k : owned_) {
+    const double m = galerkin ? acc_[static_cast<size_t>(k) * A + D + 1] : mass_[k];
+    for (int c = 0; c < D; ++c) sums[c].add(m * rate_n_[static_cast<size_t>(k) * D + c]);
+    sums[D].add(mass_[k]);
+  }
+  const int W = ExactSum::kWords;
+  const size_t rec = static_cast<size_t>(D + 1) * W;
+  std::vector<double> mine(rec);
+  for (int c = 0; c <= D; ++c) {
+    sums[c].normalise();  // (words below 2^53: exact as doubles)
+    for (int w = 0; w < W; ++w) mine[c * W + w] = static_cast<double>(sums[c].words()[w]);
+  }
+  const std::vector<double> all = coll_.allgather(mine.data(), static_cast<int64_t>(rec));
+  double f[4] = {0, 0, 0, 0};
+  std::vector<int64_t> words(W);
+  for (int c = 0; c <= D; ++c) {
+    ExactSum s;
+    for (size_t p = 0; p < all.size() / rec; ++p) {
+      for (int w = 0; w < W; ++w) words[w] = static_cast<int64_t>(all[p * rec + c * W + w]);
+      s.add_words(words.data());
+    }
+    f[c] = s.value();
+  }
+  for (int c = 0; c < D; ++c) total[c] = f[c] - f[D] * g_[c];
+  return agreed;
 }
 
 }  // namespace mfree

@@ -29,6 +29,9 @@ class FluidRanks final : public FluidSystem {
   int32_t neq() const override { return (2 * dim() + 1) * n_own_; }
   Report rhs(double t, const double *y, double *ydot) override;
   Report mass(const double *y, bool consistent, SparseMatrix &M) override;
+  void pressure(const double *y, double *p) const override;
+  Report velocity(const double *y, double *vhat) override;
+  Report wall_force(const double *y, double *total, int32_t nwall, double *per_wall) override;
   Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                    mfree_progress_fn progress, void *user, int64_t &nsteps) override;
 
@@ -49,6 +52,16 @@ class FluidRanks final : public FluidSystem {
   // step limit; reach: twice the largest displacement of an owned particle since the
   // first evaluation, negated (for the minimum of the all-gather).
   Report prepare_accel(const double *ys, bool checked, double *a, double &limit, double &reach);
+  // prepare_accel without the accelerations.
+  Report prepare_rows(const double *ys, bool checked, double &limit, double &reach);
+  // MFREE_ERR_HALO on every rank when reach (agreed by agree_min) exceeds the width;
+  // step > 0: integrate's step, named in the message.
+  void check_reach(double reach, int64_t step) const;
+  // The outputs' evaluation at the owned state y: load, the tables (and with a, the
+  // accelerations into a), agreed; refuse != MFREE_SUCCESS: this rank's error instead,
+  // with the message why (every rank then returns it; y may then be NULL).
+  Report output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why);
+  std::vector<double> stand_in_;  // output_prepare's stand-in for a NULL state
   // The predictor-corrector's corrected state in yn_ (integrate's step number step).
   Report corrected_state(double dt, int64_t step);
   // accel, with the mass check restricted to the owned nodes (ghost nodes far out have
