@@ -190,6 +190,30 @@ MFREE_ALWAYS_INLINE I8 maskload(const int32_t *p, const I8 &mask) {
 MFREE_AVX2_END
 #endif
 
+// Whether v[0 .. n) are all finite. x - x is 0 for a finite x and NaN for an infinite or
+// NaN one, so sums of such differences stay 0 exactly when every x is finite: one pass
+// without a branch, in two-lane vectors with two independent sums, because the compiler
+// leaves a loop of comparisons (|x| <= DBL_MAX) scalar. For passes over every table
+// entry or every coordinate of a call; the caller looks for the culprit only when false.
+inline bool all_finite(const double *v, int64_t n) {
+  double rest = 0.0;
+  int64_t k = 0;
+#if MFREE_VECTOR_EXTENSIONS
+  V2 a = {0.0, 0.0}, b = {0.0, 0.0};
+  for (; k + 4 <= n; k += 4) {
+    V2 x, y;
+    load<2>(x, v + k);
+    load<2>(y, v + k + 2);
+    a += x - x;
+    b += y - y;
+  }
+  a += b;
+  rest = a[0] + a[1];
+#endif
+  for (; k < n; ++k) rest += v[k] - v[k];
+  return rest == 0.0;
+}
+
 // True when the AVX2 + FMA copies may run: the running call is on the optimised backend
 // (the reference backend runs the baseline copies of every kernel that has no reference
 // path of its own: the fluid, the neighbour search), the CPU has both (and the OS saves

@@ -58,6 +58,7 @@ struct VerletLists {
   Buf<double> x0;      // positions at the build, dim per particle
   Buf<double> r0;      // search radii kappa h at the build
   Buf<int32_t> stat0;  // particle statuses at the build
+  double x0abs = 0.0;  // largest |coordinate| in x0
   HVec<int32_t> tmp;   // filtered rows, block by block, before they are placed
   bool built = false;  // cand holds for the settings below
   bool used = false;   // the last search's rows came from cand

@@ -20,29 +20,6 @@ namespace {
 // sites stay in the L2 cache
 constexpr int64_t kScreenBlock = 256;
 
-// Whether v[0 .. n) are all finite. x - x is 0 for a finite x and NaN for an infinite or
-// NaN one, so sums of such differences stay 0 exactly when every x is finite: one pass
-// without a branch, in two-lane vectors (simd.hpp) with two independent sums, because
-// the compiler leaves a loop of comparisons (|x| <= DBL_MAX) scalar, and this pass reads
-// every table entry of every setup and update.
-bool all_finite(const double *v, int64_t n) {
-  double rest = 0.0;
-  int64_t k = 0;
-#if MFREE_VECTOR_EXTENSIONS
-  simd::V2 a = {0.0, 0.0}, b = {0.0, 0.0};
-  for (; k + 4 <= n; k += 4) {
-    simd::V2 x, y;
-    simd::load<2>(x, v + k);
-    simd::load<2>(y, v + k + 2);
-    a += x - x;
-    b += y - y;
-  }
-  a += b;
-  rest = a[0] + a[1];
-#endif
-  for (; k < n; ++k) rest += v[k] - v[k];
-  return rest == 0.0;
-}
 }  // namespace
 
 Report Approximant::compute(const char *what) {
@@ -286,9 +263,9 @@ int64_t Approximant::screen_sites(int64_t b, int64_t e) {
       for (int64_t k = k0; k < k1 && !cls; ++k) cls = bad[cols_[k]];
     if (!cls && status_[s] == 0) {
       bool finite = true;
-      if (!val_.empty()) finite &= all_finite(val_.data() + k0, k1 - k0);
-      if (!grad_.empty()) finite &= all_finite(grad_.data() + k0 * dim, (k1 - k0) * dim);
-      if (!hess_.empty()) finite &= all_finite(hess_.data() + k0 * nh, (k1 - k0) * nh);
+      if (!val_.empty()) finite &= simd::all_finite(val_.data() + k0, k1 - k0);
+      if (!grad_.empty()) finite &= simd::all_finite(grad_.data() + k0 * dim, (k1 - k0) * dim);
+      if (!hess_.empty()) finite &= simd::all_finite(hess_.data() + k0 * nh, (k1 - k0) * nh);
       if (!finite) cls = MFREE_FAIL_NONFINITE;
     }
     if (cls) {
