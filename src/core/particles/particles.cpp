@@ -386,10 +386,16 @@ Report ParticleSet::validate() {
       bool ok = true;
       const double *X = pos_data();
       const int64_t si = pos_step_i(), sc = pos_step_c();
-      for (int c = 0; c < dim_; ++c) {
-        bool okc = true;
-        for (int64_t i = b; i < e; ++i) okc &= std::fabs(X[i * si + c * sc]) <= big;  // finite
-        ok = ok && okc;
+      if (sc == 1 && si == dim_) {  // packed (x, y, z) per particle: one run of doubles
+        ok = simd::all_finite(X + b * si, (e - b) * si);
+      } else {
+        for (int c = 0; c < dim_; ++c) {
+          bool okc = true;
+          if (si == 1) okc = simd::all_finite(X + c * sc + b, e - b);
+          else
+            for (int64_t i = b; i < e; ++i) okc &= std::fabs(X[i * si + c * sc]) <= big;  // finite
+          ok = ok && okc;
+        }
       }
       for (const ScalarArray *a : {&h_, &vol_, &mass_, &rho_}) {
         if (!a->set()) continue;
