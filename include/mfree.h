@@ -2151,7 +2151,7 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * state: MFREE_FAIL_NONFINITE) is returned by every rank with that rank's message
  * ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
  * consistent integration, velocity smoothing or open boundaries (MFREE_ERR_UNSUPPORTED). Outputs: the owned
- * particles' (docs/fluid-ranks.md); no consistent mass, interpolation or per_wall force. Creation is collective: bad input on one rank, or ranks that
+ * particles' (docs/fluid-ranks.md); no consistent mass or interpolation. Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.
  * libmfree_mpi's mfree_halo_create_fluid supplies the callbacks from a halo plan.
  * @param[in]  ctx         context (kept alive); NULL: MFREE_ERR_NULL on this rank alone

@@ -13,9 +13,12 @@
  *   (summed in particle order, rounded at every term) within 1e-12 of the sum of the
  *   terms' magnitudes; none at rest (003 eq 65's densities: no particle approaches a
  *   wall, the internal forces cancel), and the floor holding the column up when moving;
- * - what is not distributed fails alike on every rank: the consistent mass and the force
- *   per wall particle (MFREE_ERR_UNSUPPORTED), a NULL output on one rank only
- *   (MFREE_ERR_NULL). */
+ * - each wall particle's force bitwise one rank's and the one-process fluid's (the rows'
+ *   terms gathered and summed in global-id order), summing to the total; asked on one
+ *   rank only, the total on the others;
+ * - what is not distributed fails alike on every rank: the consistent mass
+ *   (MFREE_ERR_UNSUPPORTED); a NULL output (MFREE_ERR_NULL) or a per_wall of the wrong size
+ *   (MFREE_ERR_ARG) on one rank only. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,14 +33,16 @@ static const char *kName[NDECOMP] = {"layers", "hashed", "slabs, reversed local 
 typedef struct {
   double *p, *vh, *ml; /* per particle by global id: pressure, v_hat (2), lumped mass */
   double total[2];
+  double *per_wall; /* 2 per wall particle */
 } outputs_t;
 
-static void outputs_alloc(outputs_t *o, int n) {
+static void outputs_alloc(outputs_t *o, int n, int nwall) {
   o->p = calloc((size_t)n, sizeof(double));
   o->vh = calloc(2 * (size_t)n, sizeof(double));
   o->ml = calloc((size_t)n, sizeof(double));
+  o->per_wall = calloc(2 * (size_t)nwall, sizeof(double));
 }
-static void outputs_free(outputs_t *o) { free(o->p), free(o->vh), free(o->ml); }
+static void outputs_free(outputs_t *o) { free(o->p), free(o->vh), free(o->ml), free(o->per_wall); }
 
 /* The lumped masses of the velocity rows of M (no particles), checking the identity rows
    and the diagonal pattern. */
@@ -88,8 +93,12 @@ static void run(mfree_context_t *ctx, MPI_Comm comm, const damb_t *b, const int 
   st = mfree_system_assemble_mass(sys, y, 0, &M);
   CHECK(st == MFREE_SUCCESS, "mass: %d: %s", (int)st, mpifluid_error(ctx));
   if (st == MFREE_SUCCESS) lumped_masses(M, no, ml);
-  st = mfree_system_get_wall_force(sys, y, o->total, 0, NULL);
+  st = mfree_system_get_wall_force(sys, y, o->total, b->nwall, o->per_wall);
   CHECK(st == MFREE_SUCCESS, "wall force: %d: %s", (int)st, mpifluid_error(ctx));
+  double total_again[2] = {0.0, 0.0};
+  st = mfree_system_get_wall_force(sys, y, total_again, 0, NULL); /* the total alone: the same */
+  CHECK(st == MFREE_SUCCESS && memcmp(total_again, o->total, sizeof total_again) == 0, "wall force total alone: %d",
+        (int)st);
   if (owner) {
     mpifluid_collect(comm, no, r.id, p, 1, o->p);
     mpifluid_collect(comm, no, r.id, vh, 2, o->vh);
@@ -97,10 +106,17 @@ static void run(mfree_context_t *ctx, MPI_Comm comm, const damb_t *b, const int 
     /* not distributed: every rank fails alike */
     double f[2], *per_wall = malloc(2 * (size_t)b->nwall * sizeof *per_wall);
     expect(ctx, mfree_system_assemble_mass(sys, y, 1, &M), MFREE_ERR_UNSUPPORTED, "consistent", "consistent mass");
-    expect(ctx, mfree_system_get_wall_force(sys, y, f, b->nwall, per_wall), MFREE_ERR_UNSUPPORTED, "per wall",
-           "force per wall particle");
     int rank = 0;
     MPI_Comm_rank(comm, &rank);
+    /* the force per wall particle on rank 0 only, the total on the others: each its part */
+    st = mfree_system_get_wall_force(sys, y, rank == 0 ? NULL : f, b->nwall, rank == 0 ? per_wall : NULL);
+    CHECK(st == MFREE_SUCCESS, "per_wall on rank 0 alone: %d: %s", (int)st, mpifluid_error(ctx));
+    if (rank == 0)
+      CHECK(memcmp(per_wall, o->per_wall, 2 * (size_t)b->nwall * sizeof *per_wall) == 0, "per_wall on rank 0 alone");
+    else
+      CHECK(memcmp(f, o->total, sizeof f) == 0, "total without rank 0's");
+    expect(ctx, mfree_system_get_wall_force(sys, y, f, rank == 0 ? b->nwall - 1 : b->nwall, per_wall), MFREE_ERR_ARG,
+           "wall particles", "per_wall of the wrong size on rank 0");
     expect(ctx, mfree_system_get_velocity(sys, y, rank == 0 ? NULL : vh), MFREE_ERR_NULL, "NULL",
            "velocity output NULL on rank 0");
     expect(ctx, mfree_system_get_wall_force(sys, rank == 0 ? NULL : y, f, 0, NULL), MFREE_ERR_NULL, "NULL",
@@ -135,7 +151,7 @@ int main(int argc, char **argv) {
   const int n = b.n;
   int *owner = calloc((size_t)n, sizeof *owner);
   outputs_t o0, o1, o;
-  outputs_alloc(&o0, n), outputs_alloc(&o1, n), outputs_alloc(&o, n);
+  outputs_alloc(&o0, n, b.nwall), outputs_alloc(&o1, n, b.nwall), outputs_alloc(&o, n, b.nwall);
   double weight = 0.0;
   for (int q = 0; q < n; ++q) weight += b.m[q] * 9.81;
   for (int moved = 0; moved <= 1; ++moved) {
@@ -160,6 +176,13 @@ int main(int argc, char **argv) {
     CHECK(differ(o1.p, o0.p, n) == 0, "%s: one rank's pressures differ from the one-process fluid's", when);
     CHECK(differ(o1.vh, o0.vh, 2 * n) == 0, "%s: one rank's velocities differ from the one-process fluid's", when);
     CHECK(differ(o1.ml, o0.ml, n) == 0, "%s: one rank's lumped masses differ from the one-process fluid's", when);
+    CHECK(differ(o1.per_wall, o0.per_wall, 2 * b.nwall) == 0, "%s: one rank's force per wall particle differs from the "
+          "one-process fluid's", when);
+    double sx = 0.0, sy = 0.0;
+    for (int w = 0; w < b.nwall; ++w) sx += o1.per_wall[2 * w], sy += o1.per_wall[2 * w + 1];
+    /* without dummies the shares sum to the total */
+    CHECK(fabs(sx - o1.total[0]) <= 1e-10 * weight && fabs(sy - o1.total[1]) <= 1e-10 * weight,
+          "%s: per-wall sum (%.17g, %.17g), total (%.17g, %.17g)", when, sx, sy, o1.total[0], o1.total[1]);
     double scale = 0.0, msum = 0.0, mmin = INFINITY;
     for (int q = 0; q < n; ++q) scale += b.m[q] * 9.81, msum += o1.ml[q], mmin = fmin(mmin, o1.ml[q]);
     /* the lumped masses sum to the particle masses (the rows' partition of unity) */
@@ -191,6 +214,8 @@ int main(int argc, char **argv) {
             differ(o.vh, o1.vh, 2 * n));
       CHECK(differ(o.ml, o1.ml, n) == 0, "%s, %s: %d lumped masses differ from one rank's", when, kName[how],
             differ(o.ml, o1.ml, n));
+      CHECK(differ(o.per_wall, o1.per_wall, 2 * b.nwall) == 0, "%s, %s: %d per-wall forces differ from one rank's", when,
+            kName[how], differ(o.per_wall, o1.per_wall, 2 * b.nwall));
       CHECK(differ(o.total, o1.total, 2) == 0, "%s, %s: wall force (%.17g, %.17g), one rank (%.17g, %.17g)", when,
             kName[how], o.total[0], o.total[1], o1.total[0], o1.total[1]);
       double *all = malloc(2 * (size_t)size * sizeof *all);

@@ -1235,7 +1235,7 @@ static void rows_system(void) {
       ROW(MFREE_ERR_NULL, mfree_system_get_wall_force(fr, NULL, yd, 0, NULL));
       ROW(MFREE_ERR_NULL, mfree_system_get_wall_force(fr, ys, NULL, 0, NULL));
       ROW(MFREE_ERR_NULL, mfree_system_assemble_mass(fr, NULL, 0, &fm));
-      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_get_wall_force(fr, ys, yd, 0, yd));
+      ROW(MFREE_ERR_ARG, mfree_system_get_wall_force(fr, ys, yd, 1, yd));
       ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_mass(fr, ys, 1, &fm));
       ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_interpolation(fr, ys, &fm));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, (mfree_integrator_t)0, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));

@@ -92,6 +92,11 @@ class FluidSystem : public System {
   // particle i at node node[i], node k the state's particle part[k] (-1: none, its
   // terms dropped; nodes < n_).
   void mass_matrix(int32_t np, const int32_t *node, const int32_t *part, bool consistent, SparseMatrix &M) const;
+  // Row k's terms of the force per wall particle (wall_force's per_wall): (w, m_k f2) for
+  // each wall particle w the point x_k approaches within r0 (eqs 122-124 as accel takes
+  // them; m_k = sum_i N_i(x_k) m_i with the masses m accel divides by, vn the nodes'
+  // velocities); wall w's force sums m_k f2 n_w over the rows in node order.
+  void wall_row(int32_t k, const double *vn, const double *m, std::vector<std::pair<int32_t, double>> &terms) const;
   // The Tait pressure at density rho, rest density rho0.
   double pressure_at(double rho, double rho0) const { return kappa_ * (std::pow(rho / rho0, gamma_) - 1.0); }
 

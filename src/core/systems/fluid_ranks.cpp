@@ -491,17 +491,20 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
 
 // ---- Outputs on ranks: the owned particles' values, or totals agreed by every rank ----
 
-Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why) {
+Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why, double *want,
+                                  int nwant) {
   // (a rank without a state still takes part in the exchange and the agreement)
   if (!y) stand_in_.assign(static_cast<size_t>(neq()) + 1, 1.0);
   load(y ? y : stand_in_.data());
-  double vals[2] = {INFINITY, INFINITY};
+  double vals[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+  for (int k = 0; k < nwant; ++k) vals[2 + k] = want[k];
   const Report mine = guarded([&] {
     if (refuse != MFREE_SUCCESS) throw Error(refuse, why);
     check_ready();
     return a ? prepare_accel(ys_.data(), false, a, vals[0], vals[1]) : prepare_rows(ys_.data(), false, vals[0], vals[1]);
   });
-  const Report agreed = agree_min(mine, vals, 2);
+  const Report agreed = agree_min(mine, vals, 2 + nwant);
+  for (int k = 0; k < nwant; ++k) want[k] = vals[2 + k];
   if (agreed.ok()) check_reach(vals[1], 0);
   return agreed;
 }
@@ -545,25 +548,36 @@ Report FluidRanks::velocity(const double *y, double *vhat) {
 
 // The total: sum_i m_i a_i - M g over every rank's owned particles (FluidSystem::
 // wall_force), each sum exact (every rank's accumulator all-gathered and added as
-// integers), so that every rank gets the same bits, whatever the partition.
+// integers), so that every rank gets the same bits, whatever the partition; per_wall:
+// wall_shares.
 Report FluidRanks::wall_force(const double *y, double *total, int32_t nwall, double *per_wall) {
-  (void)nwall;
   const int D = dim();
   const size_t nd = static_cast<size_t>(D) * size();
   rate_n_.resize(nd);
+  const int32_t nw = walls_ ? walls_->size() : 0;
   mfree_status_t refuse = MFREE_SUCCESS;
-  const char *why = "";
-  if (per_wall) {
-    refuse = MFREE_ERR_UNSUPPORTED;
-    why = "no force per wall particle for the fluid on ranks yet (only the total)";
-  } else if (!total || (!y && n_own_ > 0)) {
+  std::string why;
+  if ((!total && !per_wall) || (!y && n_own_ > 0)) {
     refuse = MFREE_ERR_NULL;
-    why = total ? "y is NULL" : "total and per_wall are both NULL";
+    why = y ? "total and per_wall are both NULL" : "y is NULL";
+  } else if (per_wall && nwall != nw) {
+    refuse = MFREE_ERR_ARG;
+    why = "per_wall holds " + std::to_string(nwall) + " wall particles, the system has " + std::to_string(nw);
   }
-  const Report agreed = output_prepare(y, rate_n_.data(), refuse, why);
+  // which outputs any rank asks for: every rank takes part in their collectives
+  double want[2] = {total ? 0.0 : 1.0, per_wall ? 0.0 : 1.0};
+  const Report agreed = output_prepare(y, rate_n_.data(), refuse, why.c_str(), want, 2);
   if (!agreed.ok()) return agreed;
   const int A = 2 * D + 2;  // acc_ per node: force, mass sum, lumped mass, wall force
   const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
+  std::vector<double> unused;
+  if (want[1] == 0.0) {
+    if (!per_wall) unused.resize(static_cast<size_t>(nw) * D + 1);
+    wall_shares(galerkin, per_wall ? per_wall : unused.data());
+  }
+  if (want[0] != 0.0) return agreed;
+  double none[3];
+  if (!total) total = none;
   std::vector<ExactSum> sums(D + 1);
   for (int32_t k : owned_) {
     const double m = galerkin ? acc_[static_cast<size_t>(k) * A + D + 1] : mass_[k];
@@ -590,6 +604,40 @@ Report FluidRanks::wall_force(const double *y, double *total, int32_t nwall, dou
   }
   for (int c = 0; c < D; ++c) total[c] = f[c] - f[D] * g_[c];
   return agreed;
+}
+
+// Each wall particle's force sums the terms of the rows near it in node order on one
+// rank (FluidSystem::wall_force): every rank gathers the terms of its owned rows with
+// the wall and the row's global id, and every rank sums them all in the order of (wall,
+// global id). The rows' masses m_k read the lumped masses of ghosts, which only their
+// owners have complete.
+void FluidRanks::wall_shares(bool galerkin, double *per_wall) {
+  const int D = dim();
+  const int A = 2 * D + 2;
+  const int32_t n = size(), nw = walls_ ? walls_->size() : 0;
+  std::vector<double> m(n);
+  for (int32_t k = 0; k < n; ++k) m[k] = galerkin ? acc_[static_cast<size_t>(k) * A + D + 1] : mass_[k];
+  sync(m.data(), 1);
+  const double *vn = ys_.data() + static_cast<size_t>(D) * n;  // (no dummies on ranks)
+  std::vector<double> rec;  // (wall, row's global id, m_k f2) per term
+  std::vector<std::pair<int32_t, double>> terms;
+  for (int32_t k = 0; k < n && nw > 0; ++k) {
+    if (!is_owned_[k]) continue;
+    wall_row(k, vn, m.data(), terms);
+    for (const auto &e : terms) rec.insert(rec.end(), {static_cast<double>(e.first), Collective::pack(gid_[k]), e.second});
+  }
+  const std::vector<double> all = coll_.allgather(rec.data(), static_cast<int64_t>(rec.size()));
+  std::vector<size_t> order(all.size() / 3);
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    if (all[3 * a] != all[3 * b]) return all[3 * a] < all[3 * b];
+    return Collective::unpack(all[3 * a + 1]) < Collective::unpack(all[3 * b + 1]);
+  });
+  std::fill(per_wall, per_wall + static_cast<size_t>(nw) * D, 0.0);
+  for (size_t t : order) {
+    const size_t w = static_cast<size_t>(all[3 * t]);
+    for (int c = 0; c < D; ++c) per_wall[w * D + c] += all[3 * t + 2] * wall_n_[w * D + c];
+  }
 }
 
 }  // namespace mfree

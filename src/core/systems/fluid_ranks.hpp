@@ -59,9 +59,14 @@ class FluidRanks final : public FluidSystem {
   void check_reach(double reach, int64_t step) const;
   // The outputs' evaluation at the owned state y: load, the tables (and with a, the
   // accelerations into a), agreed; refuse != MFREE_SUCCESS: this rank's error instead,
-  // with the message why (every rank then returns it; y may then be NULL).
-  Report output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why);
+  // with the message why (every rank then returns it; y may then be NULL); want: nwant
+  // (<= 2) values replaced by their minima over the ranks.
+  Report output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why, double *want = nullptr,
+                        int nwant = 0);
   std::vector<double> stand_in_;  // output_prepare's stand-in for a NULL state
+  // wall_force's per_wall (every rank's rows' terms gathered) after output_prepare with
+  // the accelerations; galerkin: the rows' masses are the lumped masses.
+  void wall_shares(bool galerkin, double *per_wall);
   // The predictor-corrector's corrected state in yn_ (integrate's step number step).
   Report corrected_state(double dt, int64_t step);
   // accel, with the mass check restricted to the owned nodes (ghost nodes far out have

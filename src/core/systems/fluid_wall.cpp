@@ -395,31 +395,42 @@ Report FluidSystem::wall_force(const double *y, double *total, int32_t nwall, do
   if (per_wall) {
     std::fill(per_wall, per_wall + static_cast<size_t>(nw) * dim, 0.0);
     const double *vn = node_velocities(v);
+    std::vector<std::pair<int32_t, double>> terms;
     for (int32_t k = 0; k < n_ && nw > 0; ++k) {
-      if (wall_nbr_.rowptr[k] == wall_nbr_.rowptr[k + 1]) continue;
-      double vh[3] = {0, 0, 0}, mk = 0.0;
-      for (int64_t q = rb(k); q < re(k); ++q) {
-        const int32_t i = cols_[q];
-        for (int c = 0; c < dim; ++c) vh[c] += N_[q] * vn[static_cast<size_t>(i) * dim + c];
-        if (i < n_) mk += N_[q] * m[i];
-      }
-      for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
-        const int32_t w = wall_nbr_.cols[q];
-        const double *nrm = &wall_n_[static_cast<size_t>(w) * dim];
-        double r2 = 0.0, approach = 0.0;
-        for (int c = 0; c < dim; ++c) {
-          const double d = xbound_[static_cast<size_t>(k) * dim + c] - walls_->x(w, c);
-          r2 += d * d;
-          approach += vh[c] * nrm[c];
-        }
-        const double r = std::sqrt(r2);
-        if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // as in accel
-        const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
-        for (int c = 0; c < dim; ++c) per_wall[static_cast<size_t>(w) * dim + c] += mk * f2 * nrm[c];
-      }
+      wall_row(k, vn, m.data(), terms);
+      for (const auto &e : terms)
+        for (int c = 0; c < dim; ++c)
+          per_wall[static_cast<size_t>(e.first) * dim + c] += e.second * wall_n_[static_cast<size_t>(e.first) * dim + c];
     }
   }
   return rep;
+}
+
+void FluidSystem::wall_row(int32_t k, const double *vn, const double *m,
+                           std::vector<std::pair<int32_t, double>> &terms) const {
+  terms.clear();
+  if (wall_nbr_.rowptr[k] == wall_nbr_.rowptr[k + 1]) return;
+  const int dim = dim_;
+  double vh[3] = {0, 0, 0}, mk = 0.0;
+  for (int64_t q = rb(k); q < re(k); ++q) {
+    const int32_t i = cols_[q];
+    for (int c = 0; c < dim; ++c) vh[c] += N_[q] * vn[static_cast<size_t>(i) * dim + c];
+    if (i < n_) mk += N_[q] * m[i];
+  }
+  for (int64_t q = wall_nbr_.rowptr[k]; q < wall_nbr_.rowptr[k + 1]; ++q) {
+    const int32_t w = wall_nbr_.cols[q];
+    const double *nrm = &wall_n_[static_cast<size_t>(w) * dim];
+    double r2 = 0.0, approach = 0.0;
+    for (int c = 0; c < dim; ++c) {
+      const double d = xbound_[static_cast<size_t>(k) * dim + c] - walls_->x(w, c);
+      r2 += d * d;
+      approach += vh[c] * nrm[c];
+    }
+    const double r = std::sqrt(r2);
+    if (approach >= 0.0 || !(r > 0.0) || r >= r0_) continue;  // as in accel
+    const double qq = r0_ / r, f2 = strength_ / r * (qq * qq * qq * qq - qq * qq);
+    terms.push_back({w, mk * f2});
+  }
 }
 
 }  // namespace mfree
