@@ -2101,10 +2101,10 @@ typedef mfree_status_t (*mfree_allgather_fn)(void *user, const double *in, int64
                                              double *out, int64_t cap, int64_t *total);
 
 /**
- * Linear elastodynamics by collocation, as mfree_system_create_elastodynamic, on one rank
- * of several: the assembler is set up over this rank's owned particles plus ghosts (a
- * particle set with mfree_particles_set_num_ghost and global ids, ghosts at least one
- * support deep), and the state y of this rank holds its owned particles only
+ * Linear elastodynamics, as mfree_system_create_elastodynamic (or _galerkin, below), on
+ * one rank of several: the assembler is set up over this rank's owned particles plus
+ * ghosts (a particle set with mfree_particles_set_num_ghost and global ids, ghosts at
+ * least one support deep), and the state y of this rank holds its owned particles only
  * (displacements of the owned particles, then their velocities: neq = 2 ncomp n_owned).
  * Every right-hand side, native step and stress evaluation is collective: it exchanges
  * the ghosts' displacements through exchange, and gathers the boundary rows' data through
@@ -2114,11 +2114,19 @@ typedef mfree_status_t (*mfree_allgather_fn)(void *user, const double *in, int64
  * rank with that rank's message ("rank R: ..."). Creation is collective too: a NULL
  * assembler or a bad density on one rank, or ranks that disagree on the density, the
  * form or its coefficients, make every rank fail alike (MFREE_ERR_NULL, MFREE_ERR_ARG).
- * Collocation forms only (MFREE_ERR_UNSUPPORTED for Galerkin assemblers).
+ * A Galerkin stiffness assembler (Laplace or elasticity form, as for
+ * mfree_system_create_elastodynamic_galerkin) gives Galerkin elastodynamics with the
+ * lumped mass of density rho on the stiffness's quadrature points (MFREE_FORM_MASS_LUMPED:
+ * bitwise the one-process system with such a mass assembler); its ghosts must reach two
+ * support radii, and its quadrature points (mfree_assembler_set_quadrature_points) and
+ * boundary points are those within one support radius of the owned particles, in the same
+ * global order on every rank (docs/mpi.md). MFREE_ERR_UNSUPPORTED on ranks: nodal
+ * quadrature, an FE layer, consistent integration, Lagrange multipliers; no consistent
+ * mass (its inverse couples every unknown at each evaluation).
  * libmfree_mpi's mfree_halo_create_elastodynamic supplies the callbacks from a halo plan.
  * @param[in]  ctx        context (kept alive); NULL: MFREE_ERR_NULL on this rank alone
- * @param[in]  as         a set-up collocation assembler over owned particles and ghosts
- *                        (kept alive), or NULL (every rank then fails)
+ * @param[in]  as         a set-up collocation or Galerkin stiffness assembler over owned
+ *                        particles and ghosts (kept alive), or NULL (every rank then fails)
  * @param[in]  density    rho > 0, the same on every rank
  * @param[in]  exchange   the forward halo exchange (NULL: MFREE_ERR_NULL, local)
  * @param[in]  allgather  the all-gather (NULL: MFREE_ERR_NULL, local)

@@ -299,9 +299,9 @@ contains
     st = mfree_halo_create_f_c(ctx%ptr, int(comm, c_int32_t), dim, halo%ptr)
   end function mfree_halo_create
 
-  !> The elastodynamic system of a collocation assembler over the plan's particles, on
-  !> ranks (mfree_system_create_elastodynamic_ranks through the plan). Collective; the plan
-  !> must outlive the system.
+  !> The elastodynamic system of a collocation or Galerkin stiffness assembler over the
+  !> plan's particles, on ranks (mfree_system_create_elastodynamic_ranks through the plan).
+  !> Collective; the plan must outlive the system.
   integer(c_int) function mfree_halo_create_elastodynamic(halo, as, density, sys) result(st)
     type(mfree_halo), intent(in) :: halo
     type(mfree_assembler), intent(in) :: as

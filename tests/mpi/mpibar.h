@@ -33,23 +33,43 @@ typedef struct {
   int64_t *id; /* their global ids */
 } mpibar_t;
 
+/* The discretisations: t703's collocation; t704's Galerkin (MLS, linear basis, cubic
+ * spline, h = 1.5 dx, K = int E Phi' Phi' on 2-point Gauss cells between the particles,
+ * the end load as a point traction at x = L, the lumped mass) with the left end free or
+ * held by a node row (u(0) = 0, an essential condition), and the same Galerkin bar on
+ * nodal quadrature (refused on ranks). On ranks each rank passes the Gauss points and the
+ * traction point within one support radius of its owned particles, in the cells' order. */
+enum { BAR_COLLOCATION = 0, BAR_GALERKIN = 1, BAR_GALERKIN_FIXED = 2, BAR_GALERKIN_NODAL = 3 };
+
 /* Builds the bar on comm (collective); 0 on success. */
 int mpibar_make(mpibar_t *b, mfree_context_t *ctx, MPI_Comm comm, int n, int how);
+/* The same with one of the discretisations above. */
+int mpibar_make_kind(mpibar_t *b, mfree_context_t *ctx, MPI_Comm comm, int n, int how, int kind);
 void mpibar_free(mpibar_t *b);
+/* The faults every elastodynamic system on ranks answers alike, on MPI_COMM_WORLD (b on
+ * slabs of n particles, y its zero state, yd room for the rate): a NaN displacement, then
+ * a NaN velocity, on the last rank (its first owned particle): mfree_system_rhs and
+ * mfree_system_integrate return MFREE_FAIL_NONFINITE on every rank, naming the rank and
+ * the global id, the integration before any step; a load history that turns NaN on the
+ * last rank after 1 us: every rank stops at the same step and time, y the last good
+ * state. Leaves the pulse as the history. */
+void mpibar_check_faults(mpibar_t *b, mfree_context_t *ctx, double *y, double *yd);
 /* The pulse T0 long (the load history of the system). */
 double mpibar_pulse(void *user, double t);
 /* Every rank's owned values (ncomp per owned particle, in the bar's local order) into
  * out[id * ncomp + c] on every rank (n ncomp values). Collective. */
 void mpibar_collect(const mpibar_t *b, const double *vals, int ncomp, double *out);
-/* The serial system of the same bar (mfree_system_create_elastodynamic, t703's). */
+/* The serial system of the same bar (mfree_system_create_elastodynamic, t703's; Galerkin:
+ * mfree_system_create_elastodynamic_galerkin with a lumped mass assembler). */
 typedef struct {
   mfree_particles_t *ps;
   mfree_approximant_t *a;
-  mfree_assembler_t *as;
+  mfree_assembler_t *as, *mass;
   mfree_system_t *sys;
   double *x;
 } serialbar_t;
 int serialbar_make(serialbar_t *b, mfree_context_t *ctx, int n);
+int serialbar_make_kind(serialbar_t *b, mfree_context_t *ctx, int n, int kind);
 void serialbar_free(serialbar_t *b);
 
 #endif

@@ -1203,7 +1203,7 @@ static void rows_system(void) {
   ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, one_exchange, one_allgather, NULL, NULL));
   ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, NULL, one_allgather, NULL, &s));
   ROW(MFREE_ERR_NULL, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, one_exchange, NULL, NULL, &s));
-  /* a Galerkin assembler */
+  /* a Galerkin assembler on nodal quadrature */
   ROW(MFREE_ERR_UNSUPPORTED, mfree_system_create_elastodynamic_ranks(F.ctx, F.as, 1.0, one_exchange, one_allgather, NULL, &s));
   {
     /* the fluid on ranks (one rank: the callbacks of one process) */

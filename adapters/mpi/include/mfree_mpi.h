@@ -482,8 +482,8 @@ MFREE_MPI_API mfree_status_t mfree_halo_allgather(void *halo, const double *in, 
  * particles in its order (n_owned owned, then the n_ghost ghosts, with the plan's global
  * ids: mfree_halo_get_global_ids).
  * @param[in]  halo     a set-up plan
- * @param[in]  as       a set-up collocation assembler over the plan's particles (kept
- *                      alive), or NULL (every rank then fails)
+ * @param[in]  as       a set-up collocation or Galerkin stiffness assembler over the
+ *                      plan's particles (kept alive), or NULL (every rank then fails)
  * @param[in]  density  rho > 0, the same on every rank
  * @param[out] sys      the new system
  * @return as mfree_system_create_elastodynamic_ranks; MFREE_ERR_NULL (local) for a NULL

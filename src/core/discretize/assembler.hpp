@@ -80,6 +80,13 @@ class Assembler {
   double poisson() const { return poisson_; }
   double coefficient() const { return coef_; }
   const ParticleSet &particles() const { return *ps_; }
+  // For a Galerkin system on ranks: why its owned rows would not be those of one rank
+  // (nullptr when they are): nodal quadrature (its points are the set's non-ghosts, which
+  // on ranks must include the ghosts within a support radius), the FE layer, consistent
+  // integration. And the mass of the same approximants on the same quadrature points
+  // (form MFREE_FORM_MASS or _LUMPED, coefficient coef), set up.
+  const char *ranks_obstacle() const;
+  std::unique_ptr<Assembler> mass_on_same_points(int form, double coef) const;
 
  private:
   struct PointSet {  // boundary points with weights

@@ -201,6 +201,29 @@ void Assembler::quadrature_order() {
   }
 }
 
+const char *Assembler::ranks_obstacle() const {
+  if (quad_kind_ == 0)
+    return "nodal quadrature: its points are the particle set's non-ghosts, and on ranks those must include the "
+           "ghosts within one support radius of the owned particles, which the system's state (the owned "
+           "particles) cannot tell apart; give the quadrature points within one support radius of the owned "
+           "particles, in the global order of the points (mfree_assembler_set_quadrature_points)";
+  if (fe_.npe()) return "an FE layer (its elements are not distributed)";
+  for (const auto &s : psets_)
+    if (s->kind == 5) return "consistent integration (its boundary correction is not distributed)";
+  return nullptr;
+}
+
+std::unique_ptr<Assembler> Assembler::mass_on_same_points(int form, double coef) const {
+  auto m = std::make_unique<Assembler>(ps_, trial_cfg_, test_cfg_, bubnov_, form);
+  m->set_coefficient(coef);
+  m->quad_kind_ = quad_kind_;
+  m->qx_ = qx_;
+  m->qw_ = qw_;
+  const Report rep = m->setup();
+  if (!rep.ok()) throw Error(MFREE_ERR_INPUT, "the mass on the stiffness's quadrature points: " + rep.message);
+  return m;
+}
+
 void Assembler::set_consistent_integration(int32_t npts, const double *x, int layout, int64_t ld,
                                            const double *w, const double *normals) {
   if (collocation() || mass())

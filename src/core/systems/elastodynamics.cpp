@@ -132,24 +132,28 @@ void ElasticSystem::factor_boundary(int32_t nb, const std::vector<Eigen::Triplet
 void ElasticSystem::init_galerkin_mass(const Assembler *mass) {
   SparseMatrix Ms;
   mass->assemble_matrix(Ms);
+  // the free unknowns: the owned ones whose rows the essential conditions did not replace
+  const auto &kinds = as_->row_kinds();
   fpos_.assign(nd_, -1);
   for (int32_t d = 0; d < nd_; ++d)
-    if (bpos_[d] < 0) {
+    if (kinds[d] == 0) {
       fpos_[d] = static_cast<int32_t>(fdofs_.size());
       fdofs_.push_back(d);
     }
   const int32_t nf = static_cast<int32_t>(fdofs_.size());
   // M_ff: the scalar mass m_JK on every component, couplings to constrained unknowns
-  // dropped (exact when the constrained values do not accelerate, or the mass is lumped)
+  // dropped (exact when the constrained values do not accelerate, or the mass is lumped);
+  // the owned rows (on ranks the mass is lumped: no column leaves them)
   std::vector<Eigen::Triplet<double>> trip;
   lumped_ = mass->form() == MFREE_FORM_MASS_LUMPED;
-  const int32_t n = as_->particles().size();
+  const int32_t n = as_->particles().num_owned();
   for (int32_t J = 0; J < n; ++J)
     for (int64_t k = Ms.rowptr()[J]; k < Ms.rowptr()[J + 1]; ++k) {
       const int32_t K = Ms.colidx()[k];
       const double m = Ms.values()[k];
       if (m == 0.0) continue;
       if (K != J) lumped_ = false;
+      if (K >= n) continue;
       for (int a = 0; a < nc_; ++a) {
         const int32_t p = fpos_[J * nc_ + a], q = fpos_[K * nc_ + a];
         if (p >= 0 && q >= 0) trip.emplace_back(p, q, m);
@@ -157,8 +161,9 @@ void ElasticSystem::init_galerkin_mass(const Assembler *mass) {
     }
   Mff_.resize(nf, nf);
   Mff_.setFromTriplets(trip.begin(), trip.end());
+  // (a rank may own no free unknown: Eigen's norm wants a non-empty matrix)
   const Eigen::SparseMatrix<double> asym = Mff_ - Eigen::SparseMatrix<double>(Mff_.transpose());
-  if (asym.norm() > 1e-12 * Mff_.norm())
+  if (nf > 0 && asym.norm() > 1e-12 * Mff_.norm())
     throw Error(MFREE_ERR_UNSUPPORTED, "the mass matrix is not symmetric (Petrov-Galerkin): use a Bubnov mass");
   if (lumped_) {
     minv_.assign(nf, 0.0);

@@ -2,9 +2,9 @@
 // Navier(u) + b at interior particles, boundary rows (tractions, displacements) kept as
 // algebraic constraints, solved for the boundary unknowns at every evaluation; or by
 // Galerkin: M u'' = g(t) f - K u with K and M from two assemblers (any approximant).
-// Collocation also on ranks (elastodynamics_ranks.cpp): owned particles plus ghosts, the
-// ghosts' displacements exchanged and the boundary unknowns solved in global-id order on
-// every rank at each evaluation.
+// Both on ranks (elastodynamics_ranks.cpp): owned particles plus ghosts, the ghosts'
+// displacements exchanged and the boundary unknowns solved in global-id order on every
+// rank at each evaluation; Galerkin there with the lumped mass.
 #pragma once
 
 #include <Eigen/SparseCholesky>
@@ -29,10 +29,11 @@ class ElasticSystem : public System {
   // MFREE_FORM_MASS_LUMPED, coefficient = density) on the same particles.
   ElasticSystem(const Assembler *stiffness, const Assembler *mass);
 
-  // On ranks: a set-up collocation assembler over this rank's owned particles and ghosts
-  // (global ids required). Collective: every rank throws the same Error when one rank
-  // fails (as may be NULL: that rank fails) or the ranks disagree on the density, the
-  // form or its coefficients.
+  // On ranks: a set-up collocation assembler, or a Galerkin stiffness assembler on host
+  // quadrature points (the lumped mass of density rho on the same points), over this
+  // rank's owned particles and ghosts (global ids required). Collective: every rank
+  // throws the same Error when one rank fails (as may be NULL: that rank fails) or the
+  // ranks disagree on the density, the form or its coefficients.
   static std::unique_ptr<ElasticSystem> on_ranks(const Assembler *as, double density, const Collective &coll);
 
   void set_load_history(double (*fn)(void *, double), void *user);
@@ -66,6 +67,8 @@ class ElasticSystem : public System {
   void init_operator();
   void init_boundary();
   void init_ranks();
+  void sort_rows();  // on ranks: K_'s rows in global-id order of their columns
+  int64_t key(int32_t d) const;  // on ranks: unknown d's (global id, component) as one key
   // lu_ = the factorised block K_bb of nb boundary unknowns (its entries as triplets)
   void factor_boundary(int32_t nb, const std::vector<Eigen::Triplet<double>> &trip);
   double local_spacing(int32_t nrows) const;

@@ -1,4 +1,4 @@
-// Collocation elastodynamics on ranks: each rank holds its owned particles and their
+// Elastodynamics on ranks: each rank holds its owned particles and their
 // ghosts; the interior rows of its owned particles need the ghosts' displacements (one
 // halo exchange per evaluation), and the boundary rows determine the boundary unknowns
 // through a block that may couple particles of several ranks. That block is gathered
@@ -8,6 +8,10 @@
 // same order whatever the partition, so the owned particles' results are bitwise those
 // of one rank. The boundary is a lower-dimensional set: the gather and the solve grow
 // with it, not with the particles.
+// Galerkin on ranks is the same system with K, f and the lumped mass from the assembler,
+// whose owned rows are bitwise the one-rank rows when its quadrature points are the
+// host's, given in the global order (nodal quadrature is refused: its points are the
+// set's non-ghosts). The lumped mass keeps every unknown's acceleration local.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -25,17 +29,61 @@ ElasticSystem::ElasticSystem(const Assembler *as, double density, const Collecti
     : as_(as), rho_(density), coll_(coll) {
   if (!as->is_setup()) throw Error(MFREE_ERR_STATE, "the assembler is not set up");
   const int form = as->form();
-  if (form != MFREE_FORM_COLLOCATION_LAPLACE && form != MFREE_FORM_COLLOCATION_PLANE_STRESS &&
+  galerkin_ = form == MFREE_FORM_LAPLACE || form == MFREE_FORM_ELASTICITY_PLANE_STRESS ||
+              form == MFREE_FORM_ELASTICITY_PLANE_STRAIN || form == MFREE_FORM_ELASTICITY_3D;
+  if (!galerkin_ && form != MFREE_FORM_COLLOCATION_LAPLACE && form != MFREE_FORM_COLLOCATION_PLANE_STRESS &&
       form != MFREE_FORM_COLLOCATION_PLANE_STRAIN)
     throw Error(MFREE_ERR_UNSUPPORTED, "elastodynamics on ranks needs a collocation assembler (Laplace form for the "
-                                       "1D bar, or a plane collocation form); Galerkin systems run on one process");
+                                       "1D bar, or a plane collocation form) or a Galerkin stiffness assembler "
+                                       "(Laplace or elasticity form)");
+  if (galerkin_) {
+    if (as->ndofs() != as->particles().size() * as->ncomp())
+      throw Error(MFREE_ERR_UNSUPPORTED, "Lagrange multipliers are not supported in elastodynamics: impose "
+                                         "essential conditions by penalty, Nitsche or node rows");
+    if (const char *why = as->ranks_obstacle())
+      throw Error(MFREE_ERR_UNSUPPORTED, std::string("Galerkin elastodynamics on ranks does not take ") + why);
+  }
   if (!(std::isfinite(density) && density > 0.0)) throw Error(MFREE_ERR_ARG, "density must be finite and > 0");
   if (!as->particles().has_global_ids())
     throw Error(MFREE_ERR_STATE, "on ranks the particle set needs global ids (mfree_particles_set_global_ids): "
                                  "they order the boundary unknowns");
   ranks_ = true;
   init_operator();
-  dx_min_ = local_spacing(as->particles().num_owned());
+  sort_rows();
+  if (!galerkin_) {
+    dx_min_ = local_spacing(as->particles().num_owned());
+    return;
+  }
+  // The lumped mass (rows summed: the mass is local to each unknown) of the stiffness's
+  // approximants on its quadrature points. A consistent mass couples every unknown through
+  // its inverse at each evaluation, a solve over all ranks whose sums would follow the
+  // partition: it runs on one process.
+  init_galerkin_mass(as->mass_on_same_points(MFREE_FORM_MASS_LUMPED, density).get());
+}
+
+// Each row's entries in global-id order of their columns (the assembler's are in local
+// order, which depends on the partition): every sum over a row then runs in one order.
+// (K_ is used through its arrays only; its rows are not sorted by local column.)
+int64_t ElasticSystem::key(int32_t d) const {
+  return as_->particles().global_ids()[d / nc_] * nc_ + d % nc_;
+}
+
+void ElasticSystem::sort_rows() {
+  std::vector<int64_t> rp(K_.rowptr());
+  std::vector<int32_t> ci(K_.colidx());
+  std::vector<double> va(K_.values());
+  std::vector<std::pair<int64_t, int64_t>> row;
+  for (int32_t d = 0; d < K_.rows(); ++d) {
+    row.clear();
+    for (int64_t k = rp[d]; k < rp[d + 1]; ++k) row.emplace_back(key(K_.colidx()[k]), k);
+    std::sort(row.begin(), row.end());
+    for (size_t q = 0; q < row.size(); ++q) {
+      ci[rp[d] + q] = K_.colidx()[row[q].second];
+      va[rp[d] + q] = K_.values()[row[q].second];
+    }
+  }
+  K_.set_pattern(K_.rows(), K_.cols(), std::move(rp), std::move(ci));
+  K_.values_mut() = std::move(va);
 }
 
 std::unique_ptr<ElasticSystem> ElasticSystem::on_ranks(const Assembler *as, double density, const Collective &coll) {
@@ -61,7 +109,7 @@ std::unique_ptr<ElasticSystem> ElasticSystem::on_ranks(const Assembler *as, doub
     v[kPoisson] = as->poisson();
     v[kComp] = as->ncomp();
     v[kDim] = as->particles().dim();
-    v[kSpacing] = sys->dx_min_;
+    v[kSpacing] = sys->galerkin_ ? sys->limit_ : sys->dx_min_;
   }
   const std::vector<double> all = coll.allgather(v, kN);
   const size_t np = all.size() / kN;
@@ -83,38 +131,21 @@ std::unique_ptr<ElasticSystem> ElasticSystem::on_ranks(const Assembler *as, doub
     spacing = std::min(spacing, all[kN * p + kSpacing]);  // a minimum: exact in any order
   }
   // 2. the boundary block of all ranks (identical data on every rank: a failure here is
-  // every rank's)
-  sys->dx_min_ = spacing;
-  sys->limit_ = spacing / sys->c_;
+  // every rank's). Galerkin: the step limit 2 / omega_max is a minimum over ranks too
+  // (2 / sqrt of the largest Gershgorin bound: a monotone function of one rank's bound).
+  if (sys->galerkin_) {
+    sys->limit_ = spacing;
+    sys->dx_min_ = spacing * sys->c_;
+  } else {
+    sys->dx_min_ = spacing;
+    sys->limit_ = spacing / sys->c_;
+  }
   sys->init_ranks();
   return sys;
 }
 
 void ElasticSystem::init_ranks() {
-  const ParticleSet &ps = as_->particles();
-  const int64_t *gid = ps.global_ids();
   const auto &kinds = as_->row_kinds();
-  auto key = [&](int32_t d) { return gid[d / nc_] * nc_ + d % nc_; };
-  // Each row's entries in global-id order of their columns (the assembler's are in local
-  // order, which depends on the partition): every sum over a row then runs in one order.
-  // (K_ is used through its arrays only; its rows are not sorted by local column.)
-  {
-    std::vector<int64_t> rp(K_.rowptr());
-    std::vector<int32_t> ci(K_.colidx());
-    std::vector<double> va(K_.values());
-    std::vector<std::pair<int64_t, int64_t>> row;
-    for (int32_t d = 0; d < K_.rows(); ++d) {
-      row.clear();
-      for (int64_t k = rp[d]; k < rp[d + 1]; ++k) row.emplace_back(key(K_.colidx()[k]), k);
-      std::sort(row.begin(), row.end());
-      for (size_t q = 0; q < row.size(); ++q) {
-        ci[rp[d] + q] = K_.colidx()[row[q].second];
-        va[rp[d] + q] = K_.values()[row[q].second];
-      }
-    }
-    K_.set_pattern(K_.rows(), K_.cols(), std::move(rp), std::move(ci));
-    K_.values_mut() = std::move(va);
-  }
   own_b_.clear();
   for (int32_t d = 0; d < nd_; ++d)
     if (kinds[d] != 0) own_b_.push_back(d);
