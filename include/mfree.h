@@ -2179,6 +2179,96 @@ MFREE_API mfree_status_t mfree_system_create_fluid_ranks(
     const int64_t *global_ids, double width, mfree_exchange_fn exchange,
     mfree_allgather_fn allgather, void *user, mfree_system_t **sys);
 
+/**
+ * Ghost-layer rebuild for the fluid on ranks (mfree_system_set_halo_rebuild): set the
+ * host's halo up again around this rank's owned particles at their current positions, so
+ * that the ghosts hold every particle within width of them, and give the new ghosts'
+ * global ids. Collective over the system's ranks (every rank calls it at the same
+ * point); afterwards the system's exchange callback serves the new ghosts. libmfree_mpi's
+ * mfree_halo_rebuild_callback does this for a halo plan.
+ * @param[in]  user        the pointer given at the system's creation
+ * @param[in]  n_owned     owned particles on this rank (>= 0)
+ * @param[in]  x           their positions, AoS, particle i's at x[i*ld, i*ld + dim)
+ * @param[in]  ld          leading dimension (the dimension)
+ * @param[in]  global_ids  their n_owned global ids, in the order the host's halo must list
+ *                         its owned items
+ * @param[in]  width       the depth of the layer (the system's width)
+ * @param[out] n_ghost     the new ghosts' count
+ * @param[out] all_ids     n_owned + n_ghost global ids (the owned ones first, as given,
+ *                         then the ghosts in the order of the host's exchange), borrowed:
+ *                         read before the host's next callback returns
+ * @return MFREE_SUCCESS, or a failure status that every rank returns alike
+ */
+typedef mfree_status_t (*mfree_halo_rebuild_fn)(void *user, int32_t n_owned, const double *x,
+                                                int64_t ld, const int64_t *global_ids,
+                                                double width, int32_t *n_ghost,
+                                                const int64_t **all_ids);
+
+/**
+ * Let a fluid on ranks (mfree_system_create_fluid_ranks) rebuild its ghosts as particles
+ * move: when a right-hand side or a native step finds the ghost layer no longer deep
+ * enough (see mfree_system_create_fluid_ranks), every rank calls rebuild (with the
+ * system's user pointer) around its owned particles' current positions, re-seats the
+ * system on the new ghosts (their rest densities and masses by one exchange) and
+ * evaluates again, so that the run goes on with the results it would have had on one
+ * rank, bitwise. Without a rebuild callback (the default, or rebuild = NULL) such an
+ * evaluation returns MFREE_ERR_HALO. Not collective, but every rank sets the same.
+ * libmfree_mpi's mfree_halo_create_fluid sets its own. A rebuild that fails (a failing
+ * callback, ids that change an owned item, repeat or are negative) is returned by every
+ * rank, and the system then returns MFREE_ERR_STATE from every evaluation (its ghosts
+ * no longer match the host's halo: create it again).
+ * @param[in] sys      a fluid on ranks
+ * @param[in] rebuild  the host's rebuild, or NULL (none)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL system; MFREE_ERR_UNSUPPORTED if sys is not a
+ *         fluid on ranks
+ */
+MFREE_API mfree_status_t mfree_system_set_halo_rebuild(mfree_system_t *sys,
+                                                       mfree_halo_rebuild_fn rebuild);
+
+/**
+ * Particle move for mfree_system_move_particles: send this rank's owned records to their
+ * new owners and receive the records of the n_new particles this rank owns afterwards.
+ * Collective. A record is nrec doubles whose bytes must arrive unchanged: the position
+ * (dim values) first, then data of the system's own (state, rest density, mass, global
+ * id as bits).
+ * @param[in]     user     the move_user pointer of mfree_system_move_particles
+ * @param[in]     nrec     doubles per record
+ * @param[in]     n_owned  records given (this rank's owned particles)
+ * @param[in,out] records  max(n_owned, n_new) records: n_owned in, n_new out (any order)
+ * @param[in]     n_new    records this rank receives and keeps
+ * @return MFREE_SUCCESS, or a failure status that every rank returns alike (nothing moved)
+ */
+typedef mfree_status_t (*mfree_particles_move_fn)(void *user, int32_t nrec, int32_t n_owned,
+                                                  double *records, int32_t n_new);
+
+/**
+ * Move a fluid on ranks' owned particles to other ranks: the particles' records (the
+ * state from y, rest density, mass, global id) go through the host's move, the system's
+ * rebuild callback (mfree_system_set_halo_rebuild, required) sets the halo up around the
+ * n_new particles that arrived, and the system is re-seated on them, every option kept.
+ * y then holds the new owned particles' state in the order of the records move left
+ * (neq = (2 dim + 1) n_new; mfree_system_get_size): a host integrating with its own
+ * vectors re-creates them with the new length (SUNDIALS: a new vector and ARKODE's
+ * ReInit). Collective; the checks come first and are agreed (nothing moved when one rank
+ * fails them). libmfree_mpi's mfree_halo_migrate_fluid calls it with Zoltan's partition.
+ * @param[in]     sys        a fluid on ranks with a rebuild callback
+ * @param[in]     n_new      the particles this rank owns after the move (>= 0)
+ * @param[in]     move       the host's move (NULL: MFREE_ERR_NULL on every rank)
+ * @param[in]     move_user  passed to move
+ * @param[in,out] y          this rank's state ((2 dim + 1) n_owned doubles) in, the new
+ *                           one out
+ * @param[in]     capacity   doubles y holds (>= (2 dim + 1) n_new)
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG (n_new < 0, a capacity below
+ *         the new state), MFREE_ERR_NULL, MFREE_ERR_STATE (no rebuild callback, masses not
+ *         set, a system whose rebuild failed), the move's or the rebuild's failure (a failed
+ *         move leaves the system and y as they were; a failed rebuild, the system unusable);
+ *         MFREE_ERR_NULL (local) for a NULL system, MFREE_ERR_UNSUPPORTED (local) if it is not a
+ *         fluid on ranks
+ */
+MFREE_API mfree_status_t mfree_system_move_particles(mfree_system_t *sys, int32_t n_new,
+                                                     mfree_particles_move_fn move, void *move_user,
+                                                     double *y, int64_t capacity);
+
 #ifdef __cplusplus
 }
 #endif

@@ -414,4 +414,20 @@ mfree_status_t mfree_system_create_fluid_ranks(mfree_context_t *ctx, int32_t dim
   });
 }
 
+mfree_status_t mfree_system_set_halo_rebuild(mfree_system_t *sys, mfree_halo_rebuild_fn rebuild) {
+  return mfree::with_handle(sys, "mfree_system_set_halo_rebuild", [&](mfree::System &base) {
+    kind<mfree::FluidRanks>(base, "halo rebuild (not a fluid on ranks)").set_rebuild(rebuild);
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_move_particles(mfree_system_t *sys, int32_t n_new, mfree_particles_move_fn move,
+                                           void *move_user, double *y, int64_t capacity) {
+  return mfree::with_handle(sys, "mfree_system_move_particles", [&](mfree::System &base) {
+    kind<mfree::FluidRanks>(base, "particle move (not a fluid on ranks)")
+        .move_particles(n_new, move, move_user, y, capacity);
+    return MFREE_SUCCESS;
+  });
+}
+
 }  // extern "C"

@@ -509,6 +509,61 @@ MFREE_MPI_API mfree_status_t mfree_halo_create_elastodynamic(mfree_halo_t *halo,
 MFREE_MPI_API mfree_status_t mfree_halo_create_fluid(mfree_halo_t *halo, int32_t dim, double width,
                                                      mfree_system_t **sys);
 
+/**
+ * mfree_halo_setup as an mfree_halo_rebuild_fn (mfree_system_set_halo_rebuild), for a
+ * fluid on ranks created over this plan with mfree_system_create_fluid_ranks
+ * (mfree_halo_create_fluid registers it itself): the plan set up again around the given
+ * owned particles and ids with the system's width. Collective.
+ * @param[in]  halo        the plan (an mfree_halo_t *)
+ * @param[in]  n_owned     owned particles
+ * @param[in]  x           their positions, AoS
+ * @param[in]  ld          leading dimension
+ * @param[in]  global_ids  their global ids
+ * @param[in]  width       the halo width
+ * @param[out] n_ghost     the plan's new ghost count
+ * @param[out] all_ids     the plan's global ids (owned, then ghosts), borrowed until its
+ *                         next setup
+ * @return as mfree_halo_setup: the same status on every rank
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_rebuild_callback(void *halo, int32_t n_owned, const double *x,
+                                                         int64_t ld, const int64_t *global_ids, double width,
+                                                         int32_t *n_ghost, const int64_t **all_ids);
+
+/**
+ * Migrate a fluid on ranks between integration windows: Zoltan's partition of the owned
+ * particles' positions (migration's partitioner; rebalance as in mfree_migration_partition)
+ * chooses their owners, and the particles move there with their state (from y), rest
+ * densities, masses and global ids (mfree_system_move_particles); the plan is set up again
+ * around the new owned particles with the system's width, and the system re-seated on
+ * them, every option kept. Ghosts are also rebuilt during an integration when particles
+ * move too far (mfree_system_set_halo_rebuild), so migration is needed only for the
+ * balance of the counts and the size of the halo. Afterwards y holds this rank's new state
+ * ((2 dim + 1) n_new doubles: *neq), the owned particles in the order of
+ * mfree_migration_execute (those kept, then those received), the plan's global ids
+ * (mfree_halo_get_global_ids) name them; the results of the run stay bitwise those of
+ * one rank. A host integrating with its own vectors re-creates them with the new length
+ * (SUNDIALS: mfree_sundials_mpi_create_vector and ERKStepReInit, or a new integrator).
+ * The plan's registered fields are cleared. Collective.
+ * @param[in]     halo       the plan the system was created over (mfree_halo_create_fluid)
+ * @param[in]     migration  a migration plan on the same ranks
+ * @param[in]     sys        the fluid on ranks
+ * @param[in]     rebalance  1: new regions; 0: the last regions (as mfree_migration_partition)
+ * @param[in,out] y          this rank's state in ((2 dim + 1) n_owned doubles), the new one out
+ * @param[in]     capacity   doubles y holds
+ * @param[out]    neq        the new state's length (set also when capacity is too small)
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG ("capacity C is below the N
+ *         doubles of this rank's state after the move": nothing moved, grow y to *neq and
+ *         call again; a system that is not a fluid over this plan; the partition's
+ *         argument failures), MFREE_ERR_NULL (a NULL system, neq, or y with owned
+ *         particles), MFREE_ERR_STATE (a plan that is not set up), the partition's,
+ *         the migration's and the halo setup's failures (after a failed halo setup the
+ *         system returns MFREE_ERR_STATE: create it again); MFREE_ERR_NULL (local) for a
+ *         NULL plan
+ */
+MFREE_MPI_API mfree_status_t mfree_halo_migrate_fluid(mfree_halo_t *halo, mfree_migration_t *migration,
+                                                      mfree_system_t *sys, int32_t rebalance, double *y,
+                                                      int64_t capacity, int64_t *neq);
+
 #ifdef __cplusplus
 }
 #endif

@@ -155,6 +155,8 @@ struct Pending {
 // halo.cpp: a plan's pending failure, taken (MFREE_SUCCESS when none), for the
 // collective calls outside halo.cpp (the all-gather of systems on ranks).
 mfree_status_t take_pending(mfree_halo_t *h, std::string &msg) noexcept;
+// halo.cpp: a set-up plan's global ids (owned, then ghosts), borrowed until its next setup.
+const int64_t *halo_ids(const mfree_halo_t *h) noexcept;
 
 }  // namespace mfree_mpi_detail
 

@@ -470,6 +470,8 @@ mfree_status_t mfree_mpi_detail::take_pending(mfree_halo_t *h, std::string &msg)
   return l.st;
 }
 
+const int64_t *mfree_mpi_detail::halo_ids(const mfree_halo_t *h) noexcept { return h->ids.data(); }
+
 extern "C" mfree_status_t mfree_halo_get_communicator(const mfree_halo_t *h, MPI_Comm *comm) {
   if (!h || !comm) return MFREE_ERR_NULL;
   *comm = h->comm;

@@ -16,6 +16,18 @@ mfree_status_t fail(mfree_context_t *ctx, mfree_status_t st, const char *msg) {
   return mfree_context_set_error(ctx, st, text);
 }
 
+// mfree_particles_move_fn over a migration plan that has partitioned: the records
+// travel as one registered field.
+mfree_status_t move_records(void *migration, int32_t nrec, int32_t n_owned, double *records, int32_t n_new) {
+  mfree_migration_t *m = static_cast<mfree_migration_t *>(migration);
+  const int64_t bytes = static_cast<int64_t>(nrec) * static_cast<int64_t>(sizeof(double));
+  mfree_migration_clear_fields(m);
+  mfree_status_t st = mfree_migration_add_field(m, records, bytes, bytes);
+  if (st == MFREE_SUCCESS) st = mfree_migration_execute(m, n_owned > n_new ? n_owned : n_new);
+  mfree_migration_clear_fields(m);
+  return st;
+}
+
 }  // namespace
 
 extern "C" {
@@ -102,8 +114,68 @@ mfree_status_t mfree_halo_create_fluid(mfree_halo_t *halo, int32_t dim, double w
     st = mfree_halo_get_global_ids(halo, ids.data());
   }
   if (st != MFREE_SUCCESS) return st;
-  return mfree_system_create_fluid_ranks(ctx, dim, n_owned, n_ghost, ids.data(), width, mfree_halo_exchange_callback,
-                                         mfree_halo_allgather, halo, sys);
+  st = mfree_system_create_fluid_ranks(ctx, dim, n_owned, n_ghost, ids.data(), width, mfree_halo_exchange_callback,
+                                       mfree_halo_allgather, halo, sys);
+  // (on every rank alike: creation is agreed)
+  if (st == MFREE_SUCCESS) st = mfree_system_set_halo_rebuild(*sys, mfree_halo_rebuild_callback);
+  return st;
+}
+
+mfree_status_t mfree_halo_rebuild_callback(void *halo, int32_t n_owned, const double *x, int64_t ld,
+                                           const int64_t *global_ids, double width, int32_t *n_ghost,
+                                           const int64_t **all_ids) {
+  mfree_halo_t *h = static_cast<mfree_halo_t *>(halo);
+  const mfree_status_t st = mfree_halo_setup(h, n_owned, x, ld, global_ids, width);
+  if (st != MFREE_SUCCESS) return st;
+  if (!n_ghost || !all_ids) return MFREE_ERR_NULL;
+  mfree_halo_get_size(h, nullptr, n_ghost);
+  *all_ids = mfree_mpi_detail::halo_ids(h);
+  return MFREE_SUCCESS;
+}
+
+mfree_status_t mfree_halo_migrate_fluid(mfree_halo_t *halo, mfree_migration_t *migration, mfree_system_t *sys,
+                                        int32_t rebalance, double *y, int64_t capacity, int64_t *neq) {
+  mfree_context_t *ctx = nullptr, *mctx = nullptr;
+  if (mfree_halo_get_context(halo, &ctx) != MFREE_SUCCESS ||
+      mfree_migration_get_context(migration, &mctx) != MFREE_SUCCESS)
+    return MFREE_ERR_NULL;
+  // this rank's checks, handed to the partition so that every rank returns their outcome
+  int32_t dim = 0, n_owned = 0, sys_neq = 0;
+  char msg[300] = "";
+  mfree_status_t bad = MFREE_SUCCESS;
+  if (!sys || !neq) {
+    bad = MFREE_ERR_NULL;
+    std::snprintf(msg, sizeof msg, "mfree_halo_migrate_fluid: %s is NULL", !sys ? "the system" : "neq");
+  } else if (mfree_halo_get_size(halo, &n_owned, nullptr) != MFREE_SUCCESS) {
+    bad = MFREE_ERR_STATE;
+    std::snprintf(msg, sizeof msg, "mfree_halo_migrate_fluid: the halo plan is not set up");
+  } else if (mfree_system_get_dimension(sys, &dim, nullptr) != MFREE_SUCCESS ||
+             mfree_system_get_size(sys, &sys_neq) != MFREE_SUCCESS ||
+             static_cast<int64_t>(sys_neq) != static_cast<int64_t>(2 * dim + 1) * n_owned) {
+    bad = MFREE_ERR_ARG;
+    std::snprintf(msg, sizeof msg,
+                  "mfree_halo_migrate_fluid: the system is not a fluid over this plan's %d owned particles",
+                  static_cast<int>(n_owned));
+  } else if (!y && n_owned > 0) {
+    bad = MFREE_ERR_NULL;
+    std::snprintf(msg, sizeof msg, "mfree_halo_migrate_fluid: y is NULL");
+  }
+  if (bad != MFREE_SUCCESS) {
+    mfree_context_set_error(mctx, bad, msg);
+    mfree_migration_set_pending_error(migration);
+    n_owned = 0;  // (the partition reads nothing then)
+  }
+  int32_t n_new = 0;
+  mfree_status_t st = mfree_migration_partition(migration, n_owned, y, dim > 0 ? dim : 1, rebalance, &n_new);
+  if (st != MFREE_SUCCESS) {
+    // (the partition's message is on the plan's context; the host reads the halo's)
+    char m[600] = "";
+    mfree_context_get_last_error(mctx, nullptr, m, sizeof m);
+    if (mctx != ctx) mfree_context_set_error(ctx, st, m);
+    return st;
+  }
+  *neq = static_cast<int64_t>(2 * dim + 1) * n_new;
+  return mfree_system_move_particles(sys, n_new, move_records, migration, y, capacity);
 }
 
 }  // extern "C"

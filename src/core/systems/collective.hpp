@@ -28,6 +28,8 @@ class Collective {
   void allgather(const double *in, int64_t n, double *out, int64_t total) const;
   // The number of ranks (one gather, the first time).
   int size() const;
+  // The pointer the host gave with the callbacks (for its other callbacks).
+  void *user() const { return user_; }
   // The agreed outcome: the lowest rank holding an error (negative status) or, without
   // one, the lowest rank holding a failure (positive status); its status and "rank R:
   // <its message>". statuses: every rank's status, in rank order; mine: this rank's.

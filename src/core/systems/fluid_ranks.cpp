@@ -56,6 +56,10 @@ FluidRanks::FluidRanks(int dim, int32_t n_owned, int32_t n_ghost, const int64_t 
       width_(width) {
   if (!(std::isfinite(width) && width > 0.0))
     throw Error(MFREE_ERR_ARG, "the halo width must be finite and > 0, not " + std::to_string(width));
+  number(ids);
+}
+
+void FluidRanks::number(const int64_t *ids) {
   const int32_t n = size();
   if (n > 0 && !ids) throw Error(MFREE_ERR_NULL, "global ids are NULL");
   std::vector<int32_t> order(n);
@@ -77,8 +81,8 @@ FluidRanks::FluidRanks(int dim, int32_t n_owned, int32_t n_ghost, const int64_t 
     node_[order[q]] = q;
     gid_[q] = ids[order[q]];
   }
-  owned_.resize(n_owned);
-  for (int32_t p = 0; p < n_owned; ++p) {
+  owned_.resize(n_own_);
+  for (int32_t p = 0; p < n_own_; ++p) {
     owned_[p] = node_[p];
     is_owned_[node_[p]] = 1;
   }
@@ -302,32 +306,40 @@ Report FluidRanks::named(Report r) const {
 
 Report FluidRanks::rhs(double t, const double *y, double *ydot) {
   (void)t;
+  check_usable();
   const int D = dim();
-  const int32_t n = size();
-  load(y);
-  rate_n_.resize(static_cast<size_t>(D) * n);
-  vh_n_.resize(static_cast<size_t>(D) * n);
-  dr_n_.resize(n);
-  double vals[2] = {INFINITY, INFINITY};
-  const Report mine = guarded([&] {
-    Report r = prepare_accel(ys_.data(), false, rate_n_.data(), vals[0], vals[1]);
-    const size_t nd = static_cast<size_t>(D) * n;
-    if (r.ok()) kinematics(ys_.data() + nd, ys_.data() + 2 * nd, vh_n_.data(), dr_n_.data());
-    return r;
-  });
-  const Report agreed = agree_min(mine, vals, 2);
-  if (!agreed.ok()) return agreed;
-  check_reach(vals[1], 0);
-  const size_t no = static_cast<size_t>(D) * n_own_;
-  for (int32_t p = 0; p < n_own_; ++p) {
-    const size_t k = owned_[p];
-    for (int c = 0; c < D; ++c) {
-      ydot[p * D + c] = vh_n_[k * D + c];
-      ydot[no + p * D + c] = rate_n_[k * D + c];
+  // (a second pass on the ghosts the host rebuilt when the layer was too shallow)
+  for (int pass = 0;; ++pass) {
+    const int32_t n = size();
+    load(y);
+    rate_n_.resize(static_cast<size_t>(D) * n);
+    vh_n_.resize(static_cast<size_t>(D) * n);
+    dr_n_.resize(n);
+    double vals[2] = {INFINITY, INFINITY};
+    const Report mine = guarded([&] {
+      Report r = prepare_accel(ys_.data(), false, rate_n_.data(), vals[0], vals[1]);
+      const size_t nd = static_cast<size_t>(D) * n;
+      if (r.ok()) kinematics(ys_.data() + nd, ys_.data() + 2 * nd, vh_n_.data(), dr_n_.data());
+      return r;
+    });
+    const Report agreed = agree_min(mine, vals, 2);
+    if (!agreed.ok()) return agreed;
+    if (-vals[1] > width_ && rebuild_ && pass == 0) {
+      rebuild_halo(y);
+      continue;
     }
-    ydot[2 * no + p] = dr_n_[k];
+    check_reach(vals[1], 0);
+    const size_t no = static_cast<size_t>(D) * n_own_;
+    for (int32_t p = 0; p < n_own_; ++p) {
+      const size_t k = owned_[p];
+      for (int c = 0; c < D; ++c) {
+        ydot[p * D + c] = vh_n_[k * D + c];
+        ydot[no + p * D + c] = rate_n_[k * D + c];
+      }
+      ydot[2 * no + p] = dr_n_[k];
+    }
+    return agreed;
   }
-  return agreed;
 }
 
 // The predictor-corrector's step dt from the node state ys_ (its tables, accelerations
@@ -431,23 +443,37 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
           throw Error(MFREE_ERR_ARG, s.str());
         }
   }
+  check_usable();
   const int D = dim();
-  const int32_t n = size();
-  const size_t nd = static_cast<size_t>(D) * n;
-  load(y);
-  yn_.resize(ys_.size());
-  rate_n_.resize(nd);
-  vh_n_.resize(nd);
-  dr_n_.resize(n);
+  // node arrays for the current nodes (again after a rebuild of the ghosts)
+  auto seat = [&] {
+    load(y);
+    yn_.resize(ys_.size());
+    rate_n_.resize(static_cast<size_t>(D) * size());
+    vh_n_.resize(static_cast<size_t>(D) * size());
+    dr_n_.resize(size());
+  };
+  seat();
   auto failed = [&](Report r, int64_t step) {
     r.message = "step " + std::to_string(step) + ": " + r.message;
     return r;
   };
+  bool rebuilt = false;
   while (t < t_end) {
+    const int32_t n = size();
+    const size_t nd = static_cast<size_t>(D) * n;
     double vals[2] = {INFINITY, INFINITY};
     const Report mine = guarded([&] { return prepare_accel(ys_.data(), nsteps > 0, rate_n_.data(), vals[0], vals[1]); });
     Report agreed = agree_min(mine, vals, 2);
     if (!agreed.ok()) return failed(agreed, nsteps);
+    if (-vals[1] > width_ && rebuild_ && !rebuilt) {
+      // y holds the step's starting state of the owned particles
+      rebuild_halo(y);
+      seat();
+      rebuilt = true;
+      continue;
+    }
+    rebuilt = false;
     check_reach(vals[1], nsteps + 1);
     double dt = 0.0;
     agreed = step_size(vals[0], cfl, dt_max, t, t_end, nsteps, nullptr, dt);
@@ -494,19 +520,33 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
 Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why, double *want,
                                   int nwant) {
   // (a rank without a state still takes part in the exchange and the agreement)
-  if (!y) stand_in_.assign(static_cast<size_t>(neq()) + 1, 1.0);
-  load(y ? y : stand_in_.data());
-  double vals[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
-  for (int k = 0; k < nwant; ++k) vals[2 + k] = want[k];
-  const Report mine = guarded([&] {
-    if (refuse != MFREE_SUCCESS) throw Error(refuse, why);
-    check_ready();
-    return a ? prepare_accel(ys_.data(), false, a, vals[0], vals[1]) : prepare_rows(ys_.data(), false, vals[0], vals[1]);
-  });
-  const Report agreed = agree_min(mine, vals, 2 + nwant);
-  for (int k = 0; k < nwant; ++k) want[k] = vals[2 + k];
-  if (agreed.ok()) check_reach(vals[1], 0);
-  return agreed;
+  check_usable();
+  // (a second pass on the ghosts the host rebuilt when the layer was too shallow: only a
+  // rank without owned particles can be without a state then)
+  for (int pass = 0;; ++pass) {
+    if (a && pass > 0) {  // (a is rate_n_, wall_force's: sized again for the new nodes)
+      rate_n_.resize(static_cast<size_t>(dim()) * size());
+      a = rate_n_.data();
+    }
+    if (!y) stand_in_.assign(static_cast<size_t>(neq()) + 1, 1.0);
+    load(y ? y : stand_in_.data());
+    double vals[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+    for (int k = 0; k < nwant; ++k) vals[2 + k] = want[k];
+    const Report mine = guarded([&] {
+      if (refuse != MFREE_SUCCESS) throw Error(refuse, why);
+      check_ready();
+      return a ? prepare_accel(ys_.data(), false, a, vals[0], vals[1])
+               : prepare_rows(ys_.data(), false, vals[0], vals[1]);
+    });
+    const Report agreed = agree_min(mine, vals, 2 + nwant);
+    if (agreed.ok() && -vals[1] > width_ && rebuild_ && pass == 0) {
+      rebuild_halo(y);
+      continue;
+    }
+    for (int k = 0; k < nwant; ++k) want[k] = vals[2 + k];
+    if (agreed.ok()) check_reach(vals[1], 0);
+    return agreed;
+  }
 }
 
 // The velocity block on the owned rows: the lumped masses (003 eq 56) of the owned
@@ -637,6 +677,158 @@ void FluidRanks::wall_shares(bool galerkin, double *per_wall) {
   for (size_t t : order) {
     const size_t w = static_cast<size_t>(all[3 * t]);
     for (int c = 0; c < D; ++c) per_wall[w * D + c] += all[3 * t + 2] * wall_n_[w * D + c];
+  }
+}
+
+// ---- Ghosts rebuilt and particles moved ----------------------------------------------
+// The results never depend on which ghosts a rank holds, only on their being there: the
+// nodes are numbered by global id, so a rebuilt layer (or a new set of owned particles)
+// leaves every row, sum and scatter order as it was, and the results stay bitwise those
+// of one rank. A re-seat keeps every option; the nodes' per-particle data (rest density,
+// mass) travel with the owned particles and reach the new ghosts through one exchange.
+
+void FluidRanks::check_usable() const {
+  if (broken_)
+    throw Error(MFREE_ERR_STATE, "a halo rebuild of this system failed: its ghosts no longer match the host's "
+                                 "halo (create the system again)");
+}
+
+void FluidRanks::rebuild_halo(const double *y) {
+  const int D = dim();
+  mv_x_.assign(y, y + static_cast<size_t>(D) * n_own_);
+  mv_id_.resize(n_own_);
+  mv_data_.resize(2 * static_cast<size_t>(n_own_));
+  for (int32_t p = 0; p < n_own_; ++p) {
+    const int32_t k = owned_[p];
+    mv_id_[p] = gid_[k];
+    mv_data_[2 * p] = rho0_[k];
+    mv_data_[2 * p + 1] = mass_[k];
+  }
+  reseat(n_own_, mv_x_.data(), mv_id_.data(), mv_data_.data());
+}
+
+void FluidRanks::reseat(int32_t n_owned, const double *xo, const int64_t *oid, const double *data) {
+  const int D = dim();
+  int32_t ng = -1;
+  const int64_t *ids = nullptr;
+  // the host's rebuild (collective: its status is the same on every rank), then the local
+  // checks of what it returned, agreed
+  const Report mine = guarded([&] {
+    const mfree_status_t st = rebuild_(coll_.user(), n_owned, xo, D, oid, width_, &ng, &ids);
+    if (st != MFREE_SUCCESS)
+      throw Error(st, "the host's halo rebuild callback failed with status " + std::to_string(st) + " (" +
+                          mfree_status_string(st) + ")");
+    if (ng < 0) throw Error(MFREE_ERR_INPUT, "the halo rebuild returned " + std::to_string(ng) + " ghosts");
+    if (n_owned + static_cast<int64_t>(ng) > INT32_MAX)
+      throw Error(MFREE_ERR_INPUT, "more than 2^31 - 1 particles on a rank after the halo rebuild");
+    if (!ids && n_owned + ng > 0) throw Error(MFREE_ERR_INPUT, "the halo rebuild returned NULL global ids");
+    for (int32_t p = 0; p < n_owned; ++p)
+      if (ids[p] != oid[p])
+        throw Error(MFREE_ERR_INPUT, "the halo rebuild changed owned item " + std::to_string(p) + "'s global id (" +
+                                         std::to_string(oid[p]) + " -> " + std::to_string(ids[p]) + ")");
+    return Report();
+  });
+  Report agreed = coll_.agree(mine);
+  if (!agreed.ok()) {
+    broken_ = true;
+    throw Error(agreed.status, agreed.message);
+  }
+  const Report seated = guarded([&] {
+    n_own_ = n_owned;
+    n_ghost_ = ng;
+    n_ = n_owned + ng;
+    number(ids);
+    // a new particle set of the nodes (its search lists and the tables follow at the
+    // next prepare), with the system's support
+    ps_ = ParticleSet(D, n_);
+    if (h_ > 0.0) ps_.set_support(&h_, 0, MFREE_COPY);
+    lists_valid_ = false;
+    cand_search_ = -1;
+    xbound_ = nullptr;
+    rb_ = re_ = nullptr;
+    cols_ = nullptr;
+    vol_.assign(n_ > 0 ? n_ : 1, 1.0);
+    xfirst_.clear();
+    // the rest densities and masses to the nodes, the ghosts' from their owners
+    buf_.resize(2 * static_cast<size_t>(n_));
+    std::copy(data, data + 2 * static_cast<size_t>(n_owned), buf_.begin());
+    coll_.exchange(2, buf_.data(), 2);
+    rho0_.resize(n_);
+    mass_.resize(n_);
+    for (int32_t p = 0; p < n_; ++p) {
+      rho0_[node_[p]] = buf_[2 * static_cast<size_t>(p)];
+      mass_[node_[p]] = buf_[2 * static_cast<size_t>(p) + 1];
+    }
+    return Report();
+  });
+  agreed = coll_.agree(seated);
+  if (!agreed.ok()) {
+    broken_ = true;
+    throw Error(agreed.status, agreed.message);
+  }
+}
+
+void FluidRanks::move_particles(int32_t n_new, mfree_particles_move_fn move, void *move_user, double *y,
+                                int64_t capacity) {
+  const int D = dim(), nrec = 2 * D + 4;
+  const Report args = guarded([&] {
+    check_usable();
+    if (!rebuild_) throw Error(MFREE_ERR_STATE, "no halo rebuild callback (mfree_system_set_halo_rebuild)");
+    if (!move) throw Error(MFREE_ERR_NULL, "move callback is NULL");
+    if (n_new < 0) throw Error(MFREE_ERR_ARG, "negative particle count n_new " + std::to_string(n_new));
+    const int64_t need = static_cast<int64_t>(2 * D + 1) * n_new;
+    if (capacity < need)
+      throw Error(MFREE_ERR_ARG, "capacity " + std::to_string(capacity) + " is below the " + std::to_string(need) +
+                                     " doubles of this rank's state after the move");
+    if (!y && (n_own_ > 0 || n_new > 0)) throw Error(MFREE_ERR_NULL, "y is NULL");
+    check_ready();
+    return Report();
+  });
+  Report agreed = coll_.agree(args);
+  if (!agreed.ok()) throw Error(agreed.status, agreed.message);
+  // records: x, v, rho, rest density, mass, the global id's bits
+  const size_t no = static_cast<size_t>(D) * n_own_;
+  mv_rec_.resize(static_cast<size_t>(std::max(n_own_, n_new)) * nrec + 1);
+  for (int32_t p = 0; p < n_own_; ++p) {
+    double *r = &mv_rec_[static_cast<size_t>(p) * nrec];
+    const int32_t k = owned_[p];
+    for (int c = 0; c < D; ++c) {
+      r[c] = y[p * D + c];
+      r[D + c] = y[no + p * D + c];
+    }
+    r[2 * D] = y[2 * no + p];
+    r[2 * D + 1] = rho0_[k];
+    r[2 * D + 2] = mass_[k];
+    r[2 * D + 3] = Collective::pack(gid_[k]);
+  }
+  const Report moved = guarded([&] {
+    const mfree_status_t st = move(move_user, nrec, n_own_, mv_rec_.data(), n_new);
+    if (st != MFREE_SUCCESS)
+      throw Error(st, "the host's move callback failed with status " + std::to_string(st) + " (" +
+                          mfree_status_string(st) + ")");
+    return Report();
+  });
+  agreed = coll_.agree(moved);
+  if (!agreed.ok()) throw Error(agreed.status, agreed.message);  // the system as it was
+  mv_x_.resize(static_cast<size_t>(D) * n_new + 1);
+  mv_id_.resize(static_cast<size_t>(n_new) + 1);
+  mv_data_.resize(2 * static_cast<size_t>(n_new) + 1);
+  for (int32_t p = 0; p < n_new; ++p) {
+    const double *r = &mv_rec_[static_cast<size_t>(p) * nrec];
+    for (int c = 0; c < D; ++c) mv_x_[p * D + c] = r[c];
+    mv_data_[2 * p] = r[2 * D + 1];
+    mv_data_[2 * p + 1] = r[2 * D + 2];
+    mv_id_[p] = Collective::unpack(r[2 * D + 3]);
+  }
+  reseat(n_new, mv_x_.data(), mv_id_.data(), mv_data_.data());
+  const size_t nn = static_cast<size_t>(D) * n_new;
+  for (int32_t p = 0; p < n_new; ++p) {
+    const double *r = &mv_rec_[static_cast<size_t>(p) * nrec];
+    for (int c = 0; c < D; ++c) {
+      y[p * D + c] = r[c];
+      y[nn + p * D + c] = r[D + c];
+    }
+    y[2 * nn + p] = r[2 * D];
   }
 }
 

@@ -35,6 +35,15 @@ class FluidRanks final : public FluidSystem {
   Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                    mfree_progress_fn progress, void *user, int64_t &nsteps) override;
 
+  // Ghosts rebuilt and particles moved (the host's callbacks, fluid_ranks.cpp's last block).
+  // With a rebuild callback, an evaluation whose ghost layer is no longer deep enough has
+  // the host rebuild it around the owned particles and runs again on the new ghosts.
+  void set_rebuild(mfree_halo_rebuild_fn rebuild) { rebuild_ = rebuild; }
+  // Collective: the owned particles' records (state from y, rest density, mass, global id)
+  // through the host's move, the halo rebuilt around the n_new particles that arrive, the
+  // system re-seated on them and their state written to y (capacity doubles).
+  void move_particles(int32_t n_new, mfree_particles_move_fn move, void *move_user, double *y, int64_t capacity);
+
  protected:
   void to_nodes(HVec<double> &per_particle) const override;
   void rows_done() override;
@@ -80,6 +89,21 @@ class FluidRanks final : public FluidSystem {
   // ghost (its owner fails alike, and its report is the one every rank returns).
   Report named(Report r) const;
   mutable bool ghost_fault_ = false;
+
+  // The nodes from the n_own_ + n_ghost_ items' global ids (checked: >= 0, distinct).
+  void number(const int64_t *ids);
+  // The halo rebuilt by the host around n_owned particles (positions xo, dim per particle,
+  // ids oid, per-particle data: rest density and mass, two per particle, host order) and
+  // the system re-seated on them and the new ghosts (collective; a failure after the
+  // host's rebuild leaves the system broken_: its ghosts no longer match the host's).
+  void reseat(int32_t n_owned, const double *xo, const int64_t *oid, const double *data);
+  // reseat around the owned particles' current positions (the first part of y).
+  void rebuild_halo(const double *y);
+  void check_usable() const;
+  mfree_halo_rebuild_fn rebuild_ = nullptr;
+  bool broken_ = false;
+  std::vector<double> mv_x_, mv_data_, mv_rec_;
+  std::vector<int64_t> mv_id_;
 
   Collective coll_;
   int32_t n_own_ = 0, n_ghost_ = 0;

@@ -1,0 +1,135 @@
+/* The fluid on ranks across ghost rebuilds and migrations (label mpi): the dam break of
+ * paper 003 (16 x 32 particles, leap-frog at CFL 0.5) for 500 steps in four windows of
+ * 125 on 1-4 ranks, starting from vertical slabs, with a ghost layer only a quarter
+ * spacing deeper than the two support radii the rows need (so that the ranks rebuild it
+ * many times inside each window) and a migration between windows (Zoltan RCB with new
+ * regions, HSFC with new regions, HSFC in the last regions: the particles that crossed
+ * into another rank's region move there). After every window every owned particle's
+ * position, velocity and density are bitwise those of the one-rank run (MPI_COMM_SELF,
+ * the same windows), matched by global id, with the same steps and time. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpimove.h"
+#include "mpitest.h"
+
+enum { NX = 16, NZ = 32, WINDOWS = 4 };
+static const int64_t kWindow = 125;
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  mfree_context_t *ctx = NULL;
+  mfree_context_create(&ctx);
+  damb_t b;
+  damb_make(&b, NX, NZ);
+  const int n = b.n;
+  int *owner = calloc((size_t)n, sizeof *owner);
+
+  /* the reference: one rank, a deep layer, the same windows */
+  rankfluid_t ref;
+  mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, 4.0 * b.h + 4.0 * b.d, 0);
+  CHECK(st == MFREE_SUCCESS, "one-rank system: status %d: %s", (int)st, mpifluid_error(ctx));
+  double *ref_y[WINDOWS], t_ref[WINDOWS];
+  int64_t steps_ref[WINDOWS];
+  double t = 0.0;
+  for (int w = 0; w < WINDOWS && st == MFREE_SUCCESS; ++w) {
+    st = mfree_system_integrate(ref.sys, MFREE_INTEGRATOR_LEAPFROG, ref.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+                                (void *)&kWindow, &steps_ref[w]);
+    CHECK(st == MFREE_SUCCESS && steps_ref[w] == kWindow, "one rank, window %d: status %d: %s", w, (int)st,
+          mpifluid_error(ctx));
+    t_ref[w] = t;
+    ref_y[w] = malloc(5 * (size_t)n * sizeof(double));
+    memcpy(ref_y[w], ref.y, 5 * (size_t)n * sizeof(double));
+  }
+
+  /* on the ranks */
+  for (int i = 0; i < n; ++i) {
+    int p = (int)(b.y[2 * i] / b.a * size);
+    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
+  }
+  const double width = 4.0 * b.h + 0.25 * b.d;
+  rankfluid_t r;
+  counted_t cw;
+  st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
+  if (st == MFREE_SUCCESS) st = mpimove_counted(&r, ctx, &b, width, &cw);
+  CHECK(st == MFREE_SUCCESS, "system on the ranks: status %d: %s", (int)st, mpifluid_error(ctx));
+  /* a state buffer for any owned count: no reallocation between windows */
+  double *y = malloc(5 * (size_t)n * sizeof *y);
+  memcpy(y, r.y, 5 * (size_t)r.n_owned * sizeof *y);
+  mfree_migration_t *mig = NULL;
+  if (st == MFREE_SUCCESS) st = mfree_migration_create(ctx, MPI_COMM_WORLD, 2, &mig);
+  const int32_t method[WINDOWS - 1] = {MFREE_PARTITIONER_RCB, MFREE_PARTITIONER_HSFC, MFREE_PARTITIONER_HSFC};
+  const int32_t rebalance[WINDOWS - 1] = {1, 1, 0};
+  int64_t sent[WINDOWS - 1] = {0, 0, 0};
+  t = 0.0;
+  for (int w = 0; w < WINDOWS && st == MFREE_SUCCESS; ++w) {
+    int64_t steps = 0;
+    st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+                                (void *)&kWindow, &steps);
+    CHECK(st == MFREE_SUCCESS, "window %d: integrate status %d: %s", w, (int)st, mpifluid_error(ctx));
+    CHECK(steps == steps_ref[w] && t == t_ref[w], "window %d: %lld steps to t = %.17g, one rank %lld to %.17g", w,
+          (long long)steps, t, (long long)steps_ref[w], t_ref[w]);
+    int first = -1;
+    const int bad = mpimove_differs(&r, y, ref_y[w], n, &first);
+    CHECK(bad == 0, "window %d: %d owned particles differ from one rank's (first: id %d)", w, bad, first);
+    if (w == WINDOWS - 1 || st != MFREE_SUCCESS) break;
+    int64_t neq = -1, received = 0;
+    int32_t no = 0, sys_neq = 0;
+    mfree_halo_get_size(r.halo, &no, NULL);
+    char *was = calloc((size_t)n, 1); /* the owned particles before the migration */
+    int64_t *id = malloc(((size_t)n + 1) * sizeof *id), *ids_before = malloc(((size_t)n + 1) * sizeof *id);
+    mfree_halo_get_global_ids(r.halo, ids_before);
+    for (int k = 0; k < no; ++k) was[ids_before[k]] = 1;
+    st = mfree_migration_set_partitioner(mig, method[w], 1.05);
+    if (st == MFREE_SUCCESS) st = mfree_halo_migrate_fluid(r.halo, mig, r.sys, rebalance[w], y, 5 * (int64_t)n, &neq);
+    CHECK(st == MFREE_SUCCESS, "migration %d: status %d: %s", w, (int)st, mpifluid_error(ctx));
+    mfree_halo_get_size(r.halo, &no, NULL);
+    mfree_system_get_size(r.sys, &sys_neq);
+    CHECK(neq == 5 * (int64_t)no && sys_neq == neq, "migration %d: neq %lld, system %d, %d owned", w, (long long)neq,
+          (int)sys_neq, (int)no);
+    if (st == MFREE_SUCCESS) mfree_halo_get_global_ids(r.halo, id);
+    for (int k = 0; k < no && st == MFREE_SUCCESS; ++k) received += !was[id[k]];
+    free(was), free(id), free(ids_before);
+    MPI_Allreduce(&received, &sent[w], 1, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+    int total = 0, mine = no;
+    MPI_Allreduce(&mine, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    CHECK(total == n, "migration %d: %d particles owned in all", w, total);
+    /* new regions: the counts within Zoltan's tolerance of the mean */
+    int most = 0;
+    MPI_Allreduce(&mine, &most, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    CHECK(!rebalance[w] || most <= ceil(1.1 * n / size), "migration %d: a rank owns %d of %d particles", w, most, n);
+  }
+  int rebuilds = cw.rebuilds, all_rebuilds = 0;
+  MPI_Allreduce(&rebuilds, &all_rebuilds, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  /* the layer was rebuilt inside the windows (the migrations' setups are three) */
+  CHECK(all_rebuilds > WINDOWS, "the ghosts were rebuilt %d times", all_rebuilds);
+  if (size > 1) {
+    CHECK(sent[0] > 0 && sent[1] > 0, "the rebalances moved %lld and %lld particles", (long long)sent[0],
+          (long long)sent[1]);
+    CHECK(sent[2] > 0, "no particle crossed into another rank's region in the last window");
+  }
+  if (rank == 0)
+    printf("t189: %d ranks: %lld steps to t = %.6f, %d ghost rebuilds, migrations moved %lld, %lld, %lld particles\n",
+           size, (long long)(WINDOWS * kWindow), t, cw.rebuilds, (long long)sent[0], (long long)sent[1],
+           (long long)sent[2]);
+  /* the particles moved: the front left the column */
+  double front = 0.0;
+  for (int q = 0; q < n; ++q) front = fmax(front, ref_y[WINDOWS - 1][2 * q]);
+  CHECK(front > 1.1 * b.a, "the front is at %.4f m, the column %.4f m wide", front, b.a);
+
+  mfree_migration_destroy(&mig);
+  rankfluid_free(&r);
+  rankfluid_free(&ref);
+  for (int w = 0; w < WINDOWS; ++w) free(ref_y[w]);
+  free(y), free(owner);
+  damb_free(&b);
+  mfree_context_destroy(&ctx);
+  const int rc = mpitest_finish("t189-mpifluid-migrate");
+  MPI_Finalize();
+  return rc;
+}
