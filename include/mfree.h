@@ -2154,8 +2154,10 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * and density are bitwise those of the same system on one rank, whatever the partition
  * (the one-process mfree_system_create_fluid sums the forces in another order).
  * The halo is checked at every evaluation against the owned particles' displacements
- * since the first: when the layer may miss a particle, every rank returns
- * MFREE_ERR_HALO (rebuild the halo and the system). A failure on one rank (a non-finite
+ * since the first (or the last rebuild): when the layer may miss a particle, the ghosts
+ * are rebuilt through the host's rebuild callback (mfree_system_set_halo_rebuild) or,
+ * without one, every rank returns MFREE_ERR_HALO (rebuild the halo and the system).
+ * Particles move between ranks with mfree_system_move_particles. A failure on one rank (a non-finite
  * state: MFREE_FAIL_NONFINITE) is returned by every rank with that rank's message
  * ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
  * consistent integration, velocity smoothing or open boundaries (MFREE_ERR_UNSUPPORTED). Outputs: the owned
@@ -2257,9 +2259,9 @@ typedef mfree_status_t (*mfree_particles_move_fn)(void *user, int32_t nrec, int3
  * @param[in]     move_user  passed to move
  * @param[in,out] y          this rank's state ((2 dim + 1) n_owned doubles) in, the new
  *                           one out
- * @param[in]     capacity   doubles y holds (>= (2 dim + 1) n_new)
+ * @param[in]     capacity   doubles y holds (>= (2 dim + 1) n_new and >= the current neq)
  * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG (n_new < 0, a capacity below
- *         the new state), MFREE_ERR_NULL, MFREE_ERR_STATE (no rebuild callback, masses not
+ *         the new or the current state), MFREE_ERR_NULL, MFREE_ERR_STATE (no rebuild callback, masses not
  *         set, a system whose rebuild failed), the move's or the rebuild's failure (a failed
  *         move leaves the system and y as they were; a failed rebuild, the system unusable);
  *         MFREE_ERR_NULL (local) for a NULL system, MFREE_ERR_UNSUPPORTED (local) if it is not a

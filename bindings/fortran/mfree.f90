@@ -1549,6 +1549,24 @@ module mfree
       type(c_ptr), intent(out) :: sys
     end function mfree_system_create_fluid_ranks_c
 
+    integer(c_int) function mfree_system_set_halo_rebuild_c(sys, rebuild) &
+        bind(C, name="mfree_system_set_halo_rebuild")
+      import :: c_int, c_ptr, c_funptr
+      type(c_ptr), value :: sys
+      type(c_funptr), value :: rebuild
+    end function mfree_system_set_halo_rebuild_c
+
+    integer(c_int) function mfree_system_move_particles_c(sys, n_new, move, move_user, y, capacity) &
+        bind(C, name="mfree_system_move_particles")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr, c_funptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: n_new
+      type(c_funptr), value :: move
+      type(c_ptr), value :: move_user
+      real(c_double), intent(inout) :: y(*)
+      integer(c_int64_t), value :: capacity
+    end function mfree_system_move_particles_c
+
     integer(c_int) function mfree_system_get_stress_c(sys, t, y, sigma) &
         bind(C, name="mfree_system_get_stress")
       import :: c_int, c_double, c_ptr
@@ -1643,6 +1661,8 @@ module mfree
   public :: mfree_system_create_elastodynamic_ranks_c
   public :: mfree_system_create_elastodynamic_ranks
   public :: mfree_system_create_fluid_ranks_c, mfree_system_create_fluid_ranks
+  public :: mfree_system_set_halo_rebuild_c, mfree_system_set_halo_rebuild
+  public :: mfree_system_move_particles_c, mfree_system_move_particles
   public :: mfree_system_set_shepard_condition_c
   public :: mfree_system_set_approximation_c
   public :: mfree_system_get_stress_c
@@ -4128,6 +4148,31 @@ contains
     st = mfree_system_create_fluid_ranks_c(ctx%ptr, dim, n_owned, n_ghost, global_ids, width, exchange, &
                                            allgather, user, sys%ptr)
   end function mfree_system_create_fluid_ranks
+
+  !> Typed wrapper of mfree_system_set_halo_rebuild (mfree.h): rebuild is the host's
+  !> mfree_halo_rebuild_fn (c_funloc of a bind(C) function; c_null_funptr: none). Module
+  !> mfree_mpi's mfree_halo_create_fluid sets libmfree_mpi's own.
+  integer(c_int) function mfree_system_set_halo_rebuild(sys, rebuild) result(st)
+    type(mfree_system), intent(in) :: sys
+    type(c_funptr), intent(in) :: rebuild
+    st = mfree_system_set_halo_rebuild_c(sys%ptr, rebuild)
+  end function mfree_system_set_halo_rebuild
+
+  !> Typed wrapper of mfree_system_move_particles (mfree.h): y holds at least capacity
+  !> values (checked: a shorter y is passed as a capacity of -1, which every rank refuses
+  !> alike with MFREE_ERR_ARG, nothing moved). Collective.
+  integer(c_int) function mfree_system_move_particles(sys, n_new, move, move_user, y, capacity) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: n_new
+    type(c_funptr), intent(in) :: move
+    type(c_ptr), intent(in) :: move_user
+    real(c_double), intent(inout), contiguous :: y(:)
+    integer(c_int64_t), intent(in) :: capacity
+    integer(c_int64_t) :: cap
+    cap = capacity
+    if (size(y, kind=c_int64_t) < capacity) cap = -1_c_int64_t
+    st = mfree_system_move_particles_c(sys%ptr, n_new, move, move_user, y, cap)
+  end function mfree_system_move_particles
 
   !> Condition threshold of the fluid's Shepard fallback (default 100).
   integer(c_int) function mfree_system_set_shepard_condition(sys, max_cond) result(st)

@@ -259,6 +259,31 @@ module mfree_mpi
       real(c_double), value :: width
       type(c_ptr), intent(out) :: sys
     end function mfree_halo_create_fluid_c
+
+    integer(c_int) function mfree_halo_rebuild_callback_c(halo, n_owned, x, ld, global_ids, width, n_ghost, &
+        all_ids) bind(C, name="mfree_halo_rebuild_callback")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: halo
+      integer(c_int32_t), value :: n_owned
+      real(c_double), intent(in) :: x(*)
+      integer(c_int64_t), value :: ld
+      integer(c_int64_t), intent(in) :: global_ids(*)
+      real(c_double), value :: width
+      integer(c_int32_t), intent(out) :: n_ghost
+      type(c_ptr), intent(out) :: all_ids
+    end function mfree_halo_rebuild_callback_c
+
+    integer(c_int) function mfree_halo_migrate_fluid_c(halo, migration, sys, rebalance, y, capacity, neq) &
+        bind(C, name="mfree_halo_migrate_fluid")
+      import :: c_int, c_int32_t, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: halo
+      type(c_ptr), value :: migration
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: rebalance
+      real(c_double), intent(inout) :: y(*)
+      integer(c_int64_t), value :: capacity
+      integer(c_int64_t), intent(out) :: neq
+    end function mfree_halo_migrate_fluid_c
   end interface
 
   public :: mfree_halo_create_f_c, mfree_halo_destroy_c, mfree_halo_setup_c
@@ -284,9 +309,12 @@ module mfree_mpi
   public :: mfree_halo_create_elastodynamic
   public :: mfree_halo_create_fluid_c, mfree_halo_create_fluid
   public :: mfree_halo_exchange_callback, mfree_halo_allgather
+  public :: mfree_halo_rebuild_callback_c, mfree_halo_rebuild_callback
+  public :: mfree_halo_migrate_fluid_c, mfree_halo_migrate_fluid
 
   real(c_double), target, save :: empty_dbl(0)
   integer(c_int32_t), target, save :: empty_i32(0)
+  integer(c_int64_t), target, save :: empty_i64(0)
 
 contains
 
@@ -319,6 +347,55 @@ contains
     type(mfree_system), intent(out) :: sys
     st = mfree_halo_create_fluid_c(halo%ptr, dim, width, sys%ptr)
   end function mfree_halo_create_fluid
+
+  !> Typed wrapper of mfree_halo_rebuild_callback (mfree_mpi.h): the plan set up again
+  !> around n_owned particles (x: ld values each, global_ids: n_owned, checked: a short
+  !> array is handed to the plan as a failure every rank returns). all_ids points to the
+  !> plan's ids (c_f_pointer with n_owned + n_ghost). Collective.
+  integer(c_int) function mfree_halo_rebuild_callback(halo, n_owned, x, ld, global_ids, width, n_ghost, &
+                                                       all_ids) result(st)
+    type(mfree_halo), intent(in) :: halo
+    integer(c_int32_t), intent(in) :: n_owned
+    real(c_double), intent(in), contiguous :: x(:)
+    integer(c_int64_t), intent(in) :: ld
+    integer(c_int64_t), intent(in), contiguous :: global_ids(:)
+    real(c_double), intent(in) :: width
+    integer(c_int32_t), intent(out) :: n_ghost
+    type(c_ptr), intent(out) :: all_ids
+    integer(c_int64_t) :: no
+    no = max(int(n_owned, c_int64_t), 0_c_int64_t)
+    n_ghost = 0
+    all_ids = c_null_ptr
+    st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_rebuild_callback', 'x', .true., &
+                                 size(x, kind=c_int64_t), ld * no)
+    if (st == MFREE_SUCCESS) &
+      st = mfree_wrapper_check_out(halo_ctx(halo), 'mfree_halo_rebuild_callback', 'global_ids', .true., &
+                                   size(global_ids, kind=c_int64_t), no)
+    if (st /= MFREE_SUCCESS) then
+      if (mfree_halo_set_pending_error_c(halo%ptr) /= MFREE_SUCCESS) return
+      st = mfree_halo_rebuild_callback_c(halo%ptr, 0_c_int32_t, empty_dbl, ld, empty_i64, width, n_ghost, all_ids)
+      return
+    end if
+    st = mfree_halo_rebuild_callback_c(halo%ptr, n_owned, x, ld, global_ids, width, n_ghost, all_ids)
+  end function mfree_halo_rebuild_callback
+
+  !> Typed wrapper of mfree_halo_migrate_fluid (mfree_mpi.h): y holds at least capacity
+  !> values (checked: a shorter y is passed as a capacity of -1, which every rank refuses
+  !> alike with MFREE_ERR_ARG, nothing moved). Collective.
+  integer(c_int) function mfree_halo_migrate_fluid(halo, migration, sys, rebalance, y, capacity, neq) result(st)
+    type(mfree_halo), intent(in) :: halo
+    type(mfree_migration), intent(in) :: migration
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: rebalance
+    real(c_double), intent(inout), contiguous :: y(:)
+    integer(c_int64_t), intent(in) :: capacity
+    integer(c_int64_t), intent(out) :: neq
+    integer(c_int64_t) :: cap
+    cap = capacity
+    if (size(y, kind=c_int64_t) < capacity) cap = -1_c_int64_t
+    neq = 0
+    st = mfree_halo_migrate_fluid_c(halo%ptr, migration%ptr, sys%ptr, rebalance, y, cap, neq)
+  end function mfree_halo_migrate_fluid
 
   !> The same with the communicator already as integer(c_int32_t).
   integer(c_int) function mfree_halo_create_f(ctx, fcomm, dim, halo) result(st)

@@ -11,7 +11,7 @@ static mfree_status_t ca(void *u, const double *in, int64_t n, double *out, int6
   return mfree_halo_allgather(((counted_t *)u)->halo, in, n, out, cap, total);
 }
 
-static mfree_status_t cr(void *u, int32_t n_owned, const double *x, int64_t ld, const int64_t *ids, double width,
+mfree_status_t mpimove_rebuild(void *u, int32_t n_owned, const double *x, int64_t ld, const int64_t *ids, double width,
                          int32_t *n_ghost, const int64_t **all_ids) {
   counted_t *w = u;
   ++w->rebuilds;
@@ -32,7 +32,7 @@ mfree_status_t mpimove_counted(rankfluid_t *r, mfree_context_t *ctx, const damb_
       mfree_system_create_fluid_ranks(ctx, 2, r->n_owned, r->n_ghost, r->id, width, cx, ca, w, &r->sys);
   if (st == MFREE_SUCCESS) st = damb_configure(b, r->sys);
   if (st == MFREE_SUCCESS) st = mfree_system_set_masses(r->sys, m, 1);
-  if (st == MFREE_SUCCESS) st = mfree_system_set_halo_rebuild(r->sys, cr);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_halo_rebuild(r->sys, mpimove_rebuild);
   free(m);
   return st;
 }

@@ -315,6 +315,27 @@ static mfree_status_t one_allgather(void *user, const double *in, int64_t n, dou
   if (cap >= n && n > 0) memcpy(out, in, sizeof(double) * (size_t)n);
   return MFREE_SUCCESS;
 }
+/* The halo rebuild and particle move of one rank: nothing moves, no ghosts. */
+static mfree_status_t one_rebuild(void *user, int32_t n_owned, const double *x, int64_t ld, const int64_t *ids,
+                                  double width, int32_t *n_ghost, const int64_t **all_ids) {
+  (void)user, (void)n_owned, (void)x, (void)ld, (void)width;
+  *n_ghost = 0;
+  *all_ids = ids;
+  return MFREE_SUCCESS;
+}
+static mfree_status_t bad_rebuild(void *user, int32_t n_owned, const double *x, int64_t ld, const int64_t *ids,
+                                  double width, int32_t *n_ghost, const int64_t **all_ids) {
+  (void)user, (void)n_owned, (void)x, (void)ld, (void)ids, (void)width, (void)n_ghost, (void)all_ids;
+  return MFREE_ERR_INTERNAL;
+}
+static mfree_status_t one_move(void *user, int32_t nrec, int32_t n_owned, double *records, int32_t n_new) {
+  (void)user, (void)nrec, (void)records;
+  return n_new == n_owned ? MFREE_SUCCESS : MFREE_ERR_ARG;
+}
+static mfree_status_t bad_move(void *user, int32_t nrec, int32_t n_owned, double *records, int32_t n_new) {
+  (void)user, (void)nrec, (void)n_owned, (void)records, (void)n_new;
+  return MFREE_ERR_INTERNAL;
+}
 static void handler(void *user, mfree_status_t code, const char *message) {
   (void)code, (void)message;
   ++*(int *)user;
@@ -1237,6 +1258,20 @@ static void rows_system(void) {
       ROW(MFREE_ERR_NULL, mfree_system_assemble_mass(fr, NULL, 0, &fm));
       ROW(MFREE_ERR_ARG, mfree_system_get_wall_force(fr, ys, yd, 1, yd));
       ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_mass(fr, ys, 1, &fm));
+      /* ghosts rebuilt and particles moved */
+      ROW0(MFREE_ERR_NULL, mfree_system_set_halo_rebuild(NULL, one_rebuild));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_set_halo_rebuild(F.sys, one_rebuild));
+      ROW0(MFREE_ERR_NULL, mfree_system_move_particles(NULL, 2, one_move, NULL, ys, 10));
+      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_move_particles(F.sys, 2, one_move, NULL, ys, 10));
+      ROW(MFREE_ERR_STATE, mfree_system_move_particles(fr, 2, one_move, NULL, ys, 10)); /* no rebuild callback */
+      ROW(MFREE_SUCCESS, mfree_system_set_halo_rebuild(fr, one_rebuild));
+      ROW(MFREE_ERR_ARG, mfree_system_move_particles(fr, -1, one_move, NULL, ys, 10));
+      ROW(MFREE_ERR_ARG, mfree_system_move_particles(fr, 2, one_move, NULL, ys, 9));
+      ROW(MFREE_ERR_NULL, mfree_system_move_particles(fr, 2, NULL, NULL, ys, 10));
+      ROW(MFREE_ERR_NULL, mfree_system_move_particles(fr, 2, one_move, NULL, NULL, 10));
+      ROW(MFREE_ERR_INTERNAL, mfree_system_move_particles(fr, 2, bad_move, NULL, ys, 10));
+      ROW(MFREE_SUCCESS, mfree_system_move_particles(fr, 2, one_move, NULL, ys, 10));
+      ROW(MFREE_SUCCESS, mfree_system_rhs(fr, 0.0, ys, yd));
       ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_interpolation(fr, ys, &fm));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, (mfree_integrator_t)0, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, NAN, 0.2, 0, NULL, NULL, &steps));
@@ -1244,6 +1279,11 @@ static void rows_system(void) {
       ROW(MFREE_FAIL_NONFINITE, mfree_system_rhs(fr, 0.0, ys, yd));
       ROW(MFREE_FAIL_NONFINITE, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
       ROW(MFREE_FAIL_NONFINITE, mfree_system_integrate(fr, MFREE_INTEGRATOR_PREDICTOR_CORRECTOR, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
+      /* a failed rebuild leaves the system unusable */
+      ROW(MFREE_SUCCESS, mfree_system_set_halo_rebuild(fr, bad_rebuild));
+      ROW(MFREE_ERR_INTERNAL, mfree_system_move_particles(fr, 2, one_move, NULL, ys, 10));
+      ROW(MFREE_ERR_STATE, mfree_system_rhs(fr, 0.0, ys, yd));
+      ROW(MFREE_ERR_STATE, mfree_system_move_particles(fr, 2, one_move, NULL, ys, 10));
       mfree_system_destroy(&fr);
     }
     mfree_matrix_destroy(&fm);

@@ -498,7 +498,10 @@ MFREE_MPI_API mfree_status_t mfree_halo_create_elastodynamic(mfree_halo_t *halo,
  * mfree_halo_exchange, the reductions by mfree_halo_allgather; created on the plan's
  * context, keeping a pointer to the plan, which must outlive it (destroy the system
  * first). Collective. The per-particle setters of the system take the plan's
- * n_owned + n_ghost items (fill the ghosts' masses with mfree_halo_exchange).
+ * n_owned + n_ghost items (fill the ghosts' masses with mfree_halo_exchange). The system
+ * rebuilds its ghosts through the plan when particles move too far
+ * (mfree_halo_rebuild_callback, set with mfree_system_set_halo_rebuild: the plan is set
+ * up again inside the run), and migrates with mfree_halo_migrate_fluid.
  * @param[in]  halo   a set-up plan
  * @param[in]  dim    2 or 3 (the plan's dimension)
  * @param[in]  width  the width the plan was set up with (at least two support radii)
@@ -549,7 +552,7 @@ MFREE_MPI_API mfree_status_t mfree_halo_rebuild_callback(void *halo, int32_t n_o
  * @param[in]     sys        the fluid on ranks
  * @param[in]     rebalance  1: new regions; 0: the last regions (as mfree_migration_partition)
  * @param[in,out] y          this rank's state in ((2 dim + 1) n_owned doubles), the new one out
- * @param[in]     capacity   doubles y holds
+ * @param[in]     capacity   doubles y holds (at least the current state's)
  * @param[out]    neq        the new state's length (set also when capacity is too small)
  * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_ARG ("capacity C is below the N
  *         doubles of this rank's state after the move": nothing moved, grow y to *neq and

@@ -159,6 +159,10 @@ mfree_status_t mfree_halo_migrate_fluid(mfree_halo_t *halo, mfree_migration_t *m
   } else if (!y && n_owned > 0) {
     bad = MFREE_ERR_NULL;
     std::snprintf(msg, sizeof msg, "mfree_halo_migrate_fluid: y is NULL");
+  } else if (capacity < sys_neq) {
+    bad = MFREE_ERR_ARG;
+    std::snprintf(msg, sizeof msg, "mfree_halo_migrate_fluid: capacity %lld is below the %d doubles of this rank's state",
+                  static_cast<long long>(capacity), static_cast<int>(sys_neq));
   }
   if (bad != MFREE_SUCCESS) {
     mfree_context_set_error(mctx, bad, msg);

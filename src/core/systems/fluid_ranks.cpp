@@ -695,9 +695,11 @@ void FluidRanks::check_usable() const {
 
 void FluidRanks::rebuild_halo(const double *y) {
   const int D = dim();
-  mv_x_.assign(y, y + static_cast<size_t>(D) * n_own_);
-  mv_id_.resize(n_own_);
-  mv_data_.resize(2 * static_cast<size_t>(n_own_));
+  // (one more item each: the host sees arrays, also on a rank without owned particles)
+  mv_x_.resize(static_cast<size_t>(D) * n_own_ + 1);
+  std::copy(y, y + static_cast<size_t>(D) * n_own_, mv_x_.begin());
+  mv_id_.resize(static_cast<size_t>(n_own_) + 1);
+  mv_data_.resize(2 * static_cast<size_t>(n_own_) + 1);
   for (int32_t p = 0; p < n_own_; ++p) {
     const int32_t k = owned_[p];
     mv_id_[p] = gid_[k];
@@ -780,6 +782,9 @@ void FluidRanks::move_particles(int32_t n_new, mfree_particles_move_fn move, voi
     if (capacity < need)
       throw Error(MFREE_ERR_ARG, "capacity " + std::to_string(capacity) + " is below the " + std::to_string(need) +
                                      " doubles of this rank's state after the move");
+    if (capacity < neq())
+      throw Error(MFREE_ERR_ARG, "capacity " + std::to_string(capacity) + " is below the " +
+                                     std::to_string(neq()) + " doubles of this rank's state");
     if (!y && (n_own_ > 0 || n_new > 0)) throw Error(MFREE_ERR_NULL, "y is NULL");
     check_ready();
     return Report();

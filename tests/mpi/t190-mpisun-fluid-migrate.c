@@ -1,0 +1,142 @@
+/* The fluid on ranks with ARKODE across migrations (label mpi): the dam break of paper
+ * 003 (12 x 24 particles) by ERKStep (adaptive steps) on libmfree_sundials_mpi's
+ * reproducible parallel vectors, in four windows of 2.5 ms, on 1, 2 and 4 ranks: a ghost layer a
+ * fiftieth of a spacing deeper than the rows need (rebuilt inside the windows, during the
+ * right-hand sides), and between windows a migration by Zoltan (RCB with new regions,
+ * HSFC with new regions, HSFC in the last regions), after which the host re-creates its
+ * vector with the new length and the integrator (the one-rank run re-creates them at
+ * the same times). Every particle's position, velocity and density, matched by global
+ * id, and the steps of every window are bitwise those of the one-rank run. */
+#include <arkode/arkode_erkstep.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mfree_sundials.h"
+#include "mfree_sundials_mpi.h"
+#include "mpimove.h"
+#include "mpitest.h"
+
+enum { WINDOWS = 4 };
+static const double T_WINDOW = 2.5e-3, RTOL = 1e-3;
+
+static void flag(int f, const char *what) { CHECK(f >= 0, "%s returned %d", what, f); }
+
+/* One window of ERKStep from t0 on a fresh vector and integrator: y (the rank's state,
+   5 n_owned) advanced to t0 + T_WINDOW; the steps. */
+static long window(mfree_context_t *ctx, SUNContext sunctx, MPI_Comm comm, const damb_t *b, rankfluid_t *r,
+                   double *ystate, double t0) {
+  int32_t no = 0;
+  mfree_halo_get_size(r->halo, &no, NULL);
+  mfree_sundials_t *ad = NULL;
+  CHECK(mfree_sundials_create(ctx, r->sys, &ad) == MFREE_SUCCESS, "adapter: %s", mpifluid_error(ctx));
+  N_Vector y = NULL;
+  CHECK(mfree_sundials_mpi_create_vector(ctx, r->sys, comm, sunctx, &y) == MFREE_SUCCESS, "vector: %s",
+        mpifluid_error(ctx));
+  CHECK(N_VGetLocalLength_Parallel(y) == 5 * no, "local length %ld, %d owned", (long)N_VGetLocalLength_Parallel(y),
+        (int)no);
+  memcpy(N_VGetArrayPointer(y), ystate, 5 * (size_t)no * sizeof(double));
+  void *mem = ERKStepCreate(mfree_sundials_rhs, t0, y, sunctx);
+  N_Vector atol = N_VClone(y);
+  double *pa = N_VGetArrayPointer(atol);
+  for (int k = 0; k < no; ++k) {
+    pa[2 * k] = pa[2 * k + 1] = 1e-2 * b->d;
+    pa[2 * no + 2 * k] = pa[2 * no + 2 * k + 1] = 1e-2;
+    pa[4 * no + k] = 1.0;
+  }
+  flag(ERKStepSVtolerances(mem, RTOL, atol), "tolerances");
+  flag(ERKStepSetUserData(mem, ad), "user data");
+  flag(ERKStepSetMaxNumSteps(mem, 100000), "max steps");
+  flag(ERKStepSetStopTime(mem, t0 + T_WINDOW), "stop time");
+  double t = t0;
+  flag(ERKStepEvolve(mem, t0 + T_WINDOW, y, &t, ARK_NORMAL), "ERKStepEvolve");
+  long steps = -1;
+  ERKStepGetNumSteps(mem, &steps);
+  CHECK(t == t0 + T_WINDOW, "t %.17g", t);
+  memcpy(ystate, N_VGetArrayPointer(y), 5 * (size_t)no * sizeof(double));
+  ERKStepFree(&mem);
+  N_VDestroy(atol);
+  N_VDestroy(y);
+  mfree_sundials_destroy(&ad);
+  return steps;
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  mfree_context_t *ctx = NULL;
+  mfree_context_create(&ctx);
+  SUNContext sunctx = NULL, self_ctx = NULL;
+  MPI_Comm world = MPI_COMM_WORLD, self = MPI_COMM_SELF;
+  SUNContext_Create(&world, &sunctx);
+  SUNContext_Create(&self, &self_ctx);
+  damb_t b;
+  damb_make(&b, 12, 24);
+  const int n = b.n;
+  int *owner = calloc((size_t)n, sizeof *owner);
+
+  /* the reference: one rank, the same windows */
+  rankfluid_t ref;
+  mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, 4.0 * b.h + 4.0 * b.d, 0);
+  CHECK(st == MFREE_SUCCESS, "one-rank system: status %d: %s", (int)st, mpifluid_error(ctx));
+  double *ref_y[WINDOWS];
+  long ref_steps[WINDOWS];
+  for (int w = 0; w < WINDOWS; ++w) {
+    ref_steps[w] = window(ctx, self_ctx, MPI_COMM_SELF, &b, &ref, ref.y, w * T_WINDOW);
+    ref_y[w] = malloc(5 * (size_t)n * sizeof(double));
+    memcpy(ref_y[w], ref.y, 5 * (size_t)n * sizeof(double));
+  }
+
+  /* on the ranks: horizontal layers first */
+  for (int i = 0; i < n; ++i) {
+    int p = (int)(b.y[2 * i + 1] / (2.0 * b.a) * size);
+    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
+  }
+  const double width = 4.0 * b.h + 0.02 * b.d;
+  rankfluid_t r;
+  counted_t cw;
+  st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
+  if (st == MFREE_SUCCESS) st = mpimove_counted(&r, ctx, &b, width, &cw);
+  CHECK(st == MFREE_SUCCESS, "system on the ranks: status %d: %s", (int)st, mpifluid_error(ctx));
+  double *y = malloc(5 * (size_t)n * sizeof *y);
+  memcpy(y, r.y, 5 * (size_t)r.n_owned * sizeof *y);
+  mfree_migration_t *mig = NULL;
+  if (st == MFREE_SUCCESS) st = mfree_migration_create(ctx, MPI_COMM_WORLD, 2, &mig);
+  const int32_t method[WINDOWS - 1] = {MFREE_PARTITIONER_RCB, MFREE_PARTITIONER_HSFC, MFREE_PARTITIONER_HSFC};
+  const int32_t rebalance[WINDOWS - 1] = {1, 1, 0};
+  long total_steps = 0;
+  for (int w = 0; w < WINDOWS && st == MFREE_SUCCESS; ++w) {
+    const long s = window(ctx, sunctx, MPI_COMM_WORLD, &b, &r, y, w * T_WINDOW);
+    total_steps += s;
+    CHECK(s == ref_steps[w], "window %d: %ld steps, one rank %ld", w, s, ref_steps[w]);
+    int first = -1;
+    const int bad = mpimove_differs(&r, y, ref_y[w], n, &first);
+    CHECK(bad == 0, "window %d: %d owned particles differ from one rank's (first: id %d)", w, bad, first);
+    if (w == WINDOWS - 1) break;
+    int64_t neq = -1;
+    st = mfree_migration_set_partitioner(mig, method[w], 1.05);
+    if (st == MFREE_SUCCESS) st = mfree_halo_migrate_fluid(r.halo, mig, r.sys, rebalance[w], y, 5 * (int64_t)n, &neq);
+    CHECK(st == MFREE_SUCCESS, "migration %d: status %d: %s", w, (int)st, mpifluid_error(ctx));
+  }
+  int rebuilds = cw.rebuilds, fewest = 0;
+  MPI_Allreduce(&rebuilds, &fewest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  CHECK(fewest > WINDOWS, "the ghosts were rebuilt %d times", fewest);
+  if (rank == 0)
+    printf("t190: ERKStep on %d ranks: %ld steps in %d windows, %d ghost rebuilds\n", size, total_steps, WINDOWS,
+           cw.rebuilds);
+  mfree_migration_destroy(&mig);
+  rankfluid_free(&r);
+  rankfluid_free(&ref);
+  for (int w = 0; w < WINDOWS; ++w) free(ref_y[w]);
+  free(y), free(owner);
+  damb_free(&b);
+  SUNContext_Free(&self_ctx);
+  SUNContext_Free(&sunctx);
+  mfree_context_destroy(&ctx);
+  const int rc = mpitest_finish("t190-mpisun-fluid-migrate");
+  MPI_Finalize();
+  return rc;
+}
