@@ -8,12 +8,30 @@
 
 #include <cstdint>
 #include <memory>
+#include <new>
 #include <vector>
 
 #include "core/systems/collective.hpp"
 #include "core/systems/fluid.hpp"
 
 namespace mfree {
+
+// The outcome of local work as a report: a rank must reach the next agreement even when
+// its own part failed.
+template <class F>
+Report guarded(F &&f) {
+  Report r;
+  try {
+    r = f();
+  } catch (const Error &e) {
+    r.status = e.status();
+    r.message = e.what();
+  } catch (const std::bad_alloc &) {
+    r.status = MFREE_ERR_ALLOC;
+    r.message = "out of memory";
+  }
+  return r;
+}
 
 class FluidRanks final : public FluidSystem {
  public:
