@@ -105,6 +105,12 @@ void ex_progress_init(ex_progress_t *p, int quiet, double t0, double t1) {
   p->t0 = t0;
   p->t1 = t1;
   p->base = 0;
+  p->f = stderr;
+}
+
+void ex_progress_to(ex_progress_t *p, FILE *f) {
+  p->f = f;
+  p->tty = 1;
 }
 
 int32_t ex_progress(void *user, int64_t step, double t, double dt) {
@@ -116,10 +122,10 @@ int32_t ex_progress(void *user, int64_t step, double t, double dt) {
   if (pct != p->last) {
     p->last = pct;
     const int w = 40, fill = pct * w / 100;
-    fprintf(stderr, "\r[%.*s%*s] %3d%%  t = %.4g s  step %lld", fill,
+    fprintf(p->f, "\r[%.*s%*s] %3d%%  t = %.4g s  step %lld", fill,
             "########################################", w - fill, "", pct, t,
             (long long)(p->base + step));
-    fflush(stderr);
+    fflush(p->f);
   }
   return 0;
 }
@@ -128,7 +134,7 @@ void ex_progress_steps(ex_progress_t *p, int64_t steps) { p->base += steps; }
 
 void ex_progress_done(ex_progress_t *p, const char *what, double t) {
   if (p->quiet) return;
-  if (p->tty && p->last >= 0) fprintf(stderr, "\n");
+  if (p->tty && p->last >= 0) fprintf(p->f, "\n");
   else fprintf(stderr, "%s: integrated to t = %.4g s in %lld steps\n", what, t, (long long)p->base);
 }
 

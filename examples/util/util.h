@@ -50,10 +50,14 @@ typedef struct {
   int last;      /* last percentage drawn */
   double t0, t1; /* the time span of the whole run */
   int64_t base;  /* steps of earlier mfree_system_integrate calls */
+  FILE *f;       /* where the bar is drawn: stderr */
 } ex_progress_t;
 
 /* Start a run over [t0, t1]. */
 void ex_progress_init(ex_progress_t *p, int quiet, double t0, double t1);
+/* Draw the bar on the terminal f instead (e.g. /dev/tty for an MPI rank, whose stderr
+ * mpirun turns into a pipe); unless quiet. */
+void ex_progress_to(ex_progress_t *p, FILE *f);
 /* mfree_progress_fn; user = ex_progress_t *. Never stops the integration. */
 int32_t ex_progress(void *user, int64_t step, double t, double dt);
 /* After each mfree_system_integrate call: add the steps it took. */
