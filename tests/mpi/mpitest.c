@@ -30,6 +30,15 @@ char *slurp(const char *path) {
   return s;
 }
 
+mfree_context_t *mpitest_start(int *argc, char ***argv, int *rank, int *size) {
+  MPI_Init(argc, argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, rank);
+  MPI_Comm_size(MPI_COMM_WORLD, size);
+  mfree_context_t *ctx = NULL;
+  mfree_context_create(&ctx);
+  return ctx;
+}
+
 int mpitest_finish(const char *name) {
   int total = 0, rank = 0;
   MPI_Allreduce(&mpitest_failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);

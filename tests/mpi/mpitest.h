@@ -33,6 +33,10 @@ void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const
 /* The whole file at path, NUL-terminated, to be freed; NULL when it cannot be read. */
 char *slurp(const char *path);
 
+/* The start of every MPI test's main: MPI_Init, this rank and the number of ranks of
+ * MPI_COMM_WORLD, and a fresh context (NULL if it could not be made). */
+mfree_context_t *mpitest_start(int *argc, char ***argv, int *rank, int *size);
+
 /* 0 when no rank failed a check (printed by rank 0), else 1: main's exit code. */
 int mpitest_finish(const char *name);
 

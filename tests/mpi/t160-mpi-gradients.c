@@ -438,12 +438,8 @@ static void run(mfree_context_t *ctx, mfree_halo_t *halo, const cloud_t *c, cons
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
   int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  mfree_context_t *ctx = NULL;
-  mfree_context_create(&ctx);
+  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
   for (int dim = 2; dim <= 3; ++dim) {
     mfree_halo_t *halo = NULL;
     CHECK(mfree_halo_create(ctx, MPI_COMM_WORLD, dim, &halo) == MFREE_SUCCESS, "halo create");

@@ -52,12 +52,8 @@ static int same_bits(const double *a, const double *b, int n, const char *what, 
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
   int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  mfree_context_t *ctx = NULL;
-  mfree_context_create(&ctx);
+  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
   static double u1[N], v1[N], s1[N], u[N], v[N], s[N];
 
   /* the one-rank run: the same system on this rank alone */

@@ -52,12 +52,8 @@ static int one_process_differs(mfree_context_t *ctx, int nx, int nz, int64_t ste
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
   int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  mfree_context_t *ctx = NULL;
-  mfree_context_create(&ctx);
+  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
   damb_t b;
   damb_make(&b, 24, 48); /* three chunks of rows: the one-process fluid's colours reorder its scatter */
   const int n = b.n;

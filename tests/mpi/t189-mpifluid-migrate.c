@@ -19,12 +19,8 @@ enum { NX = 16, NZ = 32, WINDOWS = 4 };
 static const int64_t kWindow = 125;
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
   int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  mfree_context_t *ctx = NULL;
-  mfree_context_create(&ctx);
+  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
   damb_t b;
   damb_make(&b, NX, NZ);
   const int n = b.n;

@@ -28,12 +28,8 @@ static mfree_status_t move(void *user, int32_t nrec, int32_t n_owned, double *re
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
   int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  mfree_context_t *ctx = NULL;
-  mfree_context_create(&ctx);
+  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
   damb_t b;
   damb_make(&b, 12, 24);
   const int n = b.n;

@@ -97,12 +97,8 @@ static outcome_t run(mfree_context_t *ctx, SUNContext sunctx, MPI_Comm comm, con
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
   int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  mfree_context_t *ctx = NULL;
-  mfree_context_create(&ctx);
+  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
   SUNContext sunctx = NULL, self_ctx = NULL;
   MPI_Comm world = MPI_COMM_WORLD, self = MPI_COMM_SELF;
   SUNContext_Create(&world, &sunctx);
