@@ -163,8 +163,8 @@ MFREE_ALWAYS_INLINE double lane(double v, int) { return v; }
 // What the vector extensions cannot say (or GCC does not compile to one instruction), for
 // the AVX2 copies only (defined in the region: a call from baseline code does not
 // compile): the square root and the minimum of a vector, a
-// comparison's sign bits gathered into an int, a byte shuffle by indices known only at
-// run time (Clang's extensions have none) and a masked load (the lanes it skips are
+// comparison's sign bits gathered into an int, a byte shuffle and a lane permutation by
+// indices known only at run time (Clang's extensions have none) and a masked load (the lanes it skips are
 // never read, so they may lie past the end of an array).
 MFREE_AVX2_BEGIN
 namespace x86 {
@@ -182,6 +182,12 @@ MFREE_ALWAYS_INLINE int movemask(const M &m) {
 }
 // r[i] = v[idx[i]], or 0 where idx[i] has its top bit set (pshufb).
 MFREE_ALWAYS_INLINE B16 shuffle_bytes(const B16 &v, const B16 &idx) { return __builtin_ia32_pshufb128(v, idx); }
+// r = the 32-bit lanes of v reordered by idx (vpermps, across the halves): four doubles
+// left-packed by a table of index pairs.
+MFREE_ALWAYS_INLINE V4 permute32(const V4 &v, const I8 &idx) {
+  typedef float F8 __attribute__((vector_size(32)));
+  return (V4)__builtin_ia32_permvarsf256((F8)v, idx);
+}
 // The lanes of p where mask has its top bit set, 0 elsewhere.
 MFREE_ALWAYS_INLINE I8 maskload(const int32_t *p, const I8 &mask) {
   return __builtin_ia32_maskloadd256(reinterpret_cast<const I8 *>(p), mask);

@@ -45,6 +45,7 @@
 #include "core/base/kernel.hpp"
 #include "core/base/parallel.hpp"
 #include "core/particles/particles.hpp"
+#include "core/particles/pair_test.hpp"
 #include "core/base/simd.hpp"
 
 #include "core/particles/neighbors_cell_grid.inc"
@@ -62,6 +63,7 @@ struct VerletLists {
   HVec<int32_t> tmp;   // filtered rows, block by block, before they are placed
   bool built = false;  // cand holds for the settings below
   bool used = false;   // the last search's rows came from cand
+  bool left = false;   // ... and were left to the caller (ParticleSet::set_rows_left)
   // the settings cand was built under (another value rebuilds)
   int32_t n = -1, owned = -1;
   int conv = -1;
@@ -158,13 +160,14 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, N
     verlet_rows(ps, status, sc, out);
     return;
   }
-  sc.verlet.built = sc.verlet.used = false;
+  sc.verlet.built = sc.verlet.used = sc.verlet.left = false;
   search_rows(ps, status, sc, out, 0.0);
   ++sc.searches;
 }
 
 const Csr *neighbor_candidates(const NeighborScratch &sc) { return sc.verlet.used ? &sc.verlet.cand : nullptr; }
 int64_t neighbor_searches(const NeighborScratch &sc) { return sc.searches; }
+bool neighbor_rows_left(const NeighborScratch &sc) { return sc.verlet.used && sc.verlet.left; }
 
 void find_point_neighbors(const ParticleSet &ps, const std::vector<int32_t> &status, int32_t npts,
                           const VectorArray &x, const ScalarArray &h, Csr &out) {

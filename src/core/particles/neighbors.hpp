@@ -26,6 +26,9 @@ void find_neighbors(const ParticleSet &ps, const std::vector<int32_t> &site_stat
 const Csr *neighbor_candidates(const NeighborScratch &scratch);
 // Searches find_neighbors completed with scratch (with a skin: builds of the candidates).
 int64_t neighbor_searches(const NeighborScratch &scratch);
+// Whether the last find_neighbors left its rows to the caller (out has empty rows; see
+// ParticleSet::set_rows_left).
+bool neighbor_rows_left(const NeighborScratch &scratch);
 
 // Neighbours among the particles of ps for each host point (site support hp, the set's
 // convention and kappa), skipping particles with a nonzero status.

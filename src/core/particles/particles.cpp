@@ -171,6 +171,8 @@ void ParticleSet::set_search_skin(double skin) {
 
 int64_t ParticleSet::search_count() const { return scratch_ ? neighbor_searches(*scratch_) : 0; }
 
+bool ParticleSet::rows_left() const { return scratch_ && !host_neighbors() && neighbor_rows_left(*scratch_); }
+
 const Csr &ParticleSet::search_candidates() const {
   const Csr *c = scratch_ ? neighbor_candidates(*scratch_) : nullptr;
   return c && !host_neighbors() ? *c : nbr_;

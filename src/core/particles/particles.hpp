@@ -81,6 +81,16 @@ class ParticleSet {
   // particles, sorted by index, each holding its row of neighbors(); the same lists
   // until search_count() changes); neighbors() itself after a setup without them.
   const Csr &search_candidates() const;
+  // Rows left to the caller (off by default), for a host that filters the candidate lists
+  // in its own pass over them (the fluid's fused rows of linear MLS): with a skin, a setup
+  // whose rows would be filtered from the candidates in 2D (gather convention, no
+  // periodic axis, every particle valid, positions (x, y) packed, no global ids, the AVX2
+  // copy) then leaves them unfiltered, rows_left() is true and neighbors() has empty
+  // rows; the caller keeps the candidates of search_candidates() by pair_test.hpp's test
+  // (the same rows as the set's filter). Other setups filter as usual.
+  void set_rows_left(bool on) { rows_left_ = on; }
+  bool rows_left_wanted() const { return rows_left_ && !gid_; }
+  bool rows_left() const;
   void set_periodic(const double *lo, const double *hi, const int32_t *periodic);
   void set_neighbors(const int64_t *rowptr, const int32_t *cols, int32_t base, int mem);
   // Global ids (NULL: none) and the host's halo width (0: none declared).
@@ -184,6 +194,7 @@ class ParticleSet {
   int convention_ = MFREE_SEARCH_GATHER;
   double kappa_ = 2.0;
   double skin_ = 0.0;
+  bool rows_left_ = false;
   bool periodic_[3] = {false, false, false};
   double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
 

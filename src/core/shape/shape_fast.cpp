@@ -126,6 +126,8 @@ FastPath::FastPath(int dim, int method, int order, const Kernel &kernel, int fla
 #if MFREE_SIMD_X86
   if (simd::use_avx2()) {
     using namespace avx2;
+    filters_ = dim == 2 && cubic && method == MFREE_METHOD_MLS && order == 1 && mls1_rows2_available() &&
+               (flags & MFREE_DERIV_VALUE) && (flags & MFREE_DERIV_GRADIENT);
     switch (dim) {
       case 1: fn_ = cubic ? &block_fn_ret<1, CubicSpline> : &block_fn_ret<1, AnyShape>; break;
       case 2: fn_ = cubic ? &block_fn_ret<2, CubicSpline> : &block_fn_ret<2, AnyShape>; break;

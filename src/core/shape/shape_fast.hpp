@@ -43,6 +43,16 @@ struct FastTables {
   // the others' are left as they were.
   double *coef = nullptr;
   int64_t ncoef = 0;
+  // Rows to filter (kept != nullptr; only where FastPath::filters_rows()): rowptr and
+  // cols are a particle set's candidate lists that it left to the caller
+  // (ParticleSet::set_rows_left), the sites its particles, kappa its search radius factor.
+  // Site s keeps the candidates within kappa sh[s] by the search's pair test
+  // (pair_test.hpp), in their order, at kept[rowptr[s] ..), and its row ends at
+  // rowend[s]; values and gradients go from entry rowptr[s]. The same rows and tables as
+  // from the set's own filter.
+  int32_t *kept = nullptr;
+  int64_t *rowend = nullptr;
+  double kappa = 0.0;
 };
 
 // Per-thread scratch, sized for the longest row before the sites are computed: fourteen
@@ -78,6 +88,10 @@ class FastPath {
   // path must be used for every site.
   FastPath(int dim, int method, int order, const Kernel &kernel, int flags);
   bool ok() const { return fn_ != nullptr; }
+  // Whether run() filters rows (FastTables::kept) for value + gradient tables without
+  // correction records under the gather convention without a periodic axis: the fused
+  // rows of linear MLS in 2D with the cubic spline (shape_fast_mls1.hpp).
+  bool filters_rows() const { return filters_; }
 
   // Rows of the sites [b, e) and their entries of out (see FastSites); the scratch is
   // reserved for the longest row. support: neighbours with non-zero weight; cond:
@@ -96,6 +110,7 @@ class FastPath {
   using Fn = void (*)(const FastPath &, const FastTables &, int64_t, int64_t, FastScratch &,
                      const FastSites &);
   Fn fn_ = nullptr;
+  bool filters_ = false;
   int method_;
   int order_;
   const Kernel *kernel_;

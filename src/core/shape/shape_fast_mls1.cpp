@@ -4,12 +4,16 @@
 // accumulate the moments and factorise in separate passes; here the whole row stays in
 // registers, and the 3x3 moment matrix is inverted in closed form (small_dense.hpp).
 // Same functions as the general path to round-off (tests t404, t432). There is no
-// baseline copy: the baseline fast path takes the general rows.
+// baseline copy: the baseline fast path takes the general rows. Rows left to the caller
+// by a particle set (FastTables::kept) are filtered from its candidates in the pass that
+// computes the offsets, by the search's pair test: the kept offsets are packed as they
+// are computed, so the candidates' positions are read once.
 #include "core/shape/shape_fast_mls1.hpp"
 
 #include "core/base/kernel_eval.hpp"
 #include "core/base/simd.hpp"
 #include "core/base/small_dense.hpp"
+#include "core/particles/pair_test.hpp"
 
 namespace mfree {
 
@@ -61,7 +65,7 @@ MFREE_ALWAYS_INLINE void offsets4(const Row &r, const int32_t *j, int m) {
 }
 
 // The offsets of a row; the last group padded with the row's first neighbour.
-void offsets(const Row &r) {
+MFREE_ALWAYS_INLINE void offsets(const Row &r) {
   const int n = r.n;
   int m = 0;
   for (; m + 4 <= n; m += 4) offsets4(r, r.cc + m, m);
@@ -73,6 +77,90 @@ void offsets(const Row &r) {
   }
 }
 
+// Left-packing by a 4-bit mask k of kept lanes: d[k], the 32-bit lane indices that move
+// the kept doubles of a V4 to its front; b[k], the byte indices that move the kept ids of
+// four to the front (the others zero); n[k], their count.
+struct LeftPack {
+  int32_t d[16][8];
+  char b[16][16];
+  int n[16];
+};
+constexpr LeftPack left_pack() {
+  LeftPack t{};
+  for (int k = 0; k < 16; ++k) {
+    int c = 0;
+    for (int l = 0; l < 4; ++l)
+      if (k >> l & 1) {
+        t.d[k][2 * c] = 2 * l;
+        t.d[k][2 * c + 1] = 2 * l + 1;
+        for (int q = 0; q < 4; ++q) t.b[k][4 * c + q] = static_cast<char>(4 * l + q);
+        ++c;
+      }
+    for (int q = 4 * c; q < 16; ++q) t.b[k][q] = static_cast<char>(0x80);
+    t.n[k] = c;
+  }
+  return t;
+}
+constexpr LeftPack kLeft = left_pack();
+
+// (A) of rows to filter: the candidates j[0..3] kept by the search's pair test on their
+// offsets x_j - x_s, their scaled offsets (offsets4's values) packed to sx, sy at m and
+// their ids (four stored) to out; returns the count kept. Lanes: the valid ones
+// (the last group repeats a candidate); S: the particles' stride when known (0: r.ps).
+template <int S>
+MFREE_ALWAYS_INLINE int filter4(const Row &r, const int32_t *j, int lanes, const V4 &lim2, int32_t *out, int m) {
+  const int64_t ps = S > 0 ? S : r.ps;
+  V2 p0, p1, p2, p3;
+  simd::load<2>(p0, r.P + ps * j[0]);
+  simd::load<2>(p1, r.P + ps * j[1]);
+  simd::load<2>(p2, r.P + ps * j[2]);
+  simd::load<2>(p3, r.P + ps * j[3]);
+  V4 lo, hi;
+  simd::concat(lo, p0, p2);
+  simd::concat(hi, p1, p3);
+  const V4 dx = MFREE_SHUF(lo, hi, 0, 4, 2, 6) - r.xk, dy = MFREE_SHUF(lo, hi, 1, 5, 3, 7) - r.yk;
+  const int k = pair_test::within4(dx, dy, lim2) & lanes;
+  simd::x86::I8 idx;
+  std::memcpy(&idx, kLeft.d[k], sizeof idx);
+  simd::store<4>(r.sx + m, simd::x86::permute32(dx * r.ih, idx));
+  simd::store<4>(r.sy + m, simd::x86::permute32(dy * r.ih, idx));
+  simd::x86::B16 ids, sh;
+  std::memcpy(&ids, j, sizeof ids);
+  std::memcpy(&sh, kLeft.b[k], sizeof sh);
+  const simd::x86::B16 packed = simd::x86::shuffle_bytes(ids, sh);
+  std::memcpy(out, &packed, sizeof packed);
+  return kLeft.n[k];
+}
+
+// The row of the nc candidates cc within lim2 of the site, in their order: the ids to
+// kept, the offsets as offsets() writes them for those ids (the last group padded with
+// the first's); returns the count. Room: the block's candidates go on for three past the
+// row, whose last group then reads them (masked off) and stores four ids, at most three
+// past the row (into the next rows of the block, written after this one).
+template <int S>
+MFREE_ALWAYS_INLINE int filtered_offsets(const Row &r, const int32_t *cc, int nc, double lim2, int32_t *kept,
+                                         bool room) {
+  const V4 lv = {lim2, lim2, lim2, lim2};
+  int n = 0, p = 0;
+  for (; p + 4 <= nc; p += 4) n += filter4<S>(r, cc + p, 15, lv, kept + n, n);  // (n <= p: within the row)
+  if (p < nc) {
+    const int rest = nc - p;  // 1, 2 or 3
+    if (room) {  // (the lanes past the row: the next rows' candidates, masked off)
+      n += filter4<S>(r, cc + p, (1 << rest) - 1, lv, kept + n, n);
+    } else {
+      const int32_t jt[4] = {cc[p], rest > 1 ? cc[p + 1] : cc[p], rest > 2 ? cc[p + 2] : cc[p], cc[p]};
+      int32_t tail[4];
+      const int kn = filter4<S>(r, jt, (1 << rest) - 1, lv, tail, n);
+      for (int l = 0; l < kn; ++l) kept[n + l] = tail[l];
+      n += kn;
+    }
+  }
+  const V4 x0 = {r.sx[0], r.sx[0], r.sx[0], r.sx[0]}, y0 = {r.sy[0], r.sy[0], r.sy[0], r.sy[0]};
+  simd::store<4>(r.sx + n, x0);
+  simd::store<4>(r.sy + n, y0);
+  return n;
+}
+
 // (B) r = |s_j|, the cubic spline's shape f = 1 - 3/2 r^2 + 3/4 r^3 (r < 1), (2 - r)^3 / 4
 // (1 <= r < 2) and gf = -f'(r) / r = 3 - 9/4 r, 3/4 (2 - r)^2 / r in Horner form with a
 // blend, the padded lanes' weights zero; then the moment sums. The weights lack the
@@ -81,40 +169,54 @@ void offsets(const Row &r) {
 // the stored gf: two short loops keep their sums in registers (one loop spilled 9 of 15)
 // and let the out-of-order core overlap the square roots and divisions of successive
 // groups.
-void moments(const Row &r, Moments &mo) {
+// The weights of the group at m and its terms of the 6 sums of M (Last: the row's last
+// group, whose lanes past n get zero weights; the others have none).
+struct SumsM {
+  V4 a0, a1, a2, a11, a12, a22, cnt;
+};
+template <bool Last>
+MFREE_ALWAYS_INLINE void weights4(const Row &r, int m, SumsM &a) {
   using S = CubicSplineShape;
   static_assert(S::a0 == 1.0, "win adds one for a0");
-  const int n = r.n;
   const V4 lanes = {0.0, 1.0, 2.0, 3.0}, zero = {}, one = zero + 1.0;
-  V4 a0 = {}, a1 = {}, a2 = {}, a11 = {}, a12 = {}, a22 = {}, cnt = {};
-  for (int m = 0; m < n; m += 4) {
-    V4 x1, x2;
-    simd::load<4>(x1, r.sx + m);
-    simd::load<4>(x2, r.sy + m);
-    const V4 r2 = x1 * x1 + x2 * x2;
-    const V4 q = simd::x86::sqrt(r2);
-    const V4 win = r2 * (S::a3 * q + S::a2) + 1.0;
-    const V4 gin = -2.0 * S::a2 - 3.0 * S::a3 * q;
-    V4 bq = 2.0 - q;
-    bq = bq > 0.0 ? bq : zero;
-    const V4 bb = bq * bq;
-    const V4 wout = S::b3 * bb * bq;
-    const V4 gout = 3.0 * S::b3 * bb / q;  // q >= 1 where taken
-    const auto valid = lanes + static_cast<double>(m) < static_cast<double>(n);
-    const auto inner = q < 1.0;
-    const V4 w = valid ? (inner ? win : wout) : zero;
-    const V4 g = valid ? (inner ? gin : gout) : zero;
-    simd::store<4>(r.wv + m, w);
-    simd::store<4>(r.gv + m, g);
-    cnt += w > 0.0 ? one : zero;
-    const V4 wx = w * x1, wy = w * x2;
-    a0 += w;
-    a1 += wx;
-    a2 += wy;
-    a11 += wx * x1;
-    a12 += wx * x2;
-    a22 += wy * x2;
+  V4 x1, x2;
+  simd::load<4>(x1, r.sx + m);
+  simd::load<4>(x2, r.sy + m);
+  const V4 r2 = x1 * x1 + x2 * x2;
+  const V4 q = simd::x86::sqrt(r2);
+  const V4 win = r2 * (S::a3 * q + S::a2) + 1.0;
+  const V4 gin = -2.0 * S::a2 - 3.0 * S::a3 * q;
+  V4 bq = 2.0 - q;
+  bq = bq > 0.0 ? bq : zero;
+  const V4 bb = bq * bq;
+  const V4 wout = S::b3 * bb * bq;
+  const V4 gout = 3.0 * S::b3 * bb / q;  // q >= 1 where taken
+  const auto inner = q < 1.0;
+  V4 w = inner ? win : wout, g = inner ? gin : gout;
+  if (Last) {
+    const auto valid = lanes + static_cast<double>(m) < static_cast<double>(r.n);
+    w = valid ? w : zero;
+    g = valid ? g : zero;
   }
+  simd::store<4>(r.wv + m, w);
+  simd::store<4>(r.gv + m, g);
+  a.cnt += w > 0.0 ? one : zero;
+  const V4 wx = w * x1, wy = w * x2;
+  a.a0 += w;
+  a.a1 += wx;
+  a.a2 += wy;
+  a.a11 += wx * x1;
+  a.a12 += wx * x2;
+  a.a22 += wy * x2;
+}
+
+MFREE_ALWAYS_INLINE void moments(const Row &r, Moments &mo) {
+  const int n = r.n;
+  SumsM sa = {};
+  int m = 0;
+  for (; m + 4 <= n; m += 4) weights4<false>(r, m, sa);
+  if (m < n) weights4<true>(r, m, sa);
+  V4 &a0 = sa.a0, &a1 = sa.a1, &a2 = sa.a2, &a11 = sa.a11, &a12 = sa.a12, &a22 = sa.a22, &cnt = sa.cnt;
   V4 b1 = {}, b2 = {}, b11 = {}, b12 = {}, b22 = {}, b111 = {}, b112 = {}, b122 = {}, b222 = {};
   for (int m = 0; m < n; m += 4) {
     V4 x1, x2, g;
@@ -151,7 +253,7 @@ void moments(const Row &r, Moments &mo) {
 struct Coefs {
   double g0, g1, g2, c00, c01, c02, c10, c11, c12;
 };
-bool solve(const Moments &mo, double ih, double min_rcond, Coefs &k, double &cond) {
+MFREE_ALWAYS_INLINE bool solve(const Moments &mo, double ih, double min_rcond, Coefs &k, double &cond) {
   const double A[3][3] = {{mo.A00, mo.A01, mo.A02}, {mo.A01, mo.A11, mo.A12}, {mo.A02, mo.A12, mo.A22}};
   double X[3][3];
   if (mo.support < 3 || !dense::spd_inverse3(A, X, cond) || !(1.0 / cond >= min_rcond)) return false;
@@ -179,7 +281,7 @@ bool solve(const Moments &mo, double ih, double min_rcond, Coefs &k, double &con
 // (D) N_j = w_j g.p_j, N_j,c = w_j g_,c.p_j + gf_j s_c / h g.p_j, four at a time, the
 // gradients interleaved (x, y). The padded last group is stored lane by lane: the next
 // row, or the next block (another thread), starts right after it.
-void outputs(const Row &r, const Coefs &k, double *Nk, double *Gk) {
+MFREE_ALWAYS_INLINE void outputs(const Row &r, const Coefs &k, double *Nk, double *Gk) {
   const int n = r.n;
   for (int q = 0; q < n; q += 4) {
     V4 x1, x2, w, gf;
@@ -219,10 +321,13 @@ void outputs(const Row &r, const Coefs &k, double *Nk, double *Gk) {
 }  // namespace avx2
 }  // namespace
 
-// Row by row: (A) offsets, (B) weights and moments, (C) the 3x3 solve, its condition
-// number the general path's (see spd_inverse3), (D) the values and gradients.
-void mls1_rows2_avx2(const FastTables &t, int64_t b, int64_t e, double min_rcond, FastScratch &ws,
-                     const FastSites &out) {
+// Row by row: (A) offsets (of the kept candidates for Filter), (B) weights and moments,
+// (C) the 3x3 solve, its condition number the general path's (see spd_inverse3), (D) the
+// values and gradients.
+namespace {
+template <bool Filter>
+void mls1_rows2(const FastTables &t, int64_t b, int64_t e, double min_rcond, FastScratch &ws,
+                const FastSites &out) {
   avx2::Row r;
   r.P = t.x[0];
   r.ps = t.stride;
@@ -230,21 +335,33 @@ void mls1_rows2_avx2(const FastTables &t, int64_t b, int64_t e, double min_rcond
   r.sy = ws.d(2);
   r.wv = ws.d(4);
   r.gv = ws.d(6);
+  const int64_t kend = t.rowptr[e];
   for (int64_t s = b; s < e; ++s) {
     if (out.pst && out.pst[s] != 0) {  // failed in the set: an empty row
       out.status[s] = out.pst[s];
       out.support[s] = 0;
       out.cond[s] = 1.0;
       out.order[s] = -1;
+      if (Filter) t.rowend[s] = t.rowptr[s];
       continue;
     }
     const int64_t k0 = t.rowptr[s];
-    r.n = static_cast<int>(t.rowptr[s + 1] - k0);
-    r.cc = t.cols + k0;
-    r.ih = 1.0 / t.sh[s * t.shstride];
+    const double hs = t.sh[s * t.shstride];
+    r.ih = 1.0 / hs;
     r.xk = t.sx[0][s * t.sstride];
     r.yk = t.sx[1][s * t.sstride];
-    avx2::offsets(r);
+    if (Filter) {
+      const int nc = static_cast<int>(t.rowptr[s + 1] - k0);
+      const double lim2 = pair_test::limit2(t.kappa * hs);
+      const bool room = t.rowptr[s + 1] + 3 <= kend;
+      r.n = t.stride == 2 ? avx2::filtered_offsets<2>(r, t.cols + k0, nc, lim2, t.kept + k0, room)
+                          : avx2::filtered_offsets<0>(r, t.cols + k0, nc, lim2, t.kept + k0, room);
+      t.rowend[s] = k0 + r.n;
+    } else {
+      r.n = static_cast<int>(t.rowptr[s + 1] - k0);
+      r.cc = t.cols + k0;
+      avx2::offsets(r);
+    }
     avx2::Moments mo;
     avx2::moments(r, mo);
     avx2::Coefs k;
@@ -259,6 +376,13 @@ void mls1_rows2_avx2(const FastTables &t, int64_t b, int64_t e, double min_rcond
     out.order[s] = out.order_used;
     avx2::outputs(r, k, t.val + k0, t.grad + 2 * k0);
   }
+}
+}  // namespace
+
+void mls1_rows2_avx2(const FastTables &t, int64_t b, int64_t e, double min_rcond, FastScratch &ws,
+                     const FastSites &out) {
+  if (t.kept) mls1_rows2<true>(t, b, e, min_rcond, ws, out);
+  else mls1_rows2<false>(t, b, e, min_rcond, ws, out);
   MFREE_ZERO_UPPER();
 }
 MFREE_AVX2_END

@@ -17,7 +17,8 @@ bool mls1_rows2_available();
 // support and the condition number of the moment matrix where the MLS rows are done,
 // kFastPending where the moment matrix is not positive definite or is singular to the
 // general path's threshold min_rcond on the reciprocal condition number (the general
-// path decides). Call only when simd::use_avx2() and mls1_rows2_available().
+// path decides). With t.kept, the rows are filtered from candidate lists as
+// FastTables says. Call only when simd::use_avx2() and mls1_rows2_available().
 void mls1_rows2_avx2(const FastTables &t, int64_t b, int64_t e, double min_rcond,
                      FastScratch &w, const FastSites &out);
 

@@ -23,19 +23,28 @@ Report FluidSystem::candidates(const double *xn) {
   if (ps_.search_skin() != skin) ps_.set_search_skin(skin);
   ps_.set_positions(xn, MFREE_LAYOUT_AOS, dim, MFREE_BORROW);
   xbound_ = xn;
+  ps_.set_rows_left(fast_->filters_rows() && !vci_);
   Report r = ps_.setup();
   if (!r.ok()) {
     lists_valid_ = false;
     return r;
   }
-  const Csr &nb = ps_.neighbors();
-  rb_ = nb.rowptr.data();
-  re_ = rb_ + 1;
-  cols_ = nb.cols.data();
-  if (lists_valid_ && ps_.search_count() == cand_search_) return Report();
-  // new candidate lists: the tables' rows lie in them until the next build
   const Csr &cand = ps_.search_candidates();
   const int64_t cnnz = cand.nnz();
+  if (ps_.rows_left()) {  // (sized for the candidates: no allocation until they grow)
+    if (kept_.size() < static_cast<size_t>(cnnz)) kept_.resize(cnnz);
+    if (rowend_.size() < static_cast<size_t>(nall)) rowend_.resize(nall);
+    rb_ = cand.rowptr.data();
+    re_ = rowend_.data();
+    cols_ = kept_.data();
+  } else {
+    const Csr &nb = ps_.neighbors();
+    rb_ = nb.rowptr.data();
+    re_ = rb_ + 1;
+    cols_ = nb.cols.data();
+  }
+  if (lists_valid_ && ps_.search_count() == cand_search_) return Report();
+  // new candidate lists: the tables' rows lie in them until the next build
   N_.resize(cnnz);
   G_.resize(cnnz * dim);
   cond_.resize(nall);
@@ -125,6 +134,17 @@ namespace {
 // The methods whose rows read the particles' volumes (the others get the positions).
 bool weights_volumes(int method) { return method != MFREE_METHOD_MLS; }
 
+// Node k's place in its row of len sorted columns (it is its own neighbour at distance
+// 0): the lower bound by halving without a branch (selects, no mispredicted jumps).
+int32_t row_place(const int32_t *row, int64_t len, int32_t k) {
+  const int32_t *at = row;
+  if (len > 0) {
+    for (; len > 1; len -= len / 2) at = at[len / 2] < k ? at + len / 2 : at;
+    at += *at < k;
+  }
+  return static_cast<int32_t>(at - row);
+}
+
 }  // namespace
 
 bool FluidSystem::table_rows(int t, int32_t k0, int32_t k1, const double *xn, const double *pack, bool transpose) {
@@ -143,6 +163,14 @@ bool FluidSystem::table_rows(int t, int32_t k0, int32_t k1, const double *xn, co
   ft.hstride = ft.shstride = 0;
   ft.val = N_.data();
   ft.grad = G_.data();
+  const bool left = ps_.rows_left();
+  if (left) {  // the fast path filters the candidates (FastPath::filters_rows)
+    const Csr &cand = ps_.search_candidates();
+    ft.cols = cand.cols.data();
+    ft.kept = kept_.data();
+    ft.rowend = rowend_.data();
+    ft.kappa = ps_.kappa();
+  }
   FastSites fs;
   fs.status = site_status_.data();
   fs.support = site_support_.data();
@@ -152,17 +180,9 @@ bool FluidSystem::table_rows(int t, int32_t k0, int32_t k1, const double *xn, co
   const bool fast = fast_->ok();
   for (int32_t c0 = k0; c0 < k1; c0 += kChunk) {
     const int32_t c1 = std::min(k1, c0 + kChunk);
-    for (int32_t k = c0; k < c1; ++k) {
-      // the node's place in its row (sorted; it is its own neighbour at distance 0): the
-      // lower bound by halving without a branch (selects, no mispredicted jumps)
-      const int32_t *row = cols_ + rb_[k], *at = row;
-      int64_t len = re_[k] - rb_[k];
-      if (len > 0) {
-        for (; len > 1; len -= len / 2) at = at[len / 2] < k ? at + len / 2 : at;
-        at += *at < k;
-      }
-      self_[k] = static_cast<int32_t>(at - row);
-    }
+    // (the filtering rows do not read the places; general_row finds its own)
+    if (!left)
+      for (int32_t k = c0; k < c1; ++k) self_[k] = row_place(cols_ + rb_[k], re_[k] - rb_[k], k);
     if (fast) fast_->run(ft, c0, c1, w.fast, fs);
     for (int32_t k = c0; k < c1; ++k) {
       const bool done = fast && site_status_[k] != kFastPending;
@@ -209,7 +229,7 @@ void FluidSystem::general_row(int32_t k, const double *xn, RowsScratch &w, bool 
   }
   LocalInput in;
   in.n = n;
-  in.self = self_[k];
+  in.self = row_place(js, n, k);
   in.hs = h_;
   in.d = d;
   in.vol = w.v.data();
@@ -244,6 +264,7 @@ Report FluidSystem::prepare(const double *y, bool checked) {
     for (int64_t i = b; i < e; ++i) vol_[i] = mass_[i] / rho[i];
   });
   if (!kernel_) kernel_ = std::make_unique<Kernel>(kernel_id_, dim, kernel_param_);
+  if (!fast_) fast_ = std::make_unique<FastPath>(dim, method_, order_, *kernel_, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT);
   const double *xn = node_positions(y);  // + dummies (fluid_wall.cpp)
   Report r = candidates(xn);
   if (!r.ok()) return r;
@@ -251,7 +272,6 @@ Report FluidSystem::prepare(const double *y, bool checked) {
   const int64_t nchunk = (nall + kChunk - 1) / kChunk;  // the tables are written by chunks
   const bool transpose = vci_;  // only consistent integration reads NT_ (fluid_wall.cpp)
   if (transpose && NT_.size() < N_.size() * (dim + 1)) NT_.resize(N_.size() * (dim + 1));
-  if (!fast_) fast_ = std::make_unique<FastPath>(dim, method_, order_, *kernel_, MFREE_DERIV_VALUE | MFREE_DERIV_GRADIENT);
   if (rows_scratch_.size() < static_cast<size_t>(nt)) rows_scratch_.resize(nt);
   const int maxrow = static_cast<int>(maxrow_);
   for (int t = 0; t < nt; ++t) {  // sized for the longest row: no allocation in the rows
