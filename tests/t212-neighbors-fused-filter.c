@@ -6,7 +6,8 @@
  * and the library's MLS approximant on it (order 1, cubic spline, the same support:
  * the same fused kernel without the filter). On a jittered patch in a shear flow that
  * moves neighbours relative to each other by more than the skin (0.25 h) over the run,
- * so that the candidates are reused and rebuilt, at every step, on one and two threads:
+ * so that the candidates are reused and rebuilt, and on the lattice without jitter (pairs
+ * at exactly the support radius), at every step, on one and two threads:
  * - the pattern of the interpolation matrix S_kj = N_j(x_k) is the approximant's, entry
  *   for entry (pairs at exactly 2h included: the closed support);
  * - S equals the approximant's value table bitwise at every site where both take the MLS
@@ -31,14 +32,15 @@ enum { L = 48, N = L * L, DIM = 2 };
 static const double D = 0.005, RHO0 = 1000.0, G = 9.81, GAMMA = 7.0, U = 5.0;
 static const double HS = 1.5 * 0.005; /* smoothing length h = 1.5 D, support 2h */
 
-/* Jittered lattice, uniform density, shear flow v_0 = U sin(2 pi y / (8 D)). */
-static double *sheared_patch(double *m) {
+/* Lattice (jittered by up to jitter D), uniform density, shear flow v_0 = U sin(2 pi y /
+ * (8 D)). */
+static double *sheared_patch(double *m, double jitter) {
   double *y = calloc((2 * (size_t)DIM + 1) * N, sizeof(double));
   mfree_rng_t r;
   mfree_rng_seed(&r, 212);
   for (int p = 0; p < N; ++p) {
-    y[DIM * p] = (p % L + 0.5) * D + 0.2 * D * (2 * mfree_rng_uniform(&r) - 1);
-    y[DIM * p + 1] = (p / L + 0.5) * D + 0.2 * D * (2 * mfree_rng_uniform(&r) - 1);
+    y[DIM * p] = (p % L + 0.5) * D + jitter * D * (2 * mfree_rng_uniform(&r) - 1);
+    y[DIM * p + 1] = (p / L + 0.5) * D + jitter * D * (2 * mfree_rng_uniform(&r) - 1);
     y[(size_t)DIM * N + DIM * p] = U * sin(2.0 * M_PI * y[DIM * p + 1] / (8.0 * D));
     y[2 * (size_t)DIM * N + p] = RHO0;
     m[p] = RHO0 * D * D;
@@ -78,10 +80,10 @@ static void reference(const double *y, int64_t *rp, int32_t **cols, double **val
 
 /* Runs the patch for `steps` leap-frog steps on `threads` threads, checking S against
  * the reference after every step; the final state to yout. Returns the rows compared. */
-static int run(int threads, int steps, double *yout) {
+static int run(int threads, int steps, double jitter, double *yout) {
   assert_ok(ctx, mfree_context_set_num_threads(ctx, threads));
   double *m = malloc((size_t)N * sizeof(double));
-  double *y = sheared_patch(m);
+  double *y = sheared_patch(m, jitter);
   const double kappa = 100.0 * RHO0 * 2.0 * G * (L * D) / GAMMA; /* 003 eq 125 */
   mfree_system_t *sys = NULL;
   assert_ok(ctx, mfree_system_create_fluid(ctx, DIM, N, &sys));
@@ -142,11 +144,10 @@ enum { STEPS = 12 };
 enum { STEPS = 6 };
 #endif
 
-static void test_fused_equals_unfused(void **s) {
-  (void)s;
+static void fused_equals_unfused(double jitter) {
   const size_t ny = (2 * (size_t)DIM + 1) * N;
   double *y1 = malloc(ny * sizeof(double)), *y2 = malloc(ny * sizeof(double));
-  const int c1 = run(1, STEPS, y1), c2 = run(2, STEPS, y2);
+  const int c1 = run(1, STEPS, jitter, y1), c2 = run(2, STEPS, jitter, y2);
   assert_true(c1 > STEPS * N / 2);
   assert_int_equal(c1, c2);
   if (memcmp(y1, y2, ny * sizeof(double)) != 0) fail_msg("the states after %d steps differ on 1 and 2 threads", STEPS);
@@ -154,9 +155,21 @@ static void test_fused_equals_unfused(void **s) {
   free(y2);
 }
 
+static void test_jittered(void **s) {
+  (void)s;
+  fused_equals_unfused(0.2);
+}
+
+/* pairs at exactly the support radius 2h = 3 D along the lattice's axes */
+static void test_lattice(void **s) {
+  (void)s;
+  fused_equals_unfused(0.0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_fused_equals_unfused),
+      cmocka_unit_test(test_jittered),
+      cmocka_unit_test(test_lattice),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -77,13 +77,17 @@ MFREE_ALWAYS_INLINE void offsets(const Row &r) {
   }
 }
 
-// Left-packing by a 4-bit mask k of kept lanes: d[k], the 32-bit lane indices that move
-// the kept doubles of a V4 to its front; b[k], the byte indices that move the kept ids of
-// four to the front (the others zero); n[k], their count.
+// Left-packing by a 4-bit mask k of kept lanes, entry e[k] (64 bytes: one index
+// computation per group): d, the 32-bit lane indices that move the kept doubles of a V4
+// to its front; b, the byte indices that move the kept ids of four to the front (the
+// others zero); n, their count.
+struct alignas(64) LeftPackEntry {
+  int32_t d[8];
+  char b[16];
+  int n;
+};
 struct LeftPack {
-  int32_t d[16][8];
-  char b[16][16];
-  int n[16];
+  LeftPackEntry e[16];
 };
 constexpr LeftPack left_pack() {
   LeftPack t{};
@@ -91,13 +95,13 @@ constexpr LeftPack left_pack() {
     int c = 0;
     for (int l = 0; l < 4; ++l)
       if (k >> l & 1) {
-        t.d[k][2 * c] = 2 * l;
-        t.d[k][2 * c + 1] = 2 * l + 1;
-        for (int q = 0; q < 4; ++q) t.b[k][4 * c + q] = static_cast<char>(4 * l + q);
+        t.e[k].d[2 * c] = 2 * l;
+        t.e[k].d[2 * c + 1] = 2 * l + 1;
+        for (int q = 0; q < 4; ++q) t.e[k].b[4 * c + q] = static_cast<char>(4 * l + q);
         ++c;
       }
-    for (int q = 4 * c; q < 16; ++q) t.b[k][q] = static_cast<char>(0x80);
-    t.n[k] = c;
+    for (int q = 4 * c; q < 16; ++q) t.e[k].b[q] = static_cast<char>(0x80);
+    t.e[k].n = c;
   }
   return t;
 }
@@ -119,17 +123,18 @@ MFREE_ALWAYS_INLINE int filter4(const Row &r, const int32_t *j, int lanes, const
   simd::concat(lo, p0, p2);
   simd::concat(hi, p1, p3);
   const V4 dx = MFREE_SHUF(lo, hi, 0, 4, 2, 6) - r.xk, dy = MFREE_SHUF(lo, hi, 1, 5, 3, 7) - r.yk;
-  const int k = pair_test::within4(dx, dy, lim2) & lanes;
+  const int k = lanes == 15 ? pair_test::within4(dx, dy, lim2) : pair_test::within4(dx, dy, lim2) & lanes;
+  const LeftPackEntry &pk = kLeft.e[k];
   simd::x86::I8 idx;
-  std::memcpy(&idx, kLeft.d[k], sizeof idx);
+  std::memcpy(&idx, pk.d, sizeof idx);
   simd::store<4>(r.sx + m, simd::x86::permute32(dx * r.ih, idx));
   simd::store<4>(r.sy + m, simd::x86::permute32(dy * r.ih, idx));
   simd::x86::B16 ids, sh;
   std::memcpy(&ids, j, sizeof ids);
-  std::memcpy(&sh, kLeft.b[k], sizeof sh);
+  std::memcpy(&sh, pk.b, sizeof sh);
   const simd::x86::B16 packed = simd::x86::shuffle_bytes(ids, sh);
   std::memcpy(out, &packed, sizeof packed);
-  return kLeft.n[k];
+  return pk.n;
 }
 
 // The row of the nc candidates cc within lim2 of the site, in their order: the ids to
@@ -281,41 +286,46 @@ MFREE_ALWAYS_INLINE bool solve(const Moments &mo, double ih, double min_rcond, C
 // (D) N_j = w_j g.p_j, N_j,c = w_j g_,c.p_j + gf_j s_c / h g.p_j, four at a time, the
 // gradients interleaved (x, y). The padded last group is stored lane by lane: the next
 // row, or the next block (another thread), starts right after it.
+// The group at q, of which rest (1-4) lanes are the row's.
+MFREE_ALWAYS_INLINE void outputs4(const Row &r, const Coefs &k, int q, int rest, double *Nk, double *Gk) {
+  V4 x1, x2, w, gf;
+  simd::load<4>(x1, r.sx + q);
+  simd::load<4>(x2, r.sy + q);
+  simd::load<4>(w, r.wv + q);
+  simd::load<4>(gf, r.gv + q);
+  const V4 gp = k.g2 * x2 + (k.g1 * x1 + k.g0);
+  const V4 gq = gf * r.ih * gp;
+  const V4 Nv = w * gp;
+  const V4 gx = w * (k.c02 * x2 + (k.c01 * x1 + k.c00)) + gq * x1;
+  const V4 gy = w * (k.c12 * x2 + (k.c11 * x1 + k.c10)) + gq * x2;
+  const V4 o0 = MFREE_SHUF(gx, gy, 0, 4, 1, 5), o1 = MFREE_SHUF(gx, gy, 2, 6, 3, 7);
+  double *N = Nk + q, *G = Gk + 2 * q;
+  switch (rest) {
+    case 1:
+      simd::store<1>(N, Nv);
+      simd::store<2>(G, o0);
+      break;
+    case 2:
+      simd::store<2>(N, Nv);
+      simd::store<4>(G, o0);
+      break;
+    case 3:
+      simd::store<3>(N, Nv);
+      simd::store<4>(G, o0);
+      simd::store<2>(G + 4, o1);
+      break;
+    default:
+      simd::store<4>(N, Nv);
+      simd::store<4>(G, o0);
+      simd::store<4>(G + 4, o1);
+  }
+}
+
 MFREE_ALWAYS_INLINE void outputs(const Row &r, const Coefs &k, double *Nk, double *Gk) {
   const int n = r.n;
-  for (int q = 0; q < n; q += 4) {
-    V4 x1, x2, w, gf;
-    simd::load<4>(x1, r.sx + q);
-    simd::load<4>(x2, r.sy + q);
-    simd::load<4>(w, r.wv + q);
-    simd::load<4>(gf, r.gv + q);
-    const V4 gp = k.g2 * x2 + (k.g1 * x1 + k.g0);
-    const V4 gq = gf * r.ih * gp;
-    const V4 Nv = w * gp;
-    const V4 gx = w * (k.c02 * x2 + (k.c01 * x1 + k.c00)) + gq * x1;
-    const V4 gy = w * (k.c12 * x2 + (k.c11 * x1 + k.c10)) + gq * x2;
-    const V4 o0 = MFREE_SHUF(gx, gy, 0, 4, 1, 5), o1 = MFREE_SHUF(gx, gy, 2, 6, 3, 7);
-    double *N = Nk + q, *G = Gk + 2 * q;
-    switch (n - q) {
-      case 1:
-        simd::store<1>(N, Nv);
-        simd::store<2>(G, o0);
-        break;
-      case 2:
-        simd::store<2>(N, Nv);
-        simd::store<4>(G, o0);
-        break;
-      case 3:
-        simd::store<3>(N, Nv);
-        simd::store<4>(G, o0);
-        simd::store<2>(G + 4, o1);
-        break;
-      default:
-        simd::store<4>(N, Nv);
-        simd::store<4>(G, o0);
-        simd::store<4>(G + 4, o1);
-    }
-  }
+  int q = 0;
+  for (; q + 4 <= n; q += 4) outputs4(r, k, q, 4, Nk, Gk);
+  if (q < n) outputs4(r, k, q, n - q, Nk, Gk);
 }
 
 }  // namespace avx2
