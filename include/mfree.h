@@ -1757,7 +1757,8 @@ MFREE_API mfree_status_t mfree_system_set_approximation(mfree_system_t *sys,
  * Dummy wall particles ([Adami2012]; not in [CuetoFelgueroso2004]): fixed particles
  * filling the solid past the walls, at least 4h - d deep, with the pressure
  * extrapolated from the fluid; they give fluid nodes near a wall full supports and the
- * wall traction (docs/fluid.md). May be combined with the wall force.
+ * wall traction (docs/fluid.md). May be combined with the wall force. Not for the fluid
+ * on ranks (MFREE_ERR_UNSUPPORTED; docs/fluid-ranks.md).
  * @param[in] sys      a fluid system
  * @param[in] n        number of dummy particles; 0 removes them (the default)
  * @param[in] x        positions, dim per particle (AoS; copied)
@@ -1917,7 +1918,9 @@ MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
  * (2 dim + 1) n (docs/fluid.md, "Inflow and outflow"). Dormant particles keep their entries
  * in y, get zero rates and take no part in the nodes, the checks or the step. The native
  * integrator updates the boundaries between steps; a host integrating with SUNDIALS calls
- * mfree_system_update_open_boundaries between its windows. */
+ * mfree_system_update_open_boundaries between its windows. The fluid on ranks has no open
+ * boundaries: the setters and the update return MFREE_ERR_UNSUPPORTED there, and every
+ * owned particle is active. */
 
 /** States of a fluid's particles (mfree_system_get_active). */
 typedef enum {
@@ -1997,8 +2000,8 @@ MFREE_API mfree_status_t mfree_system_update_open_boundaries(mfree_system_t *sys
  * Number of active particles and, optionally, every particle's mfree_particle_state_t.
  * @param[in]  sys      a fluid system
  * @param[out] nactive  active particles (fluid and buffer)
- * @param[in]  n        values state holds: the system's particle count (else
- *                      MFREE_ERR_ARG; ignored when state is NULL)
+ * @param[in]  n        values state holds: the system's particle count (on ranks the
+ *                      owned count; else MFREE_ERR_ARG; ignored when state is NULL)
  * @param[out] state    n values, or NULL
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL nactive
  */

@@ -6,7 +6,15 @@
  * regions, HSFC with new regions, HSFC in the last regions: the particles that crossed
  * into another rank's region move there). After every window every owned particle's
  * position, velocity and density are bitwise those of the one-rank run (MPI_COMM_SELF,
- * the same windows), matched by global id, with the same steps and time. */
+ * the same windows), matched by global id, with the same steps and time.
+ *
+ * Built with FLUID_OPTIONS (t174), the program runs the same with one option of the
+ * one-process fluid set on every system, named by its argument: density diffusion
+ * (delta 0.1), velocity smoothing (beta 0.1), consistent integration or the lumped-mass
+ * step. Then also, on every rank, the one-process fluid (mfree_system_create_fluid, 512
+ * particles: one chunk of rows, its scatter in the rank's order) with the option takes
+ * the same steps to the same bits as the one-rank run after every window, and without
+ * the option it ends elsewhere (the option acts). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,8 +23,52 @@
 #include "mpimove.h"
 #include "mpitest.h"
 
+#ifndef TEST_NAME
+#define TEST_NAME "t189-mpifluid-migrate"
+#endif
+
 enum { NX = 16, NZ = 32, WINDOWS = 4 };
 static const int64_t kWindow = 125;
+
+#ifdef FLUID_OPTIONS
+/* The option named opt set on sys (NULL: none). */
+static mfree_status_t set_option(mfree_system_t *sys, const char *opt) {
+  if (!opt) return MFREE_SUCCESS;
+  if (!strcmp(opt, "diffusion")) return mfree_system_set_density_diffusion(sys, 0.1);
+  if (!strcmp(opt, "smoothing")) return mfree_system_set_velocity_smoothing(sys, 0.1);
+  if (!strcmp(opt, "vci")) return mfree_system_set_consistent_integration(sys, 1);
+  if (!strcmp(opt, "lumped-step")) return mfree_system_set_lumped_mass_step(sys, 1);
+  return MFREE_ERR_ARG;
+}
+
+/* The one-process fluid with option opt (or none) through the windows: 0 when it takes
+   steps[w] steps to t[w] and the state ref[w] bit for bit after every window; without
+   compare, 0 when its last state differs from ref's. */
+static int one_process_differs(mfree_context_t *ctx, const damb_t *b, const char *opt, double *const *ref,
+                               const int64_t *steps_ref, const double *t_ref, int compare) {
+  const int n = b->n;
+  mfree_system_t *sys = NULL;
+  double *y = malloc(5 * (size_t)n * sizeof *y), t = 0.0;
+  memcpy(y, b->y, 5 * (size_t)n * sizeof *y);
+  mfree_status_t st = mfree_system_create_fluid(ctx, 2, n, &sys);
+  if (st == MFREE_SUCCESS) st = damb_configure(b, sys);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_masses(sys, b->m, 1);
+  if (st == MFREE_SUCCESS) st = set_option(sys, opt);
+  int differs = 0;
+  for (int w = 0; w < WINDOWS && st == MFREE_SUCCESS; ++w) {
+    int64_t steps = 0;
+    st = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+                                (void *)&kWindow, &steps);
+    if (compare) differs += steps != steps_ref[w] || t != t_ref[w] || memcmp(y, ref[w], 5 * (size_t)n * sizeof *y);
+  }
+  CHECK(st == MFREE_SUCCESS, "one process (%s): status %d: %s", opt ? opt : "no option", (int)st,
+        mpifluid_error(ctx));
+  if (!compare) differs = !memcmp(y, ref[WINDOWS - 1], 5 * (size_t)n * sizeof *y);
+  mfree_system_destroy(&sys);
+  free(y);
+  return st != MFREE_SUCCESS || differs;
+}
+#endif
 
 int main(int argc, char **argv) {
   int rank = 0, size = 1;
@@ -29,6 +81,10 @@ int main(int argc, char **argv) {
   /* the reference: one rank, a deep layer, the same windows */
   rankfluid_t ref;
   mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, 4.0 * b.h + 4.0 * b.d, 0);
+#ifdef FLUID_OPTIONS
+  const char *opt = argc > 1 ? argv[1] : "(none)";
+  if (st == MFREE_SUCCESS) st = set_option(ref.sys, opt);
+#endif
   CHECK(st == MFREE_SUCCESS, "one-rank system: status %d: %s", (int)st, mpifluid_error(ctx));
   double *ref_y[WINDOWS], t_ref[WINDOWS];
   int64_t steps_ref[WINDOWS];
@@ -53,6 +109,9 @@ int main(int argc, char **argv) {
   counted_t cw;
   st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
   if (st == MFREE_SUCCESS) st = mpimove_counted(&r, ctx, &b, width, &cw);
+#ifdef FLUID_OPTIONS
+  if (st == MFREE_SUCCESS) st = set_option(r.sys, opt);
+#endif
   CHECK(st == MFREE_SUCCESS, "system on the ranks: status %d: %s", (int)st, mpifluid_error(ctx));
   /* a state buffer for any owned count: no reallocation between windows */
   double *y = malloc(5 * (size_t)n * sizeof *y);
@@ -110,13 +169,19 @@ int main(int argc, char **argv) {
     CHECK(sent[2] > 0, "no particle crossed into another rank's region in the last window");
   }
   if (rank == 0)
-    printf("t189: %d ranks: %lld steps to t = %.6f, %d ghost rebuilds, migrations moved %lld, %lld, %lld particles\n",
-           size, (long long)(WINDOWS * kWindow), t, cw.rebuilds, (long long)sent[0], (long long)sent[1],
+    printf("%s: %d ranks: %lld steps to t = %.6f, %d ghost rebuilds, migrations moved %lld, %lld, %lld particles\n",
+           TEST_NAME, size, (long long)(WINDOWS * kWindow), t, cw.rebuilds, (long long)sent[0], (long long)sent[1],
            (long long)sent[2]);
   /* the particles moved: the front left the column */
   double front = 0.0;
   for (int q = 0; q < n; ++q) front = fmax(front, ref_y[WINDOWS - 1][2 * q]);
   CHECK(front > 1.1 * b.a, "the front is at %.4f m, the column %.4f m wide", front, b.a);
+#ifdef FLUID_OPTIONS
+  CHECK(!one_process_differs(ctx, &b, opt, ref_y, steps_ref, t_ref, 1),
+        "%s: the one-process fluid differs from the one-rank run", opt);
+  CHECK(!one_process_differs(ctx, &b, NULL, ref_y, steps_ref, t_ref, 0), "%s: the run without it ends the same", opt);
+  if (rank == 0) printf("%s: %s\n", TEST_NAME, opt);
+#endif
 
   mfree_migration_destroy(&mig);
   rankfluid_free(&r);
@@ -125,7 +190,7 @@ int main(int argc, char **argv) {
   free(y), free(owner);
   damb_free(&b);
   mfree_context_destroy(&ctx);
-  const int rc = mpitest_finish("t189-mpifluid-migrate");
+  const int rc = mpitest_finish(TEST_NAME);
   MPI_Finalize();
   return rc;
 }

@@ -385,7 +385,7 @@ double FluidSystem::stable_dt(const double *y) {
       for (int64_t q = rb(k); q < re(k); ++q)
         if (cols_[q] < n_) lumped_[cols_[q]] += N_[q] * (k < n_ ? mass_[k] / share(k) : 0.0);
     for (int32_t i = 0; i < n_; ++i) {
-      if (!(lumped_[i] < mass_[i])) continue;
+      if (!(lumped_[i] < mass_[i]) || !steps_by(i)) continue;
       double vv = 0.0;
       for (int c = 0; c < dim_; ++c) vv += v[i * dim_ + c] * v[i * dim_ + c];
       const double s = std::sqrt(gamma_ * kappa_ / rho[i]) + std::sqrt(vv);

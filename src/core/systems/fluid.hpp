@@ -88,6 +88,10 @@ class FluidSystem : public System {
   // After the rows of a prepare, before their statuses are checked: the rows a rank does
   // not need are dropped there, and its scatter runs in node order.
   virtual void rows_done() {}
+  // Whether stable_dt's lumped-mass scaling (set_lumped_mass_step) counts node i: on ranks
+  // only the owned nodes, whose lumped masses sum every row that holds them (a far
+  // ghost's rows are dropped, its sum incomplete; its owner counts it).
+  virtual bool steps_by(int32_t i) const { (void)i; return true; }
   // The mass matrix of mass() from the prepared tables, for np particles: the state's
   // particle i at node node[i], node k the state's particle part[k] (-1: none, its
   // terms dropped; nodes < n_).

@@ -65,6 +65,10 @@ void scatter_state(const std::vector<int32_t> &active, int dim, int32_t n, const
 }  // namespace
 
 FluidOpen &FluidSystem::open() {
+  // (a rank's particles are its owned ones and ghosts: an injected particle would need a
+  // global id no rank has, and a particle that leaves would leave ghosts behind)
+  if (on_ranks())
+    throw Error(MFREE_ERR_UNSUPPORTED, "no open boundaries (active particles, inflow, outflow) for the fluid on ranks");
   if (!open_) {
     auto o = std::make_unique<FluidOpen>();
     o->state.assign(n_, kFluid);
@@ -153,11 +157,12 @@ void FluidSystem::set_outflow(int32_t k, const double *point, const double *norm
 }
 
 int32_t FluidSystem::active_states(int32_t n, int32_t *state) const {
-  if (state && n != n_)
-    throw Error(MFREE_ERR_ARG, "state holds " + std::to_string(n) + " values, the system has " + std::to_string(n_));
+  const int32_t np = neq() / (2 * dim_ + 1);  // the state's particles (on ranks the owned ones)
+  if (state && n != np)
+    throw Error(MFREE_ERR_ARG, "state holds " + std::to_string(n) + " values, the system has " + std::to_string(np));
   if (!open_) {
-    if (state) std::fill(state, state + n_, static_cast<int32_t>(kFluid));
-    return n_;
+    if (state) std::fill(state, state + np, static_cast<int32_t>(kFluid));
+    return np;
   }
   if (state)
     for (int32_t i = 0; i < n_; ++i) state[i] = open_->state[i];

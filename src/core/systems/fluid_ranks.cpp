@@ -202,9 +202,6 @@ Report FluidRanks::prepare_accel(const double *ys, bool checked, double *a, doub
 
 Report FluidRanks::prepare_rows(const double *ys, bool checked, double &limit, double &reach) {
   ghost_fault_ = false;
-  if (dummy_.n || delta_ != 0.0 || vci_ || vsmooth_ != 0.0 || open_ || lumped_step_)
-    throw Error(MFREE_ERR_UNSUPPORTED, "on ranks the fluid has no dummy particles, density diffusion, consistent "
-                                       "integration, velocity smoothing, open boundaries or lumped-mass step yet");
   Report r = named(prepare(ys, checked));
   if (!r.ok()) return r;
   const int D = dim();

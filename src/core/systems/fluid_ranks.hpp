@@ -65,6 +65,7 @@ class FluidRanks final : public FluidSystem {
  protected:
   void to_nodes(HVec<double> &per_particle) const override;
   void rows_done() override;
+  bool steps_by(int32_t i) const override { return is_owned_[i] != 0; }
 
  private:
   FluidRanks(int dim, int32_t n_owned, int32_t n_ghost, const int64_t *ids, double width, const Collective &coll);

@@ -38,6 +38,9 @@ struct NodeKernel {
 }  // namespace
 
 void FluidSystem::set_dummy_particles(int32_t n, const double *x, const double *vol, int64_t stride) {
+  // (a dummy's extrapolated density reads dummies up to three passes deep, fluid particles
+  // beyond the two support radii of ghosts a rank holds)
+  if (on_ranks()) throw Error(MFREE_ERR_UNSUPPORTED, "no dummy wall particles for the fluid on ranks");
   if (n < 0) throw Error(MFREE_ERR_ARG, "negative dummy particle count " + std::to_string(n));
   if (n > 0 && (!x || !vol)) throw Error(MFREE_ERR_NULL, "dummy positions or volumes are NULL");
   if (stride < 0) throw Error(MFREE_ERR_ARG, "negative stride");

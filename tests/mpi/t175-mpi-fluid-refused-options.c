@@ -1,0 +1,83 @@
+/* The one-process fluid's options that the fluid on ranks refuses (label mpi), on 1, 2 and
+ * 4 ranks: dummy wall particles and the open boundaries (active particles, an inflow
+ * gate, an outflow plane, their update) return MFREE_ERR_UNSUPPORTED on every rank with
+ * a message that says why, and leave the system as it was: afterwards it takes 40
+ * leap-frog steps to the same bits as a system that never saw them. The active-particle
+ * query answers for the owned particles (all active), not for the ghosts. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpifluid.h"
+#include "mpitest.h"
+
+int main(int argc, char **argv) {
+  int rank = 0, size = 1;
+  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
+  damb_t b;
+  damb_make(&b, 12, 24);
+  const int n = b.n;
+  int *owner = malloc((size_t)n * sizeof *owner);
+  for (int i = 0; i < n; ++i) {
+    int p = (int)(b.y[2 * i] / b.a * size);
+    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
+  }
+  const double width = 4.0 * b.h + 2.0 * b.d;
+  rankfluid_t r, fresh;
+  mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
+  if (st == MFREE_SUCCESS) st = rankfluid_make(&fresh, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
+  CHECK(st == MFREE_SUCCESS, "systems on the ranks: status %d: %s", (int)st, mpifluid_error(ctx));
+  if (st != MFREE_SUCCESS) MPI_Abort(MPI_COMM_WORLD, 1);
+
+  /* a row of dummies under the floor, as the serial dam break's */
+  enum { ND = 8 };
+  double xd[2 * ND], vol = b.d * b.d;
+  for (int k = 0; k < ND; ++k) xd[2 * k] = (k + 0.5) * b.d, xd[2 * k + 1] = -0.5 * b.d;
+  expect(ctx, mfree_system_set_dummy_particles(r.sys, ND, xd, &vol, 0), MFREE_ERR_UNSUPPORTED, "dummy",
+         "dummy particles");
+  expect(ctx, mfree_system_set_dummy_particles(r.sys, 0, NULL, NULL, 0), MFREE_ERR_UNSUPPORTED, "on ranks",
+         "no dummy particles");
+  expect(ctx, mfree_system_set_active(r.sys, r.n_owned), MFREE_ERR_UNSUPPORTED, "open boundaries", "active count");
+  const double origin[2] = {0.0, 0.5 * b.a}, edge[2] = {0.0, 0.5 * b.a}, normal[2] = {1.0, 0.0};
+  expect(ctx, mfree_system_set_inflow(r.sys, 0, origin, edge, normal, 0.5, 1000.0, b.d), MFREE_ERR_UNSUPPORTED,
+         "open boundaries", "inflow gate");
+  const double point[2] = {4.0 * b.a, 0.0};
+  expect(ctx, mfree_system_set_outflow(r.sys, 0, point, normal), MFREE_ERR_UNSUPPORTED, "open boundaries",
+         "outflow plane");
+  expect(ctx, mfree_system_update_open_boundaries(r.sys, 0.0, r.y), MFREE_ERR_UNSUPPORTED, "on ranks",
+         "open boundaries' update");
+  /* the query: the owned particles, every one active */
+  int32_t nactive = -1;
+  int32_t *state = malloc(((size_t)r.n_owned + 1) * sizeof *state);
+  expect(ctx, mfree_system_get_active(r.sys, &nactive, r.n_owned, state), MFREE_SUCCESS, NULL, "active query");
+  CHECK(nactive == r.n_owned, "%d active of %d owned", (int)nactive, r.n_owned);
+  int fluid = 0;
+  for (int k = 0; k < r.n_owned; ++k) fluid += state[k] == MFREE_PARTICLE_FLUID;
+  CHECK(fluid == r.n_owned, "%d of %d owned particles in the fluid state", fluid, r.n_owned);
+  if (r.n_ghost > 0)
+    expect(ctx, mfree_system_get_active(r.sys, &nactive, r.n_owned + r.n_ghost, state), MFREE_ERR_ARG, "state holds",
+           "a state sized for the ghosts too");
+
+  /* nothing changed */
+  int64_t forty = 40, steps = 0, steps_f = 0;
+  double t = 0.0, tf = 0.0;
+  st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &forty,
+                              &steps);
+  CHECK(st == MFREE_SUCCESS && steps == 40, "after the refusals: status %d, %lld steps: %s", (int)st,
+        (long long)steps, mpifluid_error(ctx));
+  st = mfree_system_integrate(fresh.sys, MFREE_INTEGRATOR_LEAPFROG, fresh.y, &tf, 1.0, 0.5, 0.0, mpifluid_stop_at,
+                              &forty, &steps_f);
+  CHECK(st == MFREE_SUCCESS && steps_f == 40 && t == tf, "the fresh system: status %d, t %.17g and %.17g", (int)st,
+        t, tf);
+  CHECK(!memcmp(r.y, fresh.y, 5 * (size_t)r.n_owned * sizeof *r.y), "the refusals changed the run");
+
+  free(state);
+  rankfluid_free(&fresh);
+  rankfluid_free(&r);
+  free(owner);
+  damb_free(&b);
+  mfree_context_destroy(&ctx);
+  const int rc = mpitest_finish("t175-mpi-fluid-refused-options");
+  MPI_Finalize();
+  return rc;
+}
