@@ -36,7 +36,10 @@
  * "front_floor_digest":.. (fc_digest of the T, Z and Z_floor samples: equal digests, equal
  * bits),"max_rel_dev":..,"compared":..,
  * "particles":..,"steps":..,"wall_seconds":..,"mass_rel_error":..,"status":..,"error":..,
- * "t_end":..,"density_range":[min,max]}, where max_rel_dev is the largest
+ * "t_end":..,"density_range":[min,max],"head_speed":..,"head_speed_experiment":..,
+ * "head_fit_points":..}, head_speed the surge front's speed dZ/dT (the least-squares slope
+ * of the samples with 1 <= T <= 3; times sqrt(2 g a) in m/s), head_speed_experiment the
+ * same fit through Martin & Moyce's points there, and max_rel_dev the largest
  * |Z - Z_exp| / Z_exp over the data points with 1 <= T <= 3 (Z linearly interpolated in
  * T; -1 when no data file), t_end the T reached and density_range the densities' extremes
  * at the output times (every 0.05 in T); "max_rel_dev_wide" and "compared_wide" the same

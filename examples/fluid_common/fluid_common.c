@@ -618,6 +618,9 @@ static int front_at(int nf, const double *fT, const double *fZ, double T, double
   return 0;
 }
 
+/* The head speed's window in T: the comparison's (the surge after its start, before the far wall). */
+static const double kHead0 = 1.0, kHead1 = 3.0;
+
 void fc_front_compare(int nf, const double *fT, const double *fZ, int ndata, const double *dT, const double *dZ,
                       fc_front_cmp_t *c) {
   double maxdev = -1.0, maxdev_wide = -1.0, off_sum = 0.0, off_min = INFINITY, off_max = -INFINITY, Zs = 0.0;
@@ -652,6 +655,14 @@ void fc_front_compare(int nf, const double *fT, const double *fZ, int ndata, con
   c->offset[0] = noff ? off_sum / noff : NAN;
   c->offset[1] = noff ? off_min : NAN;
   c->offset[2] = noff ? off_max : NAN;
+  fc_fit_t fit = {0, 0, 0, 0, 0}, fit_exp = {0, 0, 0, 0, 0};
+  for (int r = 0; r < nf; ++r)
+    if (fT[r] >= kHead0 && fT[r] <= kHead1) fc_fit_add(&fit, fT[r], fZ[r]);
+  for (int q = 0; q < ndata; ++q)
+    if (dT[q] >= kHead0 && dT[q] <= kHead1) fc_fit_add(&fit_exp, dT[q], dZ[q]);
+  fc_fit_line(&fit, &c->head_speed, NULL);
+  fc_fit_line(&fit_exp, &c->head_speed_exp, NULL);
+  c->head_points = fit.n;
 }
 
 FILE *fc_dam_csv(const fc_run_t *r, const fc_dam_t *b) {
@@ -716,6 +727,9 @@ void fc_dam_json(fc_json_t *j, const fc_dam_t *b, int nf, const double *fT, cons
   fc_json_int(j, "status", (int)r->status);
   fc_json_str(j, "error", r->status == MFREE_SUCCESS ? NULL : r->error);
   fc_json_num(j, "t_end", r->T_end);
+  fc_json_num(j, "head_speed", c->head_speed);
+  fc_json_num(j, "head_speed_experiment", c->head_speed_exp);
+  fc_json_int(j, "head_fit_points", c->head_points);
 }
 
 void fc_dam_print(int nf, const double *fT, const double *fZ, const fc_front_cmp_t *c) {
@@ -725,6 +739,9 @@ void fc_dam_print(int nf, const double *fT, const double *fZ, const fc_front_cmp
   if (c->compared_wide)
     printf("over 0.5 <= T <= 3: %.3f (%d points); the experiment lags by T = %.3f (%.3f to %.3f)\n",
            c->max_rel_dev_wide, c->compared_wide, c->offset[0], c->offset[1], c->offset[2]);
+  if (c->head_points >= 3)
+    printf("head speed dZ/dT over 1 <= T <= 3: %.4f (%d samples); the experiment %.4f\n", c->head_speed,
+           c->head_points, c->head_speed_exp);
 }
 
 void fc_digest(const double *v, size_t n, char *hex) {

@@ -239,10 +239,16 @@ int fc_read_pairs(const char *path, double *T, double *Z, int cap);
  * max_rel_dev the largest |Z - Z_exp| / Z_exp over the points with 1 <= T <= 3 (Z
  * linearly interpolated in T; -1 without a compared point), max_rel_dev_wide the same
  * over 0.5 <= T <= 3 (NaN without one), and offset[3] = mean, min, max of T_exp minus the
- * T at which the front first reaches Z_exp over 0.5 <= T <= 3 (NaN without one). */
+ * T at which the front first reaches Z_exp over 0.5 <= T <= 3 (NaN without one).
+ * head_speed: the surge front's speed dZ/dT, the least-squares slope of the samples with
+ * 1 <= T <= 3 (head_points of them; NaN with fewer than 3), before the front reaches the
+ * tank's far wall at Z = 5 (times sqrt(2 g a) in m/s); head_speed_exp the same fit
+ * through the experiment's points in that window. */
 typedef struct {
   double max_rel_dev, max_rel_dev_wide, offset[3];
   int compared, compared_wide;
+  double head_speed, head_speed_exp;
+  int head_points;
 } fc_front_cmp_t;
 void fc_front_compare(int nf, const double *fT, const double *fZ, int ndata, const double *dT, const double *dZ,
                       fc_front_cmp_t *c);
@@ -265,7 +271,8 @@ typedef struct {
  * their digests "time_digest", "front_digest", "front_floor_digest" (fc_digest),
  * "max_rel_dev", "compared", "max_rel_dev_wide", "compared_wide", "time_offset",
  * "particles", "steps", "wall_seconds", "a", "nx", "cfl", "shepard_condition", "mu",
- * "scheme", "status", "error" (null after a success), "t_end". */
+ * "scheme", "status", "error" (null after a success), "t_end", "head_speed",
+ * "head_speed_experiment", "head_fit_points" (fc_front_compare). */
 void fc_dam_json(fc_json_t *j, const fc_dam_t *b, int nf, const double *fT, const double *fZ, const double *fZf,
                  const fc_front_cmp_t *c, const fc_dam_run_t *r);
 /* Z every fourth sample and the comparison, on stdout. */

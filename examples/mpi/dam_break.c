@@ -23,14 +23,16 @@
  * in any order); Z_floor over the particles with z < 1.5 d. The fluid on ranks gives every
  * particle the bits of one rank whatever the partition, so Z(T) is the one-rank run's bit
  * for bit on any number of ranks, and up to 1,024 particles that of examples/dam_break
- * (docs/fluid-ranks.md); the JSON's digests of the history say so (t199).
+ * (docs/fluid-ranks.md); the JSON's digests of the history say so (t199). The head speed
+ * dZ/dT, the least-squares slope of those reduced samples over 1 <= T <= 3 on rank 0, is
+ * then the serial example's too.
  *
  * Output (rank 0) in DIR (--out, default mpi_dam_break_out): front.csv, front.gp and
  * front.png (gnuplot), and the summary mpi_dam_break.json (--json: on stdout too) with the
  * keys of examples/dam_break's ("front", "front_floor", their digests, "max_rel_dev",
  * "compared", "max_rel_dev_wide", "compared_wide", "time_offset", "particles", "steps",
  * "wall_seconds", "a", "nx", "cfl", "shepard_condition", "mu", "scheme", "status",
- * "error", "t_end"; "mass_rel_error" from the Galerkin lumped masses alone, summed over
+ * "error", "t_end", "head_speed", "head_speed_experiment", "head_fit_points"; "mass_rel_error" from the Galerkin lumped masses alone, summed over
  * the ranks, against the particles' total, 003 eq 57) and "ranks",
  * "partitioner", "window", "halo_width", "balance" ([T, max/mean, min/mean] after each
  * partition), "max_count_ratio", "min_count_ratio", "balanced" (1 when every partition left

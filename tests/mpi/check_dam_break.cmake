@@ -6,7 +6,9 @@
 # summaries' digests of the doubles; docs/fluid-ranks.md: up to 1,024 particles the fluid
 # on ranks is the one-process fluid bit for bit), the same steps and comparison with Martin
 # & Moyce, at least two Zoltan partitions, every rank's count within 10 % of the mean after
-# each, and particles moved between ranks on more than one rank. Then a run that fails on
+# each, and particles moved between ranks on more than one rank. The head speed (the
+# slope of the front over 1 <= T <= 3) is the serial run's, and that within 10 % of the
+# same fit through the experiment's points. Then a run that fails on
 # one rank (walls on the fluid's edge: a negative density after a few steps at the
 # particle next to the corner, owned by one rank) must exit 3 on every rank with the
 # agreed status in the summary, and a bad option must exit 2.
@@ -26,7 +28,7 @@ endfunction()
 file(REMOVE_RECURSE "${OUT}")
 file(MAKE_DIRECTORY "${OUT}")
 # the serial example's run with the scheme's arguments (a list), its summary's keys into ref_<key>
-set(keys time_digest front_digest front_floor_digest steps compared max_rel_dev)
+set(keys time_digest front_digest front_floor_digest steps compared max_rel_dev head_speed head_fit_points)
 macro(serial_reference name)
   execute_process(COMMAND "${SERIAL}" ${ARGS} ${ARGN} --out "${OUT}/${name}" --no-plot --quiet
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 200)
@@ -36,8 +38,16 @@ macro(serial_reference name)
   foreach(k ${keys})
     json_get(ref_${k} "${OUT}/${name}/dam_break.json" ${k})
   endforeach()
+  # the head speed dZ/dT, fitted over 1 <= T <= 3, within 10 % of the same fit through
+  # Martin & Moyce's points there (1.139: 1.025 to 1.253)
+  json_get(exp_head "${OUT}/${name}/dam_break.json" head_speed_experiment)
+  if(NOT ref_head_fit_points GREATER 2 OR NOT ref_head_speed GREATER 1.025 OR NOT ref_head_speed LESS 1.253
+     OR NOT exp_head GREATER 1.139 OR NOT exp_head LESS 1.1392)
+    message(FATAL_ERROR "the serial example (${name}): head speed ${ref_head_speed} over ${ref_head_fit_points} "
+                        "samples, the experiment's ${exp_head}")
+  endif()
   message(STATUS "serial (${name}): ${ref_steps} steps, front ${ref_front_digest}, max |Z - Z_exp| / Z_exp "
-                 "${ref_max_rel_dev}")
+                 "${ref_max_rel_dev}, head speed ${ref_head_speed}")
 endmacro()
 
 # the MPI example on np ranks with Zoltan's method and the extra arguments, against ref_<key>
