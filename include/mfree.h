@@ -1836,7 +1836,8 @@ MFREE_API mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, i
 MFREE_API mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y,
                                           double *ydot);
 /** Mass matrix of the state: the identity except the velocity block, which holds the
- * lumped or consistent Galerkin mass: M y' = M f(t, y) (fluid on ranks: owned rows, lumped only).
+ * lumped or consistent Galerkin mass: M y' = M f(t, y) (fluid on ranks: owned rows, lumped only;
+ * the consistent mass's products: mfree_system_apply_mass).
  * @param[in]     sys         the system
  * @param[in]     y           state
  * @param[in]     consistent  0 lumped, nonzero consistent
@@ -1845,13 +1846,34 @@ MFREE_API mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const d
 MFREE_API mfree_status_t mfree_system_assemble_mass(mfree_system_t *sys, const double *y,
                                                     int32_t consistent, mfree_matrix_t **M);
 /** S_kj = N_j(x_k) at the state's positions: initial velocity parameters solve
- * S v = v_hat ([CuetoFelgueroso2004] eq 99).
+ * S v = v_hat ([CuetoFelgueroso2004] eq 99). Fluid on ranks (collective): the owned
+ * particles' rows in the host's order, n_owned x (n_owned + n_ghost), the columns the
+ * host's items (owned, then ghosts, named by the global ids given at creation or by the
+ * last halo rebuild), each entry bitwise one rank's; S v needs v at the ghosts.
  * @param[in] sys a fluid system @param[in] y state
  * @param[in,out] S *S NULL: created (owned by the host); else refilled
  * @return MFREE_SUCCESS, or a failure named with the parameters */
 MFREE_API mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys,
                                                              const double *y,
                                                              mfree_matrix_t **S);
+/** Mv = M(y) v, the mass matrix of mfree_system_assemble_mass applied to v, for
+ * matrix-free mass solvers. The mass assembled at y is kept for the next call with the
+ * same y (bit for bit), kind and options, so that the products of one solve assemble it
+ * once. Fluid on ranks (collective, every rank alike): the rank's rows, bitwise one
+ * rank's; the consistent mass, whose rows couple owned particles to ghosts, reads v's
+ * velocities at the ghosts through one exchange (docs/fluid-ranks.md).
+ * @param[in]  sys         the system
+ * @param[in]  y           state (neq values)
+ * @param[in]  consistent  0 lumped, nonzero consistent
+ * @param[in]  v           neq values
+ * @param[out] Mv          neq values (unspecified after a failure)
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL array (on ranks: on every rank when
+ *         one rank passes one); a positive status naming the particle for a non-finite
+ *         or out-of-range state; MFREE_ERR_UNSUPPORTED as mfree_system_assemble_mass
+ *         (elastodynamics on ranks has no consistent mass) */
+MFREE_API mfree_status_t mfree_system_apply_mass(mfree_system_t *sys, const double *y,
+                                                 int32_t consistent, const double *v,
+                                                 double *Mv);
 /** Pressure at the particles from the state's densities.
  * @param[in] sys a fluid system @param[in] y state @param[out] p n values (on ranks: n_owned)
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
@@ -2164,7 +2186,7 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * state: MFREE_FAIL_NONFINITE) is returned by every rank with that rank's message
  * ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
  * consistent integration, velocity smoothing or open boundaries (MFREE_ERR_UNSUPPORTED). Outputs: the owned
- * particles' (docs/fluid-ranks.md); no consistent mass or interpolation. Creation is collective: bad input on one rank, or ranks that
+ * particles' (docs/fluid-ranks.md); the consistent mass as products (mfree_system_apply_mass). Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.
  * libmfree_mpi's mfree_halo_create_fluid supplies the callbacks from a halo plan.
  * @param[in]  ctx         context (kept alive); NULL: MFREE_ERR_NULL on this rank alone

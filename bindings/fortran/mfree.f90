@@ -1375,6 +1375,16 @@ module mfree
       type(c_ptr), intent(inout) :: S
     end function mfree_system_assemble_interpolation_c
 
+    integer(c_int) function mfree_system_apply_mass_c(sys, y, consistent, v, Mv) &
+        bind(C, name="mfree_system_apply_mass")
+      import :: c_int, c_int32_t, c_double, c_ptr
+      type(c_ptr), value :: sys
+      real(c_double), intent(in) :: y(*)
+      integer(c_int32_t), value :: consistent
+      real(c_double), intent(in) :: v(*)
+      real(c_double), intent(out) :: Mv(*)
+    end function mfree_system_apply_mass_c
+
     integer(c_int) function mfree_system_get_pressure_c(sys, y, p) &
         bind(C, name="mfree_system_get_pressure")
       import :: c_int, c_double, c_ptr
@@ -1651,6 +1661,7 @@ module mfree
   public :: mfree_system_set_lumped_mass_step_c
   public :: mfree_system_rhs_c, mfree_system_assemble_mass_c
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
+  public :: mfree_system_apply_mass_c
   public :: mfree_system_get_velocity_c, mfree_system_integrate_c
   public :: mfree_system_get_wall_force_c
   public :: mfree_system_set_active_c, mfree_system_set_inflow_c, mfree_system_set_outflow_c
@@ -1778,6 +1789,7 @@ module mfree
   public :: mfree_system_set_lumped_mass_step
   public :: mfree_system_get_size, mfree_system_rhs, mfree_system_assemble_mass
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
+  public :: mfree_system_apply_mass
   public :: mfree_system_get_velocity, mfree_system_integrate
   public :: mfree_system_get_wall_force
   public :: mfree_system_set_active, mfree_system_set_inflow, mfree_system_set_outflow
@@ -4099,6 +4111,20 @@ contains
     type(mfree_matrix), intent(inout) :: S
     st = mfree_system_assemble_interpolation_c(sys%ptr, y, S%ptr)
   end function mfree_system_assemble_interpolation
+
+  !> Mv = M(y) v (consistent: 0 lumped, nonzero consistent); Mv must be contiguous and
+  !> hold neq values (else MFREE_ERR_ARG).
+  integer(c_int) function mfree_system_apply_mass(sys, y, consistent, v, Mv) result(st)
+    type(mfree_system), intent(in) :: sys
+    real(c_double), intent(in) :: y(*)
+    integer(c_int32_t), intent(in) :: consistent
+    real(c_double), intent(in) :: v(*)
+    real(c_double), intent(out), target :: Mv(:)
+    st = check_system_out(sys, 'mfree_system_apply_mass', 'Mv', is_contiguous(Mv), &
+                          size(Mv, kind=c_int64_t), 0)
+    if (st /= MFREE_SUCCESS) return
+    st = mfree_system_apply_mass_c(sys%ptr, y, consistent, v, Mv)
+  end function mfree_system_apply_mass
 
   !> Elastodynamics by collocation on a set-up collocation assembler (kept alive).
   integer(c_int) function mfree_system_create_elastodynamic(ctx, as, density, sys) result(st)

@@ -29,15 +29,6 @@ const T &kind(const mfree::System &s, const char *what) {
   return *t;
 }
 
-// The fluid outputs that read the state of every particle of the system: a system on
-// ranks holds its owned particles' state only.
-template <class S>
-S &one_process(S &f, const char *what) {
-  if (f.on_ranks())
-    throw mfree::Error(MFREE_ERR_UNSUPPORTED, std::string("no ") + what + " for the fluid on ranks yet");
-  return f;
-}
-
 // Fill *M (created when NULL) through a core routine that writes a SparseMatrix.
 template <class Fill>
 mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, mfree_matrix_t **M, Fill &&fill) {
@@ -213,11 +204,23 @@ mfree_status_t mfree_system_assemble_mass(mfree_system_t *sys, const double *y, 
 }
 
 mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys, const double *y, mfree_matrix_t **S) {
-  if (sys && !y && sys->sys->neq() > 0)
+  const auto *fr = sys ? dynamic_cast<const mfree::FluidSystem *>(sys->sys.get()) : nullptr;
+  // (on ranks the system agrees on its arguments first)
+  if (sys && !y && sys->sys->neq() > 0 && !(fr && fr->on_ranks()))
     return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_interpolation", "y is NULL");
   return fill_matrix(sys, "mfree_system_assemble_interpolation", S, [&](mfree::System &f, mfree::SparseMatrix &m) {
-    return one_process(kind<mfree::FluidSystem>(f, "interpolation matrix (not a fluid)"), "interpolation matrix")
-        .interpolation(y, m);
+    return kind<mfree::FluidSystem>(f, "interpolation matrix (not a fluid)").interpolation(y, m);
+  });
+}
+
+mfree_status_t mfree_system_apply_mass(mfree_system_t *sys, const double *y, int32_t consistent, const double *v,
+                                       double *Mv) {
+  return mfree::with_handle(sys, "mfree_system_apply_mass", [&](mfree::System &f) {
+    const auto *fl = dynamic_cast<const mfree::FluidSystem *>(&f);
+    // (on ranks the system agrees on its arguments: a rank that returned here alone
+    // would leave the others waiting in its exchanges)
+    MFREE_REQUIRE((y && v && Mv) || f.neq() == 0 || (fl && fl->on_ranks()), MFREE_ERR_NULL, "y, v or Mv is NULL");
+    return mfree::finish(sys->ctx, "mfree_system_apply_mass", f.apply_mass(y, consistent != 0, v, Mv));
   });
 }
 

@@ -1153,6 +1153,11 @@ static void rows_system(void) {
   ROW0(MFREE_ERR_NULL, mfree_system_assemble_interpolation(NULL, F.y, &Mm));
   ROW(MFREE_ERR_NULL, mfree_system_assemble_interpolation(F.sys, NULL, &Mm));
   ROW(MFREE_ERR_NULL, mfree_system_assemble_interpolation(F.sys, F.y, NULL));
+  ROW0(MFREE_ERR_NULL, mfree_system_apply_mass(NULL, F.y, 1, F.y, ydot));
+  ROW(MFREE_ERR_NULL, mfree_system_apply_mass(F.sys, NULL, 1, F.y, ydot));
+  ROW(MFREE_ERR_NULL, mfree_system_apply_mass(F.sys, F.y, 1, NULL, ydot));
+  ROW(MFREE_ERR_NULL, mfree_system_apply_mass(F.sys, F.y, 0, F.y, NULL));
+  ROW(MFREE_FAIL_NONFINITE, mfree_system_apply_mass(F.sys, yb, 1, F.y, ydot));
   ROW0(MFREE_ERR_NULL, mfree_system_get_pressure(NULL, F.y, p));
   ROW(MFREE_ERR_NULL, mfree_system_get_pressure(F.sys, NULL, p));
   ROW(MFREE_ERR_NULL, mfree_system_get_pressure(F.sys, F.y, NULL));
@@ -1249,7 +1254,7 @@ static void rows_system(void) {
       const double m2[2] = {10.0, 10.0};
       ROW(MFREE_SUCCESS, mfree_system_set_masses(fr, m2, 1));
       ROW(MFREE_SUCCESS, mfree_system_set_smoothing(fr, 0.1));
-      /* the outputs on ranks: NULL arguments agreed by the ranks; not distributed yet */
+      /* the outputs on ranks: NULL arguments agreed by the ranks; the consistent mass as products only */
       ROW(MFREE_ERR_NULL, mfree_system_get_pressure(fr, ys, NULL));
       ROW(MFREE_ERR_NULL, mfree_system_get_velocity(fr, NULL, yd));
       ROW(MFREE_ERR_NULL, mfree_system_get_velocity(fr, ys, NULL));
@@ -1272,11 +1277,17 @@ static void rows_system(void) {
       ROW(MFREE_ERR_INTERNAL, mfree_system_move_particles(fr, 2, bad_move, NULL, ys, 10));
       ROW(MFREE_SUCCESS, mfree_system_move_particles(fr, 2, one_move, NULL, ys, 10));
       ROW(MFREE_SUCCESS, mfree_system_rhs(fr, 0.0, ys, yd));
-      ROW(MFREE_ERR_UNSUPPORTED, mfree_system_assemble_interpolation(fr, ys, &fm));
+      ROW(MFREE_ERR_NULL, mfree_system_assemble_interpolation(fr, NULL, &fm));
+      ROW(MFREE_SUCCESS, mfree_system_assemble_interpolation(fr, ys, &fm));
+      ROW(MFREE_ERR_NULL, mfree_system_apply_mass(fr, NULL, 1, ys, yd));
+      ROW(MFREE_ERR_NULL, mfree_system_apply_mass(fr, ys, 1, NULL, yd));
+      ROW(MFREE_ERR_NULL, mfree_system_apply_mass(fr, ys, 0, ys, NULL));
+      ROW(MFREE_SUCCESS, mfree_system_apply_mass(fr, ys, 1, ys, yd));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, (mfree_integrator_t)0, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, NAN, 0.2, 0, NULL, NULL, &steps));
       ys[7] = NAN;
       ROW(MFREE_FAIL_NONFINITE, mfree_system_rhs(fr, 0.0, ys, yd));
+      ROW(MFREE_FAIL_NONFINITE, mfree_system_apply_mass(fr, ys, 1, ys, yd));
       ROW(MFREE_FAIL_NONFINITE, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
       ROW(MFREE_FAIL_NONFINITE, mfree_system_integrate(fr, MFREE_INTEGRATOR_PREDICTOR_CORRECTOR, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
       /* a failed rebuild leaves the system unusable */

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <sstream>
 
@@ -250,26 +251,35 @@ Report FluidSystem::interpolation(const double *y, SparseMatrix &S) {
   if (open_) return open_interpolation(y, S);
   Report rep = prepare(y);
   if (!rep.ok()) return rep;
+  std::vector<int32_t> id(n_);
+  std::iota(id.begin(), id.end(), 0);
+  interpolation_rows(n_, id.data(), id.data(), n_, S);
+  return rep;
+}
+
+void FluidSystem::interpolation_rows(int32_t np, const int32_t *node, const int32_t *col, int32_t ncols,
+                                     SparseMatrix &S) const {
   // rows are not guaranteed sorted by column: sort each row with its values
   // the fluid rows and columns only (dummies are not unknowns)
   const auto &acols = cols_;
-  std::vector<int64_t> rp(static_cast<size_t>(n_) + 1, 0);
+  std::vector<int64_t> rp(static_cast<size_t>(np) + 1, 0);
   std::vector<int32_t> cols;
   std::vector<double> vals;
-  for (int32_t k = 0; k < n_; ++k) {
-    std::vector<std::pair<int32_t, double>> row;
+  std::vector<std::pair<int32_t, double>> row;
+  for (int32_t r = 0; r < np; ++r) {
+    const int32_t k = node[r];
+    row.clear();
     for (int64_t e = rb(k); e < re(k); ++e)
-      if (acols[e] < n_) row.push_back({acols[e], N_[e]});
+      if (acols[e] < n_) row.push_back({col[acols[e]], N_[e]});
     std::sort(row.begin(), row.end());
     for (auto &q : row) {
       cols.push_back(q.first);
       vals.push_back(q.second);
     }
-    rp[k + 1] = static_cast<int64_t>(cols.size());
+    rp[r + 1] = static_cast<int64_t>(cols.size());
   }
-  S.set_pattern(n_, n_, rp, cols);
+  S.set_pattern(np, ncols, rp, cols);
   std::copy(vals.begin(), vals.end(), S.values_mut().begin());
-  return rep;
 }
 
 Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
@@ -280,6 +290,30 @@ Report FluidSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   std::iota(part.begin(), part.end(), 0);
   mass_matrix(n_, part.data(), part.data(), consistent, M);
   return rep;
+}
+
+bool FluidSystem::KeptMass::holds(const double *at, int32_t neq, bool c, int64_t g) const {
+  return valid && consistent == c && gen == g && y.size() == static_cast<size_t>(neq) &&
+         (neq == 0 || std::memcmp(y.data(), at, static_cast<size_t>(neq) * sizeof(double)) == 0);
+}
+
+void FluidSystem::KeptMass::keep(const double *at, int32_t neq, bool c, int64_t g) {
+  y.assign(at, at + neq);
+  consistent = c;
+  gen = g;
+  valid = true;
+}
+
+Report FluidSystem::apply_mass(const double *y, bool consistent, const double *v, double *Mv) {
+  // (open boundaries change the active particles without a setter: no mass kept)
+  if (open_ || !kept_mass_.holds(y, neq(), consistent, options_gen_)) {
+    kept_mass_.valid = false;
+    Report rep = mass(y, consistent, kept_mass_.M);
+    if (!rep.ok()) return rep;
+    if (!open_) kept_mass_.keep(y, neq(), consistent, options_gen_);
+  }
+  kept_mass_.M.apply(v, Mv);
+  return Report();
 }
 
 void FluidSystem::mass_matrix(int32_t np, const int32_t *node, const int32_t *part, bool consistent,

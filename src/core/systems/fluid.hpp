@@ -53,7 +53,11 @@ class FluidSystem : public System {
 
   Report rhs(double t, const double *y, double *ydot) override;
   Report mass(const double *y, bool consistent, SparseMatrix &M) override;
-  Report interpolation(const double *y, SparseMatrix &S);
+  virtual Report interpolation(const double *y, SparseMatrix &S);
+  // M(y) v (mfree_system_apply_mass): the mass assembled at y, kept for the next product
+  // while y's bits, the kind and the options stay (a mass solver's products within one
+  // solve ask for the same mass), applied to v (neq values each).
+  Report apply_mass(const double *y, bool consistent, const double *v, double *Mv) override;
   virtual void pressure(const double *y, double *p) const;
   virtual Report velocity(const double *y, double *vhat);
   // The walls' force on the fluid at state y (fluid_wall.cpp): total (dim values, or
@@ -75,7 +79,10 @@ class FluidSystem : public System {
   int32_t active_states(int32_t n, int32_t *state) const;  // the active count; states if n > 0
   void inflow_totals(int32_t gate, int64_t &count, double &mass) const;
   void outflow_totals(int32_t k, int64_t &count, double &mass) const;
-  void options_changed() { if (open_) open_->dirty = true; }  // after every setter
+  void options_changed() {  // after every setter
+    if (open_) open_->dirty = true;
+    ++options_gen_;
+  }
 
   // On ranks (fluid_ranks.hpp): a FluidRanks numbers its nodes by global id and overrides
   // these two hooks; the one-process fluid leaves them empty.
@@ -101,6 +108,21 @@ class FluidSystem : public System {
   // them; m_k = sum_i N_i(x_k) m_i with the masses m accel divides by, vn the nodes'
   // velocities); wall w's force sums m_k f2 n_w over the rows in node order.
   void wall_row(int32_t k, const double *vn, const double *m, std::vector<std::pair<int32_t, double>> &terms) const;
+  // The interpolation matrix's rows (interpolation): np rows, row r holding node node[r]'s
+  // values N_j(x_k) at the fluid nodes j, in column col[j] of ncols, sorted by column.
+  void interpolation_rows(int32_t np, const int32_t *node, const int32_t *col, int32_t ncols, SparseMatrix &S) const;
+  // apply_mass's kept mass: M assembled at the state y (neq values) of kind consistent
+  // with the options of generation gen (options_gen_); valid: M may be used.
+  struct KeptMass {
+    SparseMatrix M;
+    std::vector<double> y;
+    bool consistent = false, valid = false;
+    int64_t gen = -1;
+    bool holds(const double *at, int32_t neq, bool c, int64_t g) const;
+    void keep(const double *at, int32_t neq, bool c, int64_t g);
+  };
+  KeptMass kept_mass_;
+  int64_t options_gen_ = 0;
   // The Tait pressure at density rho, rest density rho0.
   double pressure_at(double rho, double rho0) const { return kappa_ * (std::pow(rho / rho0, gamma_) - 1.0); }
 

@@ -533,18 +533,22 @@ Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t ref
 // particles sum the terms of every row that holds them, the owned rows' and the kept
 // ghost rows' (rows_done), sorted by value as on one process: bitwise the one-process
 // fluid's. The consistent mass couples owned particles to ghosts, which the rank's
-// state does not hold.
+// state does not hold: its products are apply_mass's (fluid_ranks_matrices.cpp).
 Report FluidRanks::mass(const double *y, bool consistent, SparseMatrix &M) {
   const Report agreed = output_prepare(
       y, nullptr, consistent ? MFREE_ERR_UNSUPPORTED : (!y && n_own_ > 0 ? MFREE_ERR_NULL : MFREE_SUCCESS),
-      consistent ? "no consistent mass for the fluid on ranks (its rows couple owned particles to ghosts): use the "
-                   "lumped mass"
+      consistent ? "no consistent mass matrix for the fluid on ranks (its rows couple owned particles to ghosts): "
+                   "use its products (mfree_system_apply_mass) or the lumped mass"
                  : "y is NULL");
   if (!agreed.ok()) return agreed;
+  lumped_rows(M);
+  return agreed;
+}
+
+void FluidRanks::lumped_rows(SparseMatrix &M) const {
   std::vector<int32_t> part(size(), -1);
   for (int32_t p = 0; p < n_own_; ++p) part[owned_[p]] = p;
   mass_matrix(n_own_, owned_.data(), part.data(), false, M);
-  return agreed;
 }
 
 // Local: the owned particles' densities and rest densities.

@@ -48,6 +48,9 @@ class FluidRanks final : public FluidSystem {
   Report rhs(double t, const double *y, double *ydot) override;
   Report mass(const double *y, bool consistent, SparseMatrix &M) override;
   void pressure(const double *y, double *p) const override;
+  // The mass products and the interpolation matrix on ranks (fluid_ranks_matrices.cpp).
+  Report apply_mass(const double *y, bool consistent, const double *v, double *Mv) override;
+  Report interpolation(const double *y, SparseMatrix &S) override;
   Report velocity(const double *y, double *vhat) override;
   Report wall_force(const double *y, double *total, int32_t nwall, double *per_wall) override;
   Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
@@ -92,6 +95,11 @@ class FluidRanks final : public FluidSystem {
   Report output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why, double *want = nullptr,
                         int nwant = 0);
   std::vector<double> stand_in_;  // output_prepare's stand-in for a NULL state
+  // After output_prepare: the lumped mass of the owned rows (mass's matrix), or the
+  // consistent mass's owned rows over every node (apply_mass's).
+  void lumped_rows(SparseMatrix &M) const;
+  void consistent_rows(SparseMatrix &M) const;
+  std::vector<double> w_;  // apply_mass's node vector
   // wall_force's per_wall (every rank's rows' terms gathered) after output_prepare with
   // the accelerations; galerkin: the rows' masses are the lumped masses.
   void wall_shares(bool galerkin, double *per_wall);

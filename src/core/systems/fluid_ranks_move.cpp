@@ -39,6 +39,7 @@ void FluidRanks::rebuild_halo(const double *y) {
 
 void FluidRanks::reseat(int32_t n_owned, const double *xo, const int64_t *oid, const double *data) {
   const int D = dim();
+  kept_mass_.valid = false;  // (apply_mass's columns are the nodes)
   int32_t ng = -1;
   const int64_t *ids = nullptr;
   // the host's rebuild (collective: its status is the same on every rank), then the local
