@@ -265,10 +265,13 @@ MFREE_SUNDIALS_API int mfree_sundials_residual(sunrealtype t, N_Vector y, N_Vect
  * predicted to time t), for matrix-free mass solvers such as SUNLinSol_PCG
  * (ARKStepSetMassLinearSolver(mem, LS, NULL, ...), ARKStepSetMassTimes(mem, NULL,
  * mfree_sundials_mass_times, ad)), and for vectors over ranks (NVECTOR_PARALLEL: the
- * mass of a system on ranks is block-diagonal by rank; collocation: the identity; the
- * fluid: its lumped mass, diagonal). The mass is assembled once per point: products at
- * the same t with no right-hand side (no new state) in between reuse it, as the
- * iterations of one mass solve do.
+ * lumped mass of a system on ranks is block-diagonal by rank; collocation: the identity;
+ * the fluid: its lumped mass, diagonal). The mass is assembled once per point: products
+ * at the same t with no right-hand side (no new state) in between reuse it, as the
+ * iterations of one mass solve do. With the consistent mass
+ * (mfree_sundials_set_consistent_mass) the product is the system's own,
+ * mfree_system_apply_mass at the same state: on ranks it couples owned particles to
+ * ghosts and exchanges v there (collective), and it keeps the mass of one state.
  * @param[in]  v            the vector to multiply (the system's length on this rank)
  * @param[out] Mv           M v
  * @param[in]  t            time

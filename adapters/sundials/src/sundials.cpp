@@ -124,22 +124,30 @@ mfree_status_t mass_form(mfree_sundials_t *ad, double t, const double *y, double
   return mfree_matrix_apply(ad->lumped, ad->work.data(), out);
 }
 
-// ad->mass = the mass at time t. M depends on positions and densities, whose rows of
-// M y' = F are y' = f: they are predicted to time t from the last right-hand side (first
-// order in t - state_t).
-mfree_status_t mass_at(mfree_sundials_t *ad, const char *fn, double t) {
+// The state the mass at time t is assembled at. M depends on positions and densities,
+// whose rows of M y' = F are y' = f: they are predicted to time t from the last
+// right-hand side (first order in t - state_t).
+mfree_status_t mass_state(mfree_sundials_t *ad, const char *fn, double t, const double **at) {
   if (!ad->has_state)
     return record(ad->ctx, MFREE_ERR_STATE, fn,
                   "no state to assemble the mass at: evaluate a right-hand side of the "
                   "adapter or call mfree_sundials_set_state first");
-  const double *at = ad->state.data();
+  *at = ad->state.data();
   if (ad->state_timed && t != ad->state_t) {
     ++ad->nmass_predicted;
     ad->predicted.resize(static_cast<size_t>(ad->neq));
     const double dt = t - ad->state_t;
     for (int32_t q = 0; q < ad->neq; ++q) ad->predicted[q] = ad->state[q] + dt * ad->rate[q];
-    at = ad->predicted.data();
+    *at = ad->predicted.data();
   }
+  return MFREE_SUCCESS;
+}
+
+// ad->mass = the mass at time t (at mass_state's state).
+mfree_status_t mass_at(mfree_sundials_t *ad, const char *fn, double t) {
+  const double *at = nullptr;
+  const mfree_status_t sst = mass_state(ad, fn, t, &at);
+  if (sst != MFREE_SUCCESS) return sst;
   // (the same decision on every rank of a system on ranks: the states kept and t are)
   if (ad->mass && ad->mass_gen == ad->state_gen && ad->mass_t == t && ad->mass_consistent == ad->consistent)
     return MFREE_SUCCESS;
@@ -393,7 +401,16 @@ int mfree_sundials_mass_times(N_Vector v, N_Vector Mv, sunrealtype t, void *mtim
     double *pv = nullptr, *pm = nullptr;
     mfree_status_t st = vector_data(ad, fn, "v", v, &pv);
     if (st == MFREE_SUCCESS) st = vector_data(ad, fn, "Mv", Mv, &pm);
-    if (st == MFREE_SUCCESS) st = mass_at(ad, fn, t);
+    if (st != MFREE_SUCCESS) return st;
+    if (ad->consistent) {
+      // the system's own product: on ranks the consistent mass couples owned particles
+      // to ghosts, which only the system exchanges; it keeps the mass of one state
+      const double *at = nullptr;
+      st = mass_state(ad, fn, t, &at);
+      if (st != MFREE_SUCCESS) return st;
+      return mfree_system_apply_mass(ad->sys, at, 1, pv, pm);
+    }
+    st = mass_at(ad, fn, t);
     if (st != MFREE_SUCCESS) return st;
     return mfree_matrix_apply(ad->mass, pv, pm);
   });
