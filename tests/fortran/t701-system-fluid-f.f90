@@ -4,7 +4,8 @@
 !> paper 003, derived results 1) to round-off;
 !> a native integration with a progress callback written in Fortran stops when the
 !> callback asks it to, and reports the steps taken. Without walls or gravity the walls' force
-!> (mfree_system_get_wall_force) vanishes.
+!> (mfree_system_get_wall_force) vanishes. The mass's product (mfree_system_apply_mass) is
+!> the assembled lumped mass's, and a short output array is refused.
 module t701_progress
   use, intrinsic :: iso_c_binding, only: c_ptr, c_int32_t, c_int64_t, c_double, c_f_pointer
   implicit none
@@ -41,7 +42,7 @@ program t701_system_fluid_f
   type(mfree_system) :: sys
   type(mfree_matrix) :: mm
   real(c_double) :: y(5 * n), yd(5 * n), m(n), kappa, mom(2), scale, fx, fz, t, hcol
-  real(c_double) :: ftot(2), pbad(3)
+  real(c_double) :: ftot(2), pbad(3), mv(5 * n)
   integer(c_int64_t), pointer :: rowptr(:)
   integer(c_int32_t), pointer :: cols(:)
   real(c_double), pointer :: vals(:)
@@ -94,6 +95,16 @@ program t701_system_fluid_f
   end do
   call check(all(abs(mom) <= 1e-12_c_double * scale), &
              'lumped-mass accelerations conserve linear momentum (003 eq 43)')
+
+  ! the mass's product (mfree_system_apply_mass): the lumped rows times yd, bit for bit;
+  ! an Mv one value short is refused
+  call check_ok(ctx, mfree_system_apply_mass(sys, y, 0_c_int32_t, yd, mv), 'apply_mass')
+  do p = 1, n
+    row = 2 * n + 2 * p - 1
+    call check(mv(row) == vals(rowptr(row) + 1) * yd(row), 'apply_mass: the lumped row times yd')
+  end do
+  call check(mfree_system_apply_mass(sys, y, 1_c_int32_t, yd, mv(1:5 * n - 1)) == MFREE_ERR_ARG, &
+             'apply_mass: an Mv one value short is refused')
 
   ! no walls and no gravity: the walls' force (the lumped-mass weighted accelerations' sum)
   ! vanishes to round-off; per_wall must hold dim values per wall particle
