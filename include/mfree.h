@@ -1817,6 +1817,25 @@ MFREE_API mfree_status_t mfree_system_set_velocity_smoothing(mfree_system_t *sys
  * @return MFREE_SUCCESS, or a failure named with the parameters
  */
 MFREE_API mfree_status_t mfree_system_set_lumped_mass_step(mfree_system_t *sys, int32_t on);
+/**
+ * The fluid's step also bounded by the largest frequency of its linearised acoustic
+ * operator (not in [CuetoFelgueroso2004]; a time-step control, the scheme is unchanged):
+ * mfree_system_integrate's step is at most 1.5 / omega, where omega^2 is the largest
+ * eigenvalue of M_L^-1 B^T M C B (B the rows' gradients that give the divergence of eq 70
+ * at each particle, M the particle masses, C = gamma kappa / rho_k as in eq 121, M_L the
+ * masses the acceleration divides by), found by a power iteration whose vector is kept
+ * from step to step (two iterations a step): three quarters of the explicit schemes'
+ * limit omega dt = 2, which the step of eq 120 approaches where ill-conditioned rows at a
+ * wall or in a crowded cluster have large gradients or small lumped masses
+ * (docs/time-integration.md). The bound applies to a fixed step (cfl <= 0, dt_max) too.
+ * Dummy particles are left out of the operator. With mfree_system_set_lumped_mass_step
+ * as well, the smaller of the two steps.
+ * @param[in] sys  a fluid system
+ * @param[in] on   0 (default: off) or 1; else MFREE_ERR_ARG
+ * @return MFREE_SUCCESS, MFREE_ERR_UNSUPPORTED (on = 1) for a fluid on ranks, or a failure
+ *         named with the parameters
+ */
+MFREE_API mfree_status_t mfree_system_set_acoustic_step(mfree_system_t *sys, int32_t on);
 
 /** Length of the state vector.
  * @param[in] sys the system @param[out] neq the length

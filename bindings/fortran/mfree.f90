@@ -1334,6 +1334,13 @@ module mfree
       integer(c_int32_t), value :: on
     end function mfree_system_set_lumped_mass_step_c
 
+    integer(c_int) function mfree_system_set_acoustic_step_c(sys, on) &
+        bind(C, name="mfree_system_set_acoustic_step")
+      import :: c_int, c_int32_t, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int32_t), value :: on
+    end function mfree_system_set_acoustic_step_c
+
     integer(c_int) function mfree_system_set_box_c(sys, lo, hi) &
         bind(C, name="mfree_system_set_box")
       import :: c_int, c_double, c_ptr
@@ -1659,6 +1666,7 @@ module mfree
   public :: mfree_system_set_dummy_particles_c, mfree_system_set_density_diffusion_c
   public :: mfree_system_set_consistent_integration_c, mfree_system_set_velocity_smoothing_c
   public :: mfree_system_set_lumped_mass_step_c
+  public :: mfree_system_set_acoustic_step_c
   public :: mfree_system_rhs_c, mfree_system_assemble_mass_c
   public :: mfree_system_assemble_interpolation_c, mfree_system_get_pressure_c
   public :: mfree_system_apply_mass_c
@@ -1787,6 +1795,7 @@ module mfree
   public :: mfree_system_set_dummy_particles, mfree_system_set_density_diffusion
   public :: mfree_system_set_consistent_integration, mfree_system_set_velocity_smoothing
   public :: mfree_system_set_lumped_mass_step
+  public :: mfree_system_set_acoustic_step
   public :: mfree_system_get_size, mfree_system_rhs, mfree_system_assemble_mass
   public :: mfree_system_assemble_interpolation, mfree_system_get_pressure
   public :: mfree_system_apply_mass
@@ -3851,6 +3860,13 @@ contains
     integer(c_int32_t), intent(in) :: on
     st = mfree_system_set_lumped_mass_step_c(sys%ptr, on)
   end function mfree_system_set_lumped_mass_step
+
+  !> The fluid's step also bounded by the acoustic operator's largest frequency: 0 off (default), 1 on.
+  integer(c_int) function mfree_system_set_acoustic_step(sys, on) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int32_t), intent(in) :: on
+    st = mfree_system_set_acoustic_step_c(sys%ptr, on)
+  end function mfree_system_set_acoustic_step
 
   !> Typed wrapper of mfree_system_set_box (mfree.h).
   integer(c_int) function mfree_system_set_box(sys, lo, hi) result(st)

@@ -177,6 +177,9 @@ mfree_status_t mfree_system_set_velocity_smoothing(mfree_system_t *sys, double b
 mfree_status_t mfree_system_set_lumped_mass_step(mfree_system_t *sys, int32_t on) {
   MFREE_SYS_SETTER("mfree_system_set_lumped_mass_step", f.set_lumped_mass_step(on));
 }
+mfree_status_t mfree_system_set_acoustic_step(mfree_system_t *sys, int32_t on) {
+  MFREE_SYS_SETTER("mfree_system_set_acoustic_step", f.set_acoustic_step(on));
+}
 
 mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
   return mfree::with_handle(sys, "mfree_system_get_size", [&](const mfree::System &f) {

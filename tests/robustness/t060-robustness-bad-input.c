@@ -1136,6 +1136,9 @@ static void rows_system(void) {
   ROW0(MFREE_ERR_NULL, mfree_system_set_lumped_mass_step(NULL, 1));
   ROW(MFREE_ERR_ARG, mfree_system_set_lumped_mass_step(F.sys, -1));
   ROW(MFREE_ERR_ARG, mfree_system_set_lumped_mass_step(F.sys, 2));
+  ROW0(MFREE_ERR_NULL, mfree_system_set_acoustic_step(NULL, 1));
+  ROW(MFREE_ERR_ARG, mfree_system_set_acoustic_step(F.sys, -1));
+  ROW(MFREE_ERR_ARG, mfree_system_set_acoustic_step(F.sys, 2));
   ROW0(MFREE_ERR_NULL, mfree_system_set_box(NULL, lo, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, NULL, hi));
   ROW(MFREE_ERR_NULL, mfree_system_set_box(F.sys, lo, NULL));

@@ -117,6 +117,14 @@ void FluidSystem::set_lumped_mass_step(int on) {
   lumped_step_ = on != 0;
 }
 
+void FluidSystem::set_acoustic_step(int on) {
+  if (on != 0 && on != 1) throw Error(MFREE_ERR_ARG, "acoustic step: 0 or 1, not " + std::to_string(on));
+  // its power iteration runs over this process's nodes; on ranks it needs the ghost exchange
+  if (on && on_ranks()) throw Error(MFREE_ERR_UNSUPPORTED, "no acoustic step for the fluid on ranks yet");
+  acoustic_step_ = on != 0;
+  pw_u_.clear();  // a fresh start of the power iteration
+}
+
 void FluidSystem::check_ready() const {
   if (mass_.size() != static_cast<size_t>(n_)) throw Error(MFREE_ERR_STATE, "particle masses are not set");
   if (!(h_ > 0.0)) throw Error(MFREE_ERR_STATE, "the smoothing length is not set");
@@ -376,6 +384,74 @@ void FluidSystem::mass_matrix(int32_t np, const int32_t *node, const int32_t *pa
   std::copy(vals.begin(), vals.end(), M.values_mut().begin());
 }
 
+// The Galerkin lumped masses m_i = sum_k N_i(x_k) M_k (eq 56) on the prepared tables, as
+// accel sums them (dummies carry no fluid mass), in the order of the rows.
+void FluidSystem::galerkin_lumped(std::vector<double> &m) const {
+  m.assign(n_, 0.0);
+  for (int32_t k = 0; k < nq(); ++k)
+    for (int64_t q = rb(k); q < re(k); ++q)
+      if (cols_[q] < n_) m[cols_[q]] += N_[q] * (k < n_ ? mass_[k] / share(k) : 0.0);
+}
+
+// The largest eigenvalue omega^2 of the linearised acoustic operator M_L^-1 B^T M C B on
+// the prepared tables (B: nodal velocities to the divergence at the particles, as the
+// density rate of eq 70 takes it; M the particle masses, C = gamma kappa / rho_k as in
+// eq 121, M_L the lumped masses accel divides by), by `iters` steps of a power iteration
+// whose vector is kept from the last call: the dominant mode moves slowly with the
+// particles, so a few iterations a step follow it. A small fixed vector is added at every
+// call so that a mode growing elsewhere (a cluster becoming ill-conditioned) always has a
+// share to grow from. The Rayleigh quotient in the M_L inner product (the operator is
+// self-adjoint in it) bounds omega^2 from below. Fluid particles only (no dummies); serial,
+// so the result does not depend on the thread count.
+double FluidSystem::acoustic_omega2(const double *y, int iters) {
+  const int D = dim_;
+  const size_t nd = static_cast<size_t>(D) * n_;
+  const double *rho = y + 2 * nd;
+  const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
+  if (galerkin) galerkin_lumped(pw_m_);
+  else pw_m_.assign(mass_.begin(), mass_.begin() + n_);
+  if (pw_u_.size() != nd) {  // first call (or the particles changed): converge from scratch
+    pw_u_.assign(nd, 0.0);
+    iters = std::max(iters, 30);
+  }
+  double uu = 0.0;
+  for (size_t q = 0; q < nd; ++q) uu += pw_u_[q] * pw_u_[q];
+  const double seed = uu > 0.0 ? 1e-3 * std::sqrt(uu / static_cast<double>(nd)) : 1.0;  // relative to u
+  for (size_t q = 0; q < nd; ++q)  // a fixed pseudo-random vector (Knuth's multiplicative hash)
+    pw_u_[q] += seed * (static_cast<double>((q * 2654435761u) % 1000) / 1000.0 - 0.5);
+  pw_w_.resize(nd);
+  pw_div_.resize(n_);
+  double lam = 0.0;
+  for (int it = 0; it < iters; ++it) {
+    for (int32_t k = 0; k < n_; ++k) {  // M C B u
+      double dv = 0.0;
+      for (int64_t q = rb(k); q < re(k); ++q)
+        if (cols_[q] < n_)
+          for (int c = 0; c < D; ++c) dv += pw_u_[static_cast<size_t>(cols_[q]) * D + c] * G_[q * D + c];
+      pw_div_[k] = dv * mass_[k] * gamma_ * kappa_ / rho[k];
+    }
+    std::fill(pw_w_.begin(), pw_w_.end(), 0.0);
+    for (int32_t k = 0; k < n_; ++k)  // B^T (M C B u)
+      for (int64_t q = rb(k); q < re(k); ++q)
+        if (cols_[q] < n_)
+          for (int c = 0; c < D; ++c) pw_w_[static_cast<size_t>(cols_[q]) * D + c] += pw_div_[k] * G_[q * D + c];
+    double num = 0.0, den = 0.0, nw = 0.0;
+    for (int32_t i = 0; i < n_; ++i)
+      for (int c = 0; c < D; ++c) {
+        const size_t q = static_cast<size_t>(i) * D + c;
+        num += pw_u_[q] * pw_w_[q];
+        den += pw_u_[q] * pw_u_[q] * pw_m_[i];
+        pw_w_[q] /= pw_m_[i];
+        nw += pw_w_[q] * pw_w_[q] * pw_m_[i];
+      }
+    if (!(den > 0.0 && nw > 0.0 && std::isfinite(nw))) break;  // no fluid motion the rows see
+    lam = num / den;
+    const double s = 1.0 / std::sqrt(nw);
+    for (size_t q = 0; q < nd; ++q) pw_u_[q] = pw_w_[q] * s;
+  }
+  return lam;
+}
+
 double FluidSystem::stable_dt(const double *y) {
   const size_t nd = static_cast<size_t>(dim_) * n_;
   const double *v = y + nd, *rho = y + 2 * nd;
@@ -414,10 +490,7 @@ double FluidSystem::stable_dt(const double *y) {
     // that extrapolate (ill-conditioned linear MLS at a wall or a sheet, whose N_i(x_k) < 0)
     // it falls to a third of M_i: the local acoustic frequency grows as sqrt(M_i / m_i)
     // and leap-frog's limit dt omega = 2 is crossed (docs/time-integration.md).
-    lumped_.assign(n_, 0.0);
-    for (int32_t k = 0; k < nq(); ++k)
-      for (int64_t q = rb(k); q < re(k); ++q)
-        if (cols_[q] < n_) lumped_[cols_[q]] += N_[q] * (k < n_ ? mass_[k] / share(k) : 0.0);
+    galerkin_lumped(lumped_);
     for (int32_t i = 0; i < n_; ++i) {
       if (!(lumped_[i] < mass_[i]) || !steps_by(i)) continue;
       double vv = 0.0;
@@ -428,6 +501,18 @@ double FluidSystem::stable_dt(const double *y) {
     }
   }
   return cmax > 0.0 ? h_ / cmax : INFINITY;
+}
+
+double FluidSystem::acoustic_cap(const double *y) {
+  if (!acoustic_step_) return INFINITY;
+  // Eq 120 measures the frequencies against h / c; at crowded sites beside a wall the
+  // rows' gradients (and the lumped masses) make the largest frequency omega of the
+  // acoustic operator exceed what h / c assumes, and with omega dt near 2 both schemes
+  // grow a period-2 mode there (docs/time-integration.md). 1.5 / omega leaves a quarter
+  // of the limit 2 for what the linear acoustics leave out (viscosity, the wall force)
+  // and for the power iteration's estimate from below.
+  const double w2 = acoustic_omega2(y, 2);
+  return w2 > 0.0 ? 1.5 / std::sqrt(w2) : INFINITY;
 }
 
 namespace {
@@ -481,7 +566,7 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
       return rep;
     }
     double dt = 0.0;
-    rep = step_size(stable_dt(y), cfl, dt_max, t, t_end, nsteps, y, dt);
+    rep = step_size(stable_dt(y), cfl, dt_max, t, t_end, nsteps, y, dt, acoustic_cap(y));
     if (!rep.ok()) return rep;
     dt = std::min(dt, t_end - t);
     double *yn = work_state_.data();
@@ -543,7 +628,7 @@ Report FluidSystem::integrate(int scheme, double *y, double &t, double t_end, do
 }
 
 Report FluidSystem::step_size(double limit, double cfl, double dt_max, double t, double t_end, int64_t nsteps,
-                              const double *y, double &dt) const {
+                              const double *y, double &dt, double cap) const {
   Report rep;
   dt = cfl > 0.0 ? cfl * limit : dt_max;
   if (cfl > 0.0 && dt_max > 0.0) dt = std::min(dt, dt_max);
@@ -553,6 +638,7 @@ Report FluidSystem::step_size(double limit, double cfl, double dt_max, double t,
     rep.fail(MFREE_FAIL_CFL, s.str());
     return rep;
   }
+  dt = std::min(dt, cap);
   if (!(t + dt > t) && dt < t_end - t) {
     // speeds so large that h / max(c + |v|) is 0 (|v|^2 or gamma kappa / rho overflow)
     // or a step below t's resolution: the loop would never end

@@ -46,6 +46,10 @@ class FluidSystem : public System {
   // The CFL step with each particle's speed scaled by sqrt(M_i / m_i) where its Galerkin
   // lumped mass m_i is below its particle mass M_i (fluid.cpp, stable_dt); 0 (default): eq 120.
   void set_lumped_mass_step(int on);
+  // The step also at most 1.5 / omega_max, omega_max the largest frequency of the
+  // linearised acoustic operator by a power iteration carried from step to step (fluid.cpp,
+  // acoustic_omega2); 0 (default): off.
+  void set_acoustic_step(int on);
 
   int dim() const { return dim_; }
   int32_t size() const { return n_; }
@@ -191,7 +195,8 @@ class FluidSystem : public System {
   // > 0) or dt_max checked against the limit, then cut at t_end; a failure if it no longer
   // advances t (y, if not NULL, names the fastest particle in the message).
   Report step_size(double limit, double cfl, double dt_max, double t, double t_end, int64_t nsteps,
-                   const double *y, double &dt) const;
+                   const double *y, double &dt, double cap = INFINITY) const;
+  double acoustic_cap(const double *y);  // set_acoustic_step's bound 1.5 / omega (INFINITY when off)
   std::string fastest(const double *y) const;  // message part naming the particle of max c_i + |v_i|
   // The first invalid particle of y, if any; step >= 0 prefixes the message with it.
   Report check_state(const double *y, int64_t step) const;
@@ -282,6 +287,11 @@ class FluidSystem : public System {
   const double *wall_switch_v_ = nullptr;
   bool lumped_step_ = false;           // set_lumped_mass_step
   std::vector<double> lumped_;         // stable_dt's lumped masses (with lumped_step_)
+  // set_acoustic_step: the power iteration's vector (kept between steps) and its scratch
+  bool acoustic_step_ = false;
+  std::vector<double> pw_u_, pw_w_, pw_div_, pw_m_;
+  double acoustic_omega2(const double *y, int iters);  // on the prepared tables
+  void galerkin_lumped(std::vector<double> &m) const;  // eq 56 on the prepared tables
   // accel scatters row k's contributions to the nodes of the row; rows go in chunks of
   // kChunk, chunk_order_[color_ptr_[c] .. color_ptr_[c + 1]) are the chunks of colour c,
   // which no two of touch a common node. Colours run one after another, so every node

@@ -351,6 +351,7 @@ FluidSystem &FluidSystem::open_inner() const {
   in->set_consistent_integration(vci_ ? 1 : 0);
   in->set_velocity_smoothing(vsmooth_);
   in->set_lumped_mass_step(lumped_step_ ? 1 : 0);
+  in->set_acoustic_step(acoustic_step_ ? 1 : 0);
   o.inner = std::move(in);
   o.dirty = false;
   return *o.inner;
