@@ -32,7 +32,10 @@
  * JSON summary bore.json (--json: on stdout too): {"status":..,"error":..,"t":..,
  * "steps":..,"particles":..,"bore_speed":..,"reference":..,"rel_dev":..,"fit_points":..,
  * "fit_window":[..],"depth_ratio":..,"h_m":..,"h_m_reference":..,"h_m_rel_dev":..,"h_m_time":..,
- * "bore":[[t,x],...],"mass_rel_error":..,"cfl":..,"wall_seconds":..}. --vtu DIR: the VTU
+ * "bore":[[t,x],...],"mass_rel_error":..,"cfl":..,"lumped_mass_step":..,"acoustic_step":..,
+ * "wall_seconds":..}. --lumped-step 1, --acoustic-step 1: the step controls beyond the paper
+ * (mfree_system_set_lumped_mass_step, mfree_system_set_acoustic_step) with which the run holds
+ * at the paper's CFL 0.5 (docs/fluid.md). --vtu DIR: the VTU
  * series every 0.05 s. A run that stops on an error says so and exits with status 3. */
 #define _XOPEN_SOURCE 700
 #include <math.h>
@@ -125,24 +128,27 @@ static double profile(const fc_run_t *r, const bore_t *b, const double *height, 
 static void usage(FILE *f) {
   fprintf(f, "usage: mfree_bore [--nz N (20)] [--ratio R (0.5)] [--deep LD (0.5 m)] [--tank L (1.5 m)]\n"
              "                  [--tend T (2 s; the run stops earlier, two depths before the end wall)]\n"
-             "                  [--cfl C (0.5)] [--mu MU (0.5)] [run options; --vtu-every in s, default 0.05]\n");
+             "                  [--cfl C (0.5)] [--mu MU (0.5)] [--lumped-step 0|1 (0)] [--acoustic-step 0|1 (0)]\n"
+             "                  [run options; --vtu-every in s, default 0.05]\n");
   fc_run_usage(f);
 }
 
 int main(int argc, char **argv) {
-  int nz = 20;
+  int nz = 20, lumped_step = 0, acoustic_step = 0;
   double ratio = 0.5, deep = 0.5, tank = 1.5, t_end = 2.0, cfl = 0.5, mu = 0.5;
   fc_run_t ro;
   fc_run_init(&ro, "bore", 0.05);
   const fc_option_t opts[] = {{"--nz", 'i', &nz},     {"--ratio", 'd', &ratio}, {"--deep", 'd', &deep},
                               {"--tank", 'd', &tank}, {"--tend", 'd', &t_end},  {"--cfl", 'd', &cfl},
-                              {"--mu", 'd', &mu},     {NULL, 0, NULL}};
+                              {"--mu", 'd', &mu},     {"--lumped-step", 'i', &lumped_step},
+                              {"--acoustic-step", 'i', &acoustic_step}, {NULL, 0, NULL}};
   const int parsed = fc_parse(argc, argv, &ro, opts, usage);
   if (parsed) return parsed < 0 ? 0 : parsed;
   const double d = kH1 / (nz > 0 ? nz : 1);
   const int nz0 = (int)lround(ratio * nz), nd = (int)lround(deep / d), ns = (int)lround((tank - deep) / d);
   if (nz < 4 || !(ratio > 0 && ratio < 1) || nz0 < 2 || nz0 >= nz || nd < 4 || !(tank - deep >= 6 * kH1) ||
-      !(t_end > 0) || !(cfl > 0 && cfl <= 1) || !(mu >= 0)) {
+      !(t_end > 0) || !(cfl > 0 && cfl <= 1) || !(mu >= 0) || (lumped_step != 0 && lumped_step != 1) ||
+      (acoustic_step != 0 && acoustic_step != 1)) {
     usage(stderr);
     return 2;
   }
@@ -169,6 +175,8 @@ int main(int argc, char **argv) {
   CHECK(fc_fluid_create(ctx, n, m, &kRho0, 0, kappa, kGamma, mu, h, kG, &w, 10.0, &sys));
   const double lo[2] = {-off, -off}, hi[2] = {L + off, 10.0 * h1};
   CHECK(mfree_system_set_box(sys, lo, hi));
+  CHECK(mfree_system_set_lumped_mass_step(sys, lumped_step));
+  CHECK(mfree_system_set_acoustic_step(sys, acoustic_step));
   double mass0 = 0.0;
   for (int k = 0; k < n; ++k) mass0 += m[k];
 
@@ -274,6 +282,8 @@ int main(int argc, char **argv) {
   fc_json_table(&js, "bore", series.n / 2, 2, series.v);
   fc_json_num(&js, "mass_rel_error", mass_err);
   fc_json_num(&js, "cfl", cfl);
+  fc_json_int(&js, "lumped_mass_step", lumped_step);
+  fc_json_int(&js, "acoustic_step", acoustic_step);
   fc_json_num(&js, "wall_seconds", wall);
   if (fc_json_finish(&js, &ro)) return 1;
   if (!ro.json_stdout) {
