@@ -47,11 +47,12 @@ struct FastTables {
   // cols are a particle set's candidate lists that it left to the caller
   // (ParticleSet::set_rows_left), the sites its particles, kappa its search radius factor.
   // Site s keeps the candidates within kappa sh[s] by the search's pair test
-  // (pair_test.hpp), in their order, at kept[rowptr[s] ..), and its row ends at
-  // rowend[s]; values and gradients go from entry rowptr[s]. The same rows and tables as
-  // from the set's own filter.
+  // (pair_test.hpp), in their order, at kept[rowbeg[s] .. rowend[s]), and its values and
+  // gradients at the same entries: the rows of a call's sites [b, e) one after the other
+  // from rowptr[b] (compacted: the tables' entries in use stay together). The same rows
+  // and tables as from the set's own filter.
   int32_t *kept = nullptr;
-  int64_t *rowend = nullptr;
+  int64_t *rowbeg = nullptr, *rowend = nullptr;
   double kappa = 0.0;
 };
 

@@ -346,13 +346,14 @@ void mls1_rows2(const FastTables &t, int64_t b, int64_t e, double min_rcond, Fas
   r.wv = ws.d(4);
   r.gv = ws.d(6);
   const int64_t kend = t.rowptr[e];
+  int64_t o = t.rowptr[b];  // (Filter: where the next row goes)
   for (int64_t s = b; s < e; ++s) {
     if (out.pst && out.pst[s] != 0) {  // failed in the set: an empty row
       out.status[s] = out.pst[s];
       out.support[s] = 0;
       out.cond[s] = 1.0;
       out.order[s] = -1;
-      if (Filter) t.rowend[s] = t.rowptr[s];
+      if (Filter) t.rowbeg[s] = t.rowend[s] = o;
       continue;
     }
     const int64_t k0 = t.rowptr[s];
@@ -364,14 +365,17 @@ void mls1_rows2(const FastTables &t, int64_t b, int64_t e, double min_rcond, Fas
       const int nc = static_cast<int>(t.rowptr[s + 1] - k0);
       const double lim2 = pair_test::limit2(t.kappa * hs);
       const bool room = t.rowptr[s + 1] + 3 <= kend;
-      r.n = t.stride == 2 ? avx2::filtered_offsets<2>(r, t.cols + k0, nc, lim2, t.kept + k0, room)
-                          : avx2::filtered_offsets<0>(r, t.cols + k0, nc, lim2, t.kept + k0, room);
-      t.rowend[s] = k0 + r.n;
+      r.n = t.stride == 2 ? avx2::filtered_offsets<2>(r, t.cols + k0, nc, lim2, t.kept + o, room)
+                          : avx2::filtered_offsets<0>(r, t.cols + k0, nc, lim2, t.kept + o, room);
+      t.rowbeg[s] = o;
+      t.rowend[s] = o + r.n;
     } else {
       r.n = static_cast<int>(t.rowptr[s + 1] - k0);
       r.cc = t.cols + k0;
       avx2::offsets(r);
     }
+    const int64_t w0 = Filter ? o : k0;  // the row's first entry
+    if (Filter) o += r.n;
     avx2::Moments mo;
     avx2::moments(r, mo);
     avx2::Coefs k;
@@ -384,7 +388,7 @@ void mls1_rows2(const FastTables &t, int64_t b, int64_t e, double min_rcond, Fas
     out.support[s] = mo.support;
     out.cond[s] = cond;
     out.order[s] = out.order_used;
-    avx2::outputs(r, k, t.val + k0, t.grad + 2 * k0);
+    avx2::outputs(r, k, t.val + w0, t.grad + 2 * w0);
   }
 }
 }  // namespace

@@ -258,12 +258,13 @@ class FluidSystem : public System {
   int64_t re(int64_t k) const { return re_[k]; }
   // row begins and ends and the columns: ps_.neighbors() after the last prepare, or,
   // where the set left its rows to the fast path's filter (ps_.rows_left(): no
-  // consistent integration, whose transposed writes need every row first), rows at the
-  // candidates' offsets, their columns in kept_ and their ends in rowend_
+  // consistent integration, whose transposed writes need every row first), rows in the
+  // candidates' storage, each chunk's rows one after the other from its candidates' start
+  // (FastTables::kept): columns in kept_, begins and ends in rowbeg_ and rowend_
   const int64_t *rb_ = nullptr, *re_ = nullptr;
   const int32_t *cols_ = nullptr;
   HVec<int32_t> kept_;
-  HVec<int64_t> rowend_;
+  HVec<int64_t> rowbeg_, rowend_;
   // HVec: without an allocator hook, blocks >= 2 MiB get transparent huge pages (alloc.hpp):
   // the tables (~18 MB at 25,000 particles) are written and read three times per step
   HVec<double> N_, G_, NT_;

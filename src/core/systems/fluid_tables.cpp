@@ -33,8 +33,11 @@ Report FluidSystem::candidates(const double *xn) {
   const int64_t cnnz = cand.nnz();
   if (ps_.rows_left()) {  // (sized for the candidates: no allocation until they grow)
     if (kept_.size() < static_cast<size_t>(cnnz)) kept_.resize(cnnz);
-    if (rowend_.size() < static_cast<size_t>(nall)) rowend_.resize(nall);
-    rb_ = cand.rowptr.data();
+    if (rowend_.size() < static_cast<size_t>(nall)) {
+      rowbeg_.resize(nall);
+      rowend_.resize(nall);
+    }
+    rb_ = rowbeg_.data();
     re_ = rowend_.data();
     cols_ = kept_.data();
   } else {
@@ -166,8 +169,10 @@ bool FluidSystem::table_rows(int t, int32_t k0, int32_t k1, const double *xn, co
   const bool left = ps_.rows_left();
   if (left) {  // the fast path filters the candidates (FastPath::filters_rows)
     const Csr &cand = ps_.search_candidates();
+    ft.rowptr = cand.rowptr.data();
     ft.cols = cand.cols.data();
     ft.kept = kept_.data();
+    ft.rowbeg = rowbeg_.data();
     ft.rowend = rowend_.data();
     ft.kappa = ps_.kappa();
   }
