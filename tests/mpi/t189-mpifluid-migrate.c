@@ -11,7 +11,8 @@
  * Built with FLUID_OPTIONS (t174), the program runs the same with one option of the
  * one-process fluid set on every system, named by its argument: density diffusion
  * (delta 0.1), velocity smoothing (beta 0.1), consistent integration or the lumped-mass
- * step. Then also, on every rank, the one-process fluid (mfree_system_create_fluid, 512
+ * step, or all four ("all"); a second argument "pc" runs the predictor-corrector in place
+ * of leap-frog. Then also, on every rank, the one-process fluid (mfree_system_create_fluid, 512
  * particles: one chunk of rows, its scatter in the rank's order) with the option takes
  * the same steps to the same bits as the one-rank run after every window, and without
  * the option it ends elsewhere (the option acts). */
@@ -29,11 +30,18 @@
 
 enum { NX = 16, NZ = 32, WINDOWS = 4 };
 static const int64_t kWindow = 125;
+static mfree_integrator_t scheme = MFREE_INTEGRATOR_LEAPFROG;
 
 #ifdef FLUID_OPTIONS
 /* The option named opt set on sys (NULL: none). */
 static mfree_status_t set_option(mfree_system_t *sys, const char *opt) {
   if (!opt) return MFREE_SUCCESS;
+  if (!strcmp(opt, "all")) {
+    static const char *each[4] = {"diffusion", "smoothing", "vci", "lumped-step"};
+    mfree_status_t st = MFREE_SUCCESS;
+    for (int k = 0; k < 4 && st == MFREE_SUCCESS; ++k) st = set_option(sys, each[k]);
+    return st;
+  }
   if (!strcmp(opt, "diffusion")) return mfree_system_set_density_diffusion(sys, 0.1);
   if (!strcmp(opt, "smoothing")) return mfree_system_set_velocity_smoothing(sys, 0.1);
   if (!strcmp(opt, "vci")) return mfree_system_set_consistent_integration(sys, 1);
@@ -57,7 +65,7 @@ static int one_process_differs(mfree_context_t *ctx, const damb_t *b, const char
   int differs = 0;
   for (int w = 0; w < WINDOWS && st == MFREE_SUCCESS; ++w) {
     int64_t steps = 0;
-    st = mfree_system_integrate(sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+    st = mfree_system_integrate(sys, scheme, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
                                 (void *)&kWindow, &steps);
     if (compare) differs += steps != steps_ref[w] || t != t_ref[w] || memcmp(y, ref[w], 5 * (size_t)n * sizeof *y);
   }
@@ -83,6 +91,7 @@ int main(int argc, char **argv) {
   mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, 4.0 * b.h + 4.0 * b.d, 0);
 #ifdef FLUID_OPTIONS
   const char *opt = argc > 1 ? argv[1] : "(none)";
+  if (argc > 2 && !strcmp(argv[2], "pc")) scheme = MFREE_INTEGRATOR_PREDICTOR_CORRECTOR;
   if (st == MFREE_SUCCESS) st = set_option(ref.sys, opt);
 #endif
   CHECK(st == MFREE_SUCCESS, "one-rank system: status %d: %s", (int)st, mpifluid_error(ctx));
@@ -90,7 +99,7 @@ int main(int argc, char **argv) {
   int64_t steps_ref[WINDOWS];
   double t = 0.0;
   for (int w = 0; w < WINDOWS && st == MFREE_SUCCESS; ++w) {
-    st = mfree_system_integrate(ref.sys, MFREE_INTEGRATOR_LEAPFROG, ref.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+    st = mfree_system_integrate(ref.sys, scheme, ref.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
                                 (void *)&kWindow, &steps_ref[w]);
     CHECK(st == MFREE_SUCCESS && steps_ref[w] == kWindow, "one rank, window %d: status %d: %s", w, (int)st,
           mpifluid_error(ctx));
@@ -124,7 +133,7 @@ int main(int argc, char **argv) {
   t = 0.0;
   for (int w = 0; w < WINDOWS && st == MFREE_SUCCESS; ++w) {
     int64_t steps = 0;
-    st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
+    st = mfree_system_integrate(r.sys, scheme, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at,
                                 (void *)&kWindow, &steps);
     CHECK(st == MFREE_SUCCESS, "window %d: integrate status %d: %s", w, (int)st, mpifluid_error(ctx));
     CHECK(steps == steps_ref[w] && t == t_ref[w], "window %d: %lld steps to t = %.17g, one rank %lld to %.17g", w,
@@ -180,7 +189,7 @@ int main(int argc, char **argv) {
   CHECK(!one_process_differs(ctx, &b, opt, ref_y, steps_ref, t_ref, 1),
         "%s: the one-process fluid differs from the one-rank run", opt);
   CHECK(!one_process_differs(ctx, &b, NULL, ref_y, steps_ref, t_ref, 0), "%s: the run without it ends the same", opt);
-  if (rank == 0) printf("%s: %s\n", TEST_NAME, opt);
+  if (rank == 0) printf("%s: %s, %s\n", TEST_NAME, opt, scheme == MFREE_INTEGRATOR_LEAPFROG ? "leap-frog" : "pc");
 #endif
 
   mfree_migration_destroy(&mig);
