@@ -1851,7 +1851,9 @@ MFREE_API mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, i
  * @param[in] sys the system @param[in] t time @param[in] y state
  * @param[out] ydot its rate (unspecified after a positive status)
  * @return a positive status naming the particle for a non-finite or out-of-range
- *         state */
+ *         state; MFREE_ERR_NULL for a NULL y or ydot (neq > 0). On ranks collective: a
+ *         NULL array on one rank makes every rank return MFREE_ERR_NULL with that rank's
+ *         message ("rank R: y or ydot is NULL"), no output written (docs/mpi.md) */
 MFREE_API mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y,
                                           double *ydot);
 /** Mass matrix of the state: the identity except the velocity block, which holds the
@@ -1861,7 +1863,9 @@ MFREE_API mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const d
  * @param[in]     y           state
  * @param[in]     consistent  0 lumped, nonzero consistent
  * @param[in,out] M           *M NULL: created (owned by the host); else refilled
- * @return MFREE_SUCCESS, or a failure named with the parameters */
+ * @return MFREE_SUCCESS, or a failure named with the parameters; MFREE_ERR_NULL for a
+ *         NULL M or y (neq > 0). The fluid on ranks: collective, a NULL on one rank is
+ *         MFREE_ERR_NULL on every rank ("rank R: ..."), no matrix made or changed */
 MFREE_API mfree_status_t mfree_system_assemble_mass(mfree_system_t *sys, const double *y,
                                                     int32_t consistent, mfree_matrix_t **M);
 /** S_kj = N_j(x_k) at the state's positions: initial velocity parameters solve
@@ -1901,7 +1905,8 @@ MFREE_API mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys,
 /** Interpolated velocities v_hat(x_k) (on ranks: of the owned particles; collective).
  * @param[in] sys a fluid system @param[in] y state
  * @param[out] vhat dim values per particle (AoS)
- * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL y or vhat (on ranks: on every rank,
+ *         with the rank's message "rank R: y or vhat is NULL") */
 MFREE_API mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y,
                                                    double *vhat);
 
@@ -1922,7 +1927,8 @@ MFREE_API mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const do
  *                       (else MFREE_ERR_ARG; ignored when per_wall is NULL)
  * @param[out] per_wall  dim values per wall particle (AoS), or NULL (not both NULL)
  * @return MFREE_SUCCESS, or a failure named with the parameters; a positive status
- *         naming the particle for a non-finite or out-of-range state
+ *         naming the particle for a non-finite or out-of-range state. On ranks every
+ *         failure, a NULL y or both outputs NULL on one rank too, is every rank's
  */
 MFREE_API mfree_status_t mfree_system_get_wall_force(mfree_system_t *sys, const double *y,
                                                      double *total, int32_t nwall,
@@ -1945,7 +1951,10 @@ MFREE_API mfree_status_t mfree_system_get_wall_force(mfree_system_t *sys, const 
  * @param[in]     progress  called after every step, or NULL
  * @param[in]     user      passed to progress
  * @param[out]    nsteps    steps taken, or NULL
- * @return MFREE_FAIL_NONFINITE, MFREE_FAIL_DOMAIN or MFREE_FAIL_CFL as above
+ * @return MFREE_FAIL_NONFINITE, MFREE_FAIL_DOMAIN or MFREE_FAIL_CFL as above;
+ *         MFREE_ERR_NULL for a NULL t or y (neq > 0). On ranks collective: a NULL on
+ *         one rank makes every rank return MFREE_ERR_NULL ("rank R: y or t is NULL")
+ *         before any step, y and t unchanged
  */
 MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
                                                 mfree_integrator_t scheme, double *y,
@@ -2112,7 +2121,8 @@ MFREE_API mfree_status_t mfree_system_set_load_history(mfree_system_t *sys,
  * applied at time t.
  * @param[in] sys a collocation elastodynamic system (Galerkin: MFREE_ERR_UNSUPPORTED)
  * @param[in] t time @param[in] y state @param[out] sigma stresses
- * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL y or sigma (on ranks, where the
+ *         call is collective: on every rank, with the rank's message "rank R: ...") */
 MFREE_API mfree_status_t mfree_system_get_stress(mfree_system_t *sys, double t,
                                                  const double *y, double *sigma);
 
@@ -2154,8 +2164,9 @@ typedef mfree_status_t (*mfree_allgather_fn)(void *user, const double *in, int64
  * the ghosts' displacements through exchange, and gathers the boundary rows' data through
  * allgather (the boundary unknowns are solved in global-id order on every rank, so that
  * the owned particles' results are bitwise those of one rank, whatever the partition).
- * A failure on one rank (a non-finite state: MFREE_FAIL_NONFINITE) is returned by every
- * rank with that rank's message ("rank R: ..."). Creation is collective too: a NULL
+ * A failure on one rank (a non-finite state: MFREE_FAIL_NONFINITE; a NULL array or
+ * output passed to a collective call: MFREE_ERR_NULL, the rank still taking part) is
+ * returned by every rank with that rank's message ("rank R: ..."). Creation is collective too: a NULL
  * assembler or a bad density on one rank, or ranks that disagree on the density, the
  * form or its coefficients, make every rank fail alike (MFREE_ERR_NULL, MFREE_ERR_ARG).
  * A Galerkin stiffness assembler (Laplace or elasticity form, as for
@@ -2175,7 +2186,8 @@ typedef mfree_status_t (*mfree_allgather_fn)(void *user, const double *in, int64
  * @param[in]  exchange   the forward halo exchange (NULL: MFREE_ERR_NULL, local)
  * @param[in]  allgather  the all-gather (NULL: MFREE_ERR_NULL, local)
  * @param[in]  user       passed to both callbacks; kept
- * @param[out] sys        the new system (NULL: MFREE_ERR_NULL, local)
+ * @param[out] sys        the new system (NULL: the rank takes part, every rank fails
+ *                        with MFREE_ERR_NULL)
  * @return MFREE_SUCCESS, or a failure named with the parameters, alike on every rank
  */
 MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
@@ -2202,8 +2214,9 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * are rebuilt through the host's rebuild callback (mfree_system_set_halo_rebuild) or,
  * without one, every rank returns MFREE_ERR_HALO (rebuild the halo and the system).
  * Particles move between ranks with mfree_system_move_particles. A failure on one rank (a non-finite
- * state: MFREE_FAIL_NONFINITE) is returned by every rank with that rank's message
- * ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
+ * state: MFREE_FAIL_NONFINITE; a NULL array or output passed to a collective call:
+ * MFREE_ERR_NULL, the rank still taking part) is returned by every rank with that rank's
+ * message ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
  * consistent integration, velocity smoothing or open boundaries (MFREE_ERR_UNSUPPORTED). Outputs: the owned
  * particles' (docs/fluid-ranks.md); the consistent mass as products (mfree_system_apply_mass). Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.
@@ -2217,7 +2230,8 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * @param[in]  exchange    the forward halo exchange (NULL: MFREE_ERR_NULL, local)
  * @param[in]  allgather   the all-gather (NULL: MFREE_ERR_NULL, local)
  * @param[in]  user        passed to both callbacks; kept
- * @param[out] sys         the new system (NULL: MFREE_ERR_NULL, local)
+ * @param[out] sys         the new system (NULL: the rank takes part, every rank fails
+ *                         with MFREE_ERR_NULL)
  * @return MFREE_SUCCESS, or a failure named with the parameters, alike on every rank
  */
 MFREE_API mfree_status_t mfree_system_create_fluid_ranks(

@@ -1,3 +1,5 @@
+#include <vector>
+
 #include "core/systems/elastodynamics.hpp"
 #include "core/systems/fluid.hpp"
 #include "core/systems/fluid_ranks.hpp"
@@ -29,11 +31,62 @@ const T &kind(const mfree::System &s, const char *what) {
   return *t;
 }
 
-// Fill *M (created when NULL) through a core routine that writes a SparseMatrix.
+// The arguments of a call that is collective for a system on ranks. A fault found here
+// (a NULL array or output) is thrown at once for a system in one process, as by any
+// call; on ranks the call goes on with stand-in buffers and the fault pending on the
+// system's collective operations, whose first agreement returns it on every rank, so
+// that no rank waits in a collective for one that returned. A fault that no agreement
+// took (the operation is local on ranks) is thrown when the call ends.
+class CollectiveArgs {
+ public:
+  explicit CollectiveArgs(const mfree::System &s) : coll_(s.collective()) {}
+  explicit CollectiveArgs(const mfree::Collective *coll) : coll_(coll) {}
+  CollectiveArgs(const CollectiveArgs &) = delete;
+  CollectiveArgs &operator=(const CollectiveArgs &) = delete;
+  ~CollectiveArgs() {
+    if (coll_) coll_->set_pending(mfree::Report());
+  }
+  // A check: its fault (the first one) thrown, or pending on ranks.
+  void require(bool ok, mfree_status_t st, const char *why) {
+    if (ok || faulty()) return;
+    if (!coll_) throw mfree::Error(st, why);
+    fault_.fail(st, why);
+    coll_->set_pending(fault_);
+  }
+  bool faulty() const { return !fault_.ok(); }
+  // p, or after a fault, when p is NULL, a stand-in of n values.
+  template <class T>
+  T *stand_in(T *p, int64_t n) {
+    if (p || !faulty()) return p;
+    stand_ins_.emplace_back(static_cast<size_t>(n > 0 ? n : 0) + 1, 0.0);
+    return stand_ins_.back().data();
+  }
+  // The call's outcome, or the fault no agreement took.
+  mfree_status_t done(mfree_status_t st) {
+    mfree::Report f;
+    if (coll_ && coll_->take_pending(f)) throw mfree::Error(f.status, f.message);
+    return st;
+  }
+
+ private:
+  const mfree::Collective *coll_;
+  mfree::Report fault_;
+  std::vector<std::vector<double>> stand_ins_;  // (moved on growth: their data stay put)
+};
+
+// Fill *M (created when NULL) at state y through a core routine that writes a
+// SparseMatrix; a NULL M with a fault pending fills a stand-in.
 template <class Fill>
-mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, mfree_matrix_t **M, Fill &&fill) {
+mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, const double *y, mfree_matrix_t **M, Fill &&fill) {
   return mfree::with_handle(s, fn, [&](mfree::System &f) {
-    MFREE_REQUIRE(M, MFREE_ERR_NULL, "output pointer is NULL");
+    CollectiveArgs args(f);
+    args.require(y || f.neq() == 0, MFREE_ERR_NULL, "y is NULL");
+    args.require(M, MFREE_ERR_NULL, "output pointer is NULL");
+    y = args.stand_in(y, f.neq());
+    if (!M) {
+      mfree::SparseMatrix scratch;
+      return args.done(mfree::finish(s->ctx, fn, fill(f, y, scratch)));
+    }
     mfree_matrix_t *m = *M;
     bool fresh = false;
     if (!m) {
@@ -43,7 +96,8 @@ mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, mfree_matrix_t **M
     }
     mfree::Report rep;
     try {
-      rep = fill(f, m->m);
+      rep = fill(f, y, m->m);
+      args.done(MFREE_SUCCESS);
     } catch (...) {
       if (fresh) mfree::release(m);
       throw;
@@ -191,29 +245,26 @@ mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
 
 mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y, double *ydot) {
   return mfree::with_handle(sys, "mfree_system_rhs", [&](mfree::System &f) {
-    MFREE_REQUIRE((y && ydot) || f.neq() == 0, MFREE_ERR_NULL, "y or ydot is NULL");
-    return mfree::finish(sys->ctx, "mfree_system_rhs", f.rhs(t, y, ydot));
+    CollectiveArgs args(f);
+    args.require((y && ydot) || f.neq() == 0, MFREE_ERR_NULL, "y or ydot is NULL");
+    const mfree::Report rep = f.rhs(t, args.stand_in(y, f.neq()), args.stand_in(ydot, f.neq()));
+    return args.done(mfree::finish(sys->ctx, "mfree_system_rhs", rep));
   });
 }
 
 mfree_status_t mfree_system_assemble_mass(mfree_system_t *sys, const double *y, int32_t consistent,
                                           mfree_matrix_t **M) {
-  const auto *fr = sys ? dynamic_cast<const mfree::FluidSystem *>(sys->sys.get()) : nullptr;
-  if (sys && !y && sys->sys->neq() > 0 && !(fr && fr->on_ranks()))
-    return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_mass", "y is NULL");
-  return fill_matrix(sys, "mfree_system_assemble_mass", M, [&](mfree::System &f, mfree::SparseMatrix &m) {
-    return f.mass(y, consistent != 0, m);
-  });
+  return fill_matrix(sys, "mfree_system_assemble_mass", y, M,
+                     [&](mfree::System &f, const double *ys, mfree::SparseMatrix &m) {
+                       return f.mass(ys, consistent != 0, m);
+                     });
 }
 
 mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys, const double *y, mfree_matrix_t **S) {
-  const auto *fr = sys ? dynamic_cast<const mfree::FluidSystem *>(sys->sys.get()) : nullptr;
-  // (on ranks the system agrees on its arguments first)
-  if (sys && !y && sys->sys->neq() > 0 && !(fr && fr->on_ranks()))
-    return mfree::record(sys->ctx, MFREE_ERR_NULL, "mfree_system_assemble_interpolation", "y is NULL");
-  return fill_matrix(sys, "mfree_system_assemble_interpolation", S, [&](mfree::System &f, mfree::SparseMatrix &m) {
-    return kind<mfree::FluidSystem>(f, "interpolation matrix (not a fluid)").interpolation(y, m);
-  });
+  return fill_matrix(sys, "mfree_system_assemble_interpolation", y, S,
+                     [&](mfree::System &f, const double *ys, mfree::SparseMatrix &m) {
+                       return kind<mfree::FluidSystem>(f, "interpolation matrix (not a fluid)").interpolation(ys, m);
+                     });
 }
 
 mfree_status_t mfree_system_apply_mass(mfree_system_t *sys, const double *y, int32_t consistent, const double *v,
@@ -239,10 +290,11 @@ mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double
 mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, double *vhat) {
   return mfree::with_handle(sys, "mfree_system_get_velocity", [&](mfree::System &base) {
     auto &f = kind<mfree::FluidSystem>(base, "interpolated velocity (not a fluid)");
-    // (on ranks the system agrees on its arguments: a rank that returned here alone
-    // would leave the others waiting in its exchanges)
-    MFREE_REQUIRE((y && vhat) || f.size() == 0 || f.on_ranks(), MFREE_ERR_NULL, "y or vhat is NULL");
-    return mfree::finish(sys->ctx, "mfree_system_get_velocity", f.velocity(y, vhat));
+    CollectiveArgs args(f);
+    args.require((y && vhat) || f.neq() == 0, MFREE_ERR_NULL, "y or vhat is NULL");
+    const mfree::Report rep =
+        f.velocity(args.stand_in(y, f.neq()), args.stand_in(vhat, static_cast<int64_t>(f.dim()) * f.size()));
+    return args.done(mfree::finish(sys->ctx, "mfree_system_get_velocity", rep));
   });
 }
 
@@ -250,9 +302,12 @@ mfree_status_t mfree_system_get_wall_force(mfree_system_t *sys, const double *y,
                                           double *per_wall) {
   return mfree::with_handle(sys, "mfree_system_get_wall_force", [&](mfree::System &base) {
     auto &f = kind<mfree::FluidSystem>(base, "wall force (not a fluid)");
-    MFREE_REQUIRE(total || per_wall || f.on_ranks(), MFREE_ERR_NULL, "total and per_wall are both NULL");
-    MFREE_REQUIRE(y || f.size() == 0 || f.on_ranks(), MFREE_ERR_NULL, "y is NULL");
-    return mfree::finish(sys->ctx, "mfree_system_get_wall_force", f.wall_force(y, total, nwall, per_wall));
+    CollectiveArgs args(f);
+    args.require(total || per_wall, MFREE_ERR_NULL, "total and per_wall are both NULL");
+    args.require(y || f.neq() == 0, MFREE_ERR_NULL, "y is NULL");
+    const mfree::Report rep =
+        f.wall_force(args.stand_in(y, f.neq()), args.stand_in(total, f.dim()), nwall, per_wall);
+    return args.done(mfree::finish(sys->ctx, "mfree_system_get_wall_force", rep));
   });
 }
 
@@ -262,9 +317,11 @@ mfree_status_t mfree_system_integrate(mfree_system_t *sys, mfree_integrator_t sc
   // steps taken is written on every return, also when integrate throws part-way
   int64_t steps = 0;
   const mfree_status_t status = mfree::with_handle(sys, "mfree_system_integrate", [&](mfree::System &f) {
-    MFREE_REQUIRE(t && (y || f.neq() == 0), MFREE_ERR_NULL, "y or t is NULL");
-    mfree::Report rep = f.integrate(scheme, y, *t, t_end, cfl, dt_max, progress, user, steps);
-    return mfree::finish(sys->ctx, "mfree_system_integrate", rep);
+    CollectiveArgs args(f);
+    args.require(t && (y || f.neq() == 0), MFREE_ERR_NULL, "y or t is NULL");
+    const mfree::Report rep = f.integrate(scheme, args.stand_in(y, f.neq()), *args.stand_in(t, 1), t_end, cfl,
+                                          dt_max, progress, user, steps);
+    return args.done(mfree::finish(sys->ctx, "mfree_system_integrate", rep));
   });
   if (nsteps) *nsteps = steps;
   return status;
@@ -346,12 +403,14 @@ mfree_status_t mfree_system_create_elastodynamic_ranks(mfree_context_t *ctx, mfr
                                                       void *user, mfree_system_t **sys) {
   if (!ctx) return MFREE_ERR_NULL;
   return mfree::guard(ctx, "mfree_system_create_elastodynamic_ranks", [&]() {
-    // (local failures: without the callbacks or the output no rank can be told)
-    MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
-    *sys = nullptr;
+    // (a local failure: without the callbacks no rank can be told)
     MFREE_REQUIRE(exchange && allgather, MFREE_ERR_NULL, "exchange or allgather callback is NULL");
-    auto impl = mfree::ElasticSystem::on_ranks(as ? &as->as : nullptr, density,
-                                               mfree::Collective(exchange, allgather, user));
+    if (sys) *sys = nullptr;
+    const mfree::Collective coll(exchange, allgather, user);
+    CollectiveArgs args(&coll);
+    args.require(sys, MFREE_ERR_NULL, "output pointer is NULL");
+    auto impl = mfree::ElasticSystem::on_ranks(as ? &as->as : nullptr, density, coll);
+    args.done(MFREE_SUCCESS);
     *sys = elastic_handle(ctx, std::move(impl), as);
     return MFREE_SUCCESS;
   });
@@ -370,9 +429,11 @@ mfree_status_t mfree_system_get_stress(mfree_system_t *sys, double t, const doub
     MFREE_REQUIRE(!e.galerkin(), MFREE_ERR_UNSUPPORTED,
                   "no stress output for Galerkin systems: apply the trial approximant's gradient "
                   "(mfree_approximant_apply, MFREE_OP_GRADIENT) to the displacements");
-    MFREE_REQUIRE(y && sigma, MFREE_ERR_NULL, "y or sigma is NULL");
-    e.stress(t, y, sigma);
-    return MFREE_SUCCESS;
+    CollectiveArgs args(e);
+    args.require((y && sigma) || e.neq() == 0, MFREE_ERR_NULL, "y or sigma is NULL");
+    e.stress(t, args.stand_in(y, e.neq()),
+             args.stand_in(sigma, static_cast<int64_t>(e.stress_components()) * e.num_particles()));
+    return args.done(MFREE_SUCCESS);
   });
 }
 
@@ -405,12 +466,14 @@ mfree_status_t mfree_system_create_fluid_ranks(mfree_context_t *ctx, int32_t dim
                                                mfree_allgather_fn allgather, void *user, mfree_system_t **sys) {
   if (!ctx) return MFREE_ERR_NULL;
   return mfree::guard(ctx, "mfree_system_create_fluid_ranks", [&]() {
-    // (local failures: without the callbacks or the output no rank can be told)
-    MFREE_REQUIRE(sys, MFREE_ERR_NULL, "output pointer is NULL");
-    *sys = nullptr;
+    // (a local failure: without the callbacks no rank can be told)
     MFREE_REQUIRE(exchange && allgather, MFREE_ERR_NULL, "exchange or allgather callback is NULL");
-    auto impl = mfree::FluidRanks::create(dim, n_owned, n_ghost, global_ids, width,
-                                          mfree::Collective(exchange, allgather, user));
+    if (sys) *sys = nullptr;
+    const mfree::Collective coll(exchange, allgather, user);
+    CollectiveArgs args(&coll);
+    args.require(sys, MFREE_ERR_NULL, "output pointer is NULL");
+    auto impl = mfree::FluidRanks::create(dim, n_owned, n_ghost, global_ids, width, coll);
+    args.done(MFREE_SUCCESS);
     auto *s = new mfree_system_t();
     s->ctx = ctx;
     s->sys = std::move(impl);

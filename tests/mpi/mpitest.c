@@ -14,6 +14,26 @@ void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const
   CHECK(!needle || strstr(msg, needle), "%s: message '%s' lacks '%s'", what, msg, needle);
 }
 
+void expect_agreed(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, int bad, const char *why,
+                   const char *what) {
+  int lo = 0, hi = 0, mine = (int)got;
+  MPI_Allreduce(&mine, &lo, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&mine, &hi, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  CHECK(lo == hi, "%s: the ranks return statuses %d to %d", what, lo, hi);
+  char needle[200];
+  snprintf(needle, sizeof needle, "rank %d: %s", bad, why);
+  expect(ctx, got, want, needle, what);
+}
+
+int mpitest_same_bits(const double *a, const double *b, int64_t n, const char *what) {
+  for (int64_t i = 0; i < n; ++i)
+    if (memcmp(&a[i], &b[i], sizeof(double)) != 0) {
+      CHECK(0, "%s: item %lld differs: %.17g, reference %.17g", what, (long long)i, a[i], b[i]);
+      return 0;
+    }
+  return 1;
+}
+
 char *slurp(const char *path) {
   FILE *f = fopen(path, "rb");
   if (!f) return NULL;

@@ -30,6 +30,15 @@ extern int mpitest_failures;
  * (NULL: any message); what names the case in a failed check. */
 void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle, const char *what);
 
+/* expect for a collective call: got the same on every rank of MPI_COMM_WORLD, want, and a
+ * message naming the rank that failed, "rank <bad>: <why>". Collective. */
+void expect_agreed(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, int bad, const char *why,
+                   const char *what);
+
+/* a and b, n doubles each, hold the same bits: else one failed check naming what and the
+ * first item that differs (its two values). Returns 1 when they do. */
+int mpitest_same_bits(const double *a, const double *b, int64_t n, const char *what);
+
 /* The whole file at path, NUL-terminated, to be freed; NULL when it cannot be read. */
 char *slurp(const char *path);
 

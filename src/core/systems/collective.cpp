@@ -76,6 +76,13 @@ Report Collective::agree_from(const std::vector<double> &statuses, const Report 
   return r;
 }
 
+bool Collective::take_pending(Report &fault) const {
+  if (pending_.ok()) return false;
+  fault = pending_;
+  pending_ = Report();
+  return true;
+}
+
 Report Collective::agree(const Report &mine) const {
   const double st = static_cast<double>(mine.status);
   std::vector<double> all(static_cast<size_t>(size()));

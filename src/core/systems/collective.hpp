@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,23 @@
 #include "mfree.h"
 
 namespace mfree {
+
+// The outcome of local work as a report: a rank must reach the next agreement even when
+// its own part failed.
+template <class F>
+Report guarded(F &&f) {
+  Report r;
+  try {
+    r = f();
+  } catch (const Error &e) {
+    r.status = e.status();
+    r.message = e.what();
+  } catch (const std::bad_alloc &) {
+    r.status = MFREE_ERR_ALLOC;
+    r.message = "out of memory";
+  }
+  return r;
+}
 
 class Collective {
  public:
@@ -37,6 +55,22 @@ class Collective {
   // agree_from after one gather of the statuses.
   Report agree(const Report &mine) const;
 
+  // A fault of a collective call's arguments found on this rank before the call (a NULL
+  // or short array): the call still takes part, on stand-in buffers, and the local step
+  // before its first agreement (local) returns the fault instead of running, so that
+  // every rank returns it and none waits for a rank that left. The caller clears it
+  // after the call (a call that reached no agreement leaves it untaken).
+  void set_pending(const Report &fault) const { pending_ = fault; }
+  bool take_pending(Report &fault) const;
+  // The local step before an agreement: the pending fault (taken) if there is one, the
+  // step skipped; else f's outcome (guarded).
+  template <class F>
+  Report local(F &&f) const {
+    Report r;
+    if (take_pending(r)) return r;
+    return guarded(f);
+  }
+
   // Integers travel through the all-gather as the bits of a double.
   static double pack(int64_t v);
   static int64_t unpack(double d);
@@ -46,6 +80,7 @@ class Collective {
   mfree_allgather_fn ag_ = nullptr;
   void *user_ = nullptr;
   mutable int size_ = 0;
+  mutable Report pending_;
 };
 
 }  // namespace mfree

@@ -286,7 +286,7 @@ Report ElasticSystem::check(const double *y, const std::string &when) const {
 }
 
 Report ElasticSystem::rhs(double t, const double *y, double *ydot) {
-  Report rep = check(y, "");
+  Report rep = ranks_ ? coll_.local([&] { return check(y, ""); }) : check(y, "");
   if (ranks_) {
     rep = fill_state(t, y, rep);  // every rank takes part, a failing one too
     if (!rep.ok()) return settle(rep);
@@ -335,7 +335,7 @@ Report ElasticSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
 
 void ElasticSystem::stress(double t, const double *y, double *sigma) const {
   if (ranks_) {
-    settle(fill_state(t, y, Report()));
+    settle(fill_state(t, y, coll_.local([] { return Report(); })));
   } else {
     std::copy(y, y + nd_, work_.begin());
     enforce_boundary(t, work_.data());
@@ -374,6 +374,7 @@ Report ElasticSystem::integrate(int scheme, double *y, double &t, double t_end, 
   Report rep;
   double dt = 0.0;
   try {
+    if (ranks_ && coll_.take_pending(rep)) throw Error(rep.status, rep.message);
     if (scheme != MFREE_INTEGRATOR_LEAPFROG)
       throw Error(MFREE_ERR_UNSUPPORTED, "elastodynamics integrates with the central-difference (leap-frog) scheme");
     if (!(std::isfinite(t_end) && std::isfinite(t))) throw Error(MFREE_ERR_ARG, "times must be finite");

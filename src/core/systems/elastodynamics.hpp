@@ -49,6 +49,7 @@ class ElasticSystem : public System {
   // the owned particles (all of them off ranks)
   int32_t num_particles() const { return nc_ > 0 ? nd_ / nc_ : 0; }
   bool ranks() const { return ranks_; }
+  const Collective *collective() const override { return ranks_ ? &coll_ : nullptr; }
   // Stress at the particles from the displacements of y (boundary unknowns enforced);
   // collocation systems only (the Galerkin trial tables live in the assembler). On ranks
   // collective (the ghosts' displacements), the owned particles' stresses.

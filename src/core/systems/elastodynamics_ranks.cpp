@@ -89,17 +89,11 @@ void ElasticSystem::sort_rows() {
 std::unique_ptr<ElasticSystem> ElasticSystem::on_ranks(const Assembler *as, double density, const Collective &coll) {
   // 1. the local part, its outcome and the values every rank must share, agreed
   std::unique_ptr<ElasticSystem> sys;
-  Report mine;
-  try {
+  const Report mine = coll.local([&] {
     if (!as) throw Error(MFREE_ERR_NULL, "assembler is NULL");
     sys.reset(new ElasticSystem(as, density, coll));
-  } catch (const Error &e) {
-    mine.status = e.status();
-    mine.message = e.what();
-  } catch (const std::bad_alloc &) {
-    mine.status = MFREE_ERR_ALLOC;
-    mine.message = "out of memory";
-  }
+    return Report();
+  });
   enum { kStatus, kDensity, kForm, kCoef, kYoung, kPoisson, kComp, kDim, kSpacing, kN };
   double v[kN] = {static_cast<double>(mine.status), density, 0, 0, 0, 0, 0, 0, INFINITY};
   if (sys) {

@@ -74,7 +74,7 @@ void FluidRanks::number(const int64_t *ids) {
 std::unique_ptr<FluidRanks> FluidRanks::create(int dim, int32_t n_owned, int32_t n_ghost, const int64_t *ids,
                                                double width, const Collective &coll) {
   std::unique_ptr<FluidRanks> sys;
-  const Report mine = guarded([&] {
+  const Report mine = coll.local([&] {
     sys.reset(new FluidRanks(dim, n_owned, n_ghost, ids, width, coll));
     return Report();
   });
@@ -296,7 +296,7 @@ Report FluidRanks::rhs(double t, const double *y, double *ydot) {
     vh_n_.resize(static_cast<size_t>(D) * n);
     dr_n_.resize(n);
     double vals[2] = {INFINITY, INFINITY};
-    const Report mine = guarded([&] {
+    const Report mine = coll_.local([&] {
       Report r = prepare_accel(ys_.data(), false, rate_n_.data(), vals[0], vals[1]);
       const size_t nd = static_cast<size_t>(D) * n;
       if (r.ok()) kinematics(ys_.data() + nd, ys_.data() + 2 * nd, vh_n_.data(), dr_n_.data());
@@ -393,7 +393,7 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
   nsteps = 0;
   // the arguments, checked and then agreed: ranks that took different steps would wait
   // for each other in the exchanges
-  const Report args = guarded([&] {
+  const Report args = coll_.local([&] {
     if (scheme != MFREE_INTEGRATOR_LEAPFROG && scheme != MFREE_INTEGRATOR_PREDICTOR_CORRECTOR)
       throw Error(MFREE_ERR_ARG, "unknown integrator");
     if (!(std::isfinite(t_end) && std::isfinite(t))) throw Error(MFREE_ERR_ARG, "times must be finite");
@@ -512,7 +512,7 @@ Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t ref
     load(y ? y : stand_in_.data());
     double vals[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
     for (int k = 0; k < nwant; ++k) vals[2 + k] = want[k];
-    const Report mine = guarded([&] {
+    const Report mine = coll_.local([&] {
       if (refuse != MFREE_SUCCESS) throw Error(refuse, why);
       check_ready();
       return a ? prepare_accel(ys_.data(), false, a, vals[0], vals[1])
@@ -536,10 +536,9 @@ Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t ref
 // state does not hold: its products are apply_mass's (fluid_ranks_matrices.cpp).
 Report FluidRanks::mass(const double *y, bool consistent, SparseMatrix &M) {
   const Report agreed = output_prepare(
-      y, nullptr, consistent ? MFREE_ERR_UNSUPPORTED : (!y && n_own_ > 0 ? MFREE_ERR_NULL : MFREE_SUCCESS),
-      consistent ? "no consistent mass matrix for the fluid on ranks (its rows couple owned particles to ghosts): "
-                   "use its products (mfree_system_apply_mass) or the lumped mass"
-                 : "y is NULL");
+      y, nullptr, consistent ? MFREE_ERR_UNSUPPORTED : MFREE_SUCCESS,
+      "no consistent mass matrix for the fluid on ranks (its rows couple owned particles to ghosts): "
+      "use its products (mfree_system_apply_mass) or the lumped mass");
   if (!agreed.ok()) return agreed;
   lumped_rows(M);
   return agreed;
@@ -558,8 +557,7 @@ void FluidRanks::pressure(const double *y, double *p) const {
 }
 
 Report FluidRanks::velocity(const double *y, double *vhat) {
-  const bool null = (!y || !vhat) && n_own_ > 0;
-  const Report agreed = output_prepare(y, nullptr, null ? MFREE_ERR_NULL : MFREE_SUCCESS, "y or vhat is NULL");
+  const Report agreed = output_prepare(y, nullptr, MFREE_SUCCESS, "");
   if (!agreed.ok()) return agreed;
   const int D = dim();
   const size_t nd = static_cast<size_t>(D) * size();
@@ -581,10 +579,7 @@ Report FluidRanks::wall_force(const double *y, double *total, int32_t nwall, dou
   const int32_t nw = walls_ ? walls_->size() : 0;
   mfree_status_t refuse = MFREE_SUCCESS;
   std::string why;
-  if ((!total && !per_wall) || (!y && n_own_ > 0)) {
-    refuse = MFREE_ERR_NULL;
-    why = y ? "total and per_wall are both NULL" : "y is NULL";
-  } else if (per_wall && nwall != nw) {
+  if (per_wall && nwall != nw) {
     refuse = MFREE_ERR_ARG;
     why = "per_wall holds " + std::to_string(nwall) + " wall particles, the system has " + std::to_string(nw);
   }

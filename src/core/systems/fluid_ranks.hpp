@@ -8,30 +8,12 @@
 
 #include <cstdint>
 #include <memory>
-#include <new>
 #include <vector>
 
 #include "core/systems/collective.hpp"
 #include "core/systems/fluid.hpp"
 
 namespace mfree {
-
-// The outcome of local work as a report: a rank must reach the next agreement even when
-// its own part failed.
-template <class F>
-Report guarded(F &&f) {
-  Report r;
-  try {
-    r = f();
-  } catch (const Error &e) {
-    r.status = e.status();
-    r.message = e.what();
-  } catch (const std::bad_alloc &) {
-    r.status = MFREE_ERR_ALLOC;
-    r.message = "out of memory";
-  }
-  return r;
-}
 
 class FluidRanks final : public FluidSystem {
  public:
@@ -44,6 +26,7 @@ class FluidRanks final : public FluidSystem {
                                             double width, const Collective &coll);
 
   bool on_ranks() const override { return true; }
+  const Collective *collective() const override { return &coll_; }
   int32_t neq() const override { return (2 * dim() + 1) * n_own_; }
   Report rhs(double t, const double *y, double *ydot) override;
   Report mass(const double *y, bool consistent, SparseMatrix &M) override;
@@ -90,8 +73,8 @@ class FluidRanks final : public FluidSystem {
   void check_reach(double reach, int64_t step) const;
   // The outputs' evaluation at the owned state y: load, the tables (and with a, the
   // accelerations into a), agreed; refuse != MFREE_SUCCESS: this rank's error instead,
-  // with the message why (every rank then returns it; y may then be NULL); want: nwant
-  // (<= 2) values replaced by their minima over the ranks.
+  // with the message why (every rank then returns it); y may be NULL on a rank that owns
+  // no particle; want: nwant (<= 2) values replaced by their minima over the ranks.
   Report output_prepare(const double *y, double *a, mfree_status_t refuse, const char *why, double *want = nullptr,
                         int nwant = 0);
   std::vector<double> stand_in_;  // output_prepare's stand-in for a NULL state

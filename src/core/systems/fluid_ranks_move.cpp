@@ -102,7 +102,7 @@ void FluidRanks::reseat(int32_t n_owned, const double *xo, const int64_t *oid, c
 void FluidRanks::move_particles(int32_t n_new, mfree_particles_move_fn move, void *move_user, double *y,
                                 int64_t capacity) {
   const int D = dim(), nrec = 2 * D + 4;
-  const Report args = guarded([&] {
+  const Report args = coll_.local([&] {
     check_usable();
     if (!rebuild_) throw Error(MFREE_ERR_STATE, "no halo rebuild callback (mfree_system_set_halo_rebuild)");
     if (!move) throw Error(MFREE_ERR_NULL, "move callback is NULL");

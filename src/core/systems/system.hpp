@@ -6,6 +6,7 @@
 
 #include "core/base/error.hpp"
 #include "core/discretize/matrix.hpp"
+#include "core/systems/collective.hpp"
 #include "mfree.h"
 
 namespace mfree {
@@ -25,6 +26,9 @@ class System {
   }
   virtual Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                            mfree_progress_fn progress, void *user, int64_t &nsteps) = 0;
+  // A system on ranks: its collective operations (a pending fault of a call's arguments
+  // is agreed through them); nullptr for a system in one process.
+  virtual const Collective *collective() const { return nullptr; }
 };
 
 }  // namespace mfree
