@@ -2216,8 +2216,9 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * Particles move between ranks with mfree_system_move_particles. A failure on one rank (a non-finite
  * state: MFREE_FAIL_NONFINITE; a NULL array or output passed to a collective call:
  * MFREE_ERR_NULL, the rank still taking part) is returned by every rank with that rank's
- * message ("rank R: ..."). Both native integrators; no dummy particles, density diffusion,
- * consistent integration, velocity smoothing or open boundaries (MFREE_ERR_UNSUPPORTED). Outputs: the owned
+ * message ("rank R: ..."). Both native integrators; density diffusion, velocity smoothing,
+ * consistent integration and the lumped-mass step as on one process; no dummy particles, open boundaries or
+ * acoustic step (MFREE_ERR_UNSUPPORTED at their setters). Outputs: the owned
  * particles' (docs/fluid-ranks.md); the consistent mass as products (mfree_system_apply_mass). Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.
  * libmfree_mpi's mfree_halo_create_fluid supplies the callbacks from a halo plan.

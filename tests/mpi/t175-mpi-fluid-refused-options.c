@@ -1,6 +1,6 @@
 /* The one-process fluid's options that the fluid on ranks refuses (label mpi), on 1, 2 and
  * 4 ranks: dummy wall particles and the open boundaries (active particles, an inflow
- * gate, an outflow plane, their update) return MFREE_ERR_UNSUPPORTED on every rank with
+ * gate, an outflow plane, their update) and the acoustic step return MFREE_ERR_UNSUPPORTED on every rank with
  * a message that says why, and leave the system as it was: afterwards it takes 40
  * leap-frog steps to the same bits as a system that never saw them. The active-particle
  * query answers for the owned particles (all active), not for the ghosts. */
@@ -46,6 +46,8 @@ int main(int argc, char **argv) {
          "outflow plane");
   expect(ctx, mfree_system_update_open_boundaries(r.sys, 0.0, r.y), MFREE_ERR_UNSUPPORTED, "on ranks",
          "open boundaries' update");
+  expect(ctx, mfree_system_set_acoustic_step(r.sys, 1), MFREE_ERR_UNSUPPORTED, "acoustic step", "acoustic step");
+  expect(ctx, mfree_system_set_acoustic_step(r.sys, 0), MFREE_SUCCESS, NULL, "acoustic step off");
   /* the query: the owned particles, every one active */
   int32_t nactive = -1;
   int32_t *state = malloc(((size_t)r.n_owned + 1) * sizeof *state);
