@@ -59,15 +59,7 @@ static int one_step(void *user, int64_t step, double t, double dt) {
 static void reference(const double *y, int64_t *rp, int32_t **cols, double **val, double *cond) {
   mfree_particles_t *ps = NULL;
   mfree_approximant_t *a = NULL;
-  assert_ok(ctx, mfree_particles_create(ctx, DIM, N, &ps));
-  assert_ok(ctx, mfree_particles_set_positions(ps, y, MFREE_LAYOUT_AOS, DIM, MFREE_COPY));
-  assert_ok(ctx, mfree_particles_set_support(ps, &HS, 0, MFREE_COPY));
-  assert_ok(ctx, mfree_particles_setup(ps));
-  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
-  assert_ok(ctx, mfree_approximant_set_kernel(a, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
-  assert_ok(ctx, mfree_approximant_set_order(a, 1));
-  assert_ok(ctx, mfree_approximant_set_fallback(a, MFREE_FALLBACK_LOWER_ORDER));
-  assert_ok(ctx, mfree_approximant_setup(a));
+  mfree_test_fluid_approximant(ctx, DIM, N, y, HS, NULL, &ps, &a);
   int64_t nnz = 0;
   assert_ok(ctx, mfree_approximant_get_nnz(a, &nnz));
   *cols = malloc((size_t)nnz * sizeof(int32_t));
@@ -85,11 +77,7 @@ static int run(int threads, int steps, double jitter, double *yout) {
   double *m = malloc((size_t)N * sizeof(double));
   double *y = sheared_patch(m, jitter);
   const double kappa = 100.0 * RHO0 * 2.0 * G * (L * D) / GAMMA; /* 003 eq 125 */
-  mfree_system_t *sys = NULL;
-  assert_ok(ctx, mfree_system_create_fluid(ctx, DIM, N, &sys));
-  assert_ok(ctx, mfree_system_set_fluid(sys, &RHO0, 0, kappa, GAMMA, 1e-3));
-  assert_ok(ctx, mfree_system_set_masses(sys, m, 1));
-  assert_ok(ctx, mfree_system_set_smoothing(sys, HS));
+  mfree_system_t *sys = mfree_test_fluid_create(ctx, N, m, RHO0, kappa, GAMMA, 1e-3, HS);
   int64_t *rp = malloc(((size_t)N + 1) * sizeof(int64_t));
   double *cond = malloc((size_t)N * sizeof(double));
   double t = 0.0;

@@ -109,16 +109,7 @@ static void reference(const double *y, const double *m, reference_t *ref) {
   mfree_approximant_t *a = NULL;
   double *vol = malloc((size_t)N * sizeof(double));
   for (int i = 0; i < N; ++i) vol[i] = m[i] / y[2 * (size_t)DIM * N + i];
-  assert_ok(ctx, mfree_particles_create(ctx, DIM, N, &ps));
-  assert_ok(ctx, mfree_particles_set_positions(ps, y, MFREE_LAYOUT_AOS, DIM, MFREE_COPY));
-  assert_ok(ctx, mfree_particles_set_volumes(ps, vol, 1, MFREE_COPY));
-  assert_ok(ctx, mfree_particles_set_support(ps, &HS, 0, MFREE_COPY));
-  assert_ok(ctx, mfree_particles_setup(ps));
-  assert_ok(ctx, mfree_approximant_create(ctx, ps, MFREE_METHOD_MLS, &a));
-  assert_ok(ctx, mfree_approximant_set_kernel(a, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
-  assert_ok(ctx, mfree_approximant_set_order(a, 1));
-  assert_ok(ctx, mfree_approximant_set_fallback(a, MFREE_FALLBACK_LOWER_ORDER));
-  assert_ok(ctx, mfree_approximant_setup(a));
+  mfree_test_fluid_approximant(ctx, DIM, N, y, HS, vol, &ps, &a);
   int64_t nnz = 0;
   assert_ok(ctx, mfree_approximant_get_nnz(a, &nnz));
   ref->rp = malloc(((size_t)N + 1) * sizeof(int64_t));

@@ -94,6 +94,20 @@ mfree_system_t *mfree_test_fluid_create(mfree_context_t *ctx, int n, const doubl
   return sys;
 }
 
+void mfree_test_fluid_approximant(mfree_context_t *ctx, int dim, int n, const double *y, double h,
+                                  const double *vol, mfree_particles_t **ps, mfree_approximant_t **a) {
+  assert_ok(ctx, mfree_particles_create(ctx, dim, n, ps));
+  assert_ok(ctx, mfree_particles_set_positions(*ps, y, MFREE_LAYOUT_AOS, dim, MFREE_COPY));
+  if (vol) assert_ok(ctx, mfree_particles_set_volumes(*ps, vol, 1, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_set_support(*ps, &h, 0, MFREE_COPY));
+  assert_ok(ctx, mfree_particles_setup(*ps));
+  assert_ok(ctx, mfree_approximant_create(ctx, *ps, MFREE_METHOD_MLS, a));
+  assert_ok(ctx, mfree_approximant_set_kernel(*a, MFREE_KERNEL_CUBIC_SPLINE, 0.0));
+  assert_ok(ctx, mfree_approximant_set_order(*a, 1));
+  assert_ok(ctx, mfree_approximant_set_fallback(*a, MFREE_FALLBACK_LOWER_ORDER));
+  assert_ok(ctx, mfree_approximant_setup(*a));
+}
+
 int32_t mfree_test_backend(int argc, char **argv) {
   return argc > 1 && strcmp(argv[1], "ref") == 0 ? MFREE_BACKEND_REF : MFREE_BACKEND_OPT;
 }

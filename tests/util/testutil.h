@@ -71,6 +71,13 @@ int mfree_test_tank_walls(double L, double d, double off, double top, double **x
 mfree_system_t *mfree_test_fluid_create(mfree_context_t *ctx, int n, const double *m, double rho0, double kappa,
                                         double gamma, double mu, double h);
 
+/* The approximant the fluid's rows equal ([CuetoFelgueroso2004] Sect. 3): linear MLS with
+ * the cubic spline, falling back to lower order, set up on a new particle set of n
+ * particles of dimension dim at positions y (AoS, copied), support h (one value) and
+ * volumes vol (n values, copied; NULL: none). Both handles are the caller's to destroy. */
+void mfree_test_fluid_approximant(mfree_context_t *ctx, int dim, int n, const double *y, double h,
+                                  const double *vol, mfree_particles_t **ps, mfree_approximant_t **a);
+
 /* The collocation bar of paper 001 Sect. 6.4: n particles x_i = i L / (n - 1) written into
  * x (n values, borrowed by the set: they must outlive the bar), h = 1.5 dx, volumes dx;
  * SSPH with the revised super Gauss (a = 1.6), quadratic basis, derivatives to the second;
