@@ -16,16 +16,19 @@
  * (0, -2) m/s (a constant field is reproduced exactly, 003 eq 100), its lowest particle
  * 2 d above the plate's face. rho0 = 1000, mu = 0.5 (the paper's drop), gamma = 7, sound
  * speed ten times the impact speed (kappa = rho0 c^2 / gamma), h = 1.5 d, MLS linear,
- * nodal integration, Galerkin lumped mass (eq 56), leap-frog with CFL --cfl (default
- * 0.25: at the paper's 0.5 the run at nd = 40 stops at t = 0.009 s with a negative
- * density after the impact, and at nd = 20 the momentum drifts 3 % from the impulse),
+ * nodal integration, Galerkin lumped mass (eq 56), leap-frog with CFL --cfl (default the
+ * paper's 0.5) and the acoustic step (--acoustic-step, default 1; without it the run at
+ * CFL 0.5 and nd = 40 stops at t = 0.0076 s with a negative density after the impact, at
+ * CFL 0.25 it holds; --lumped-step 1 also holds it: mfree_system_set_acoustic_step,
+ * mfree_system_set_lumped_mass_step),
  * gravity 9.81 m/s^2, to --tend (default 0.04 s: the drop has spread into a sheet and
  * its vertical momentum is gone).
  *
- * Measured (CFL 0.25): the impulse within 0.39 %, 0.13 % and 0.17 % of the momentum
- * change at nd = 20, 30 and 40 (317, 709 and 1,257 particles), 0.956, 0.970 and 0.963 of
- * M (2 + g t); at nd = 20 the mean force peaks at 750 N/m over 0.5 ms, about 3.7 rho0 V^2
- * D, 2 ms after the first contact, then decays to the drop's weight as it spreads.
+ * Measured (CFL 0.5, acoustic step): the impulse within 0.52 %, 0.28 % and 0.24 % of the
+ * momentum change at nd = 20, 30 and 40 (317, 709 and 1,257 particles; 651, 1,231 and
+ * 1,641 steps), 0.951, 0.963 and 0.958 of M (2 + g t); at CFL 0.25 without it 0.30 % at
+ * nd = 40 (2,232 steps). The mean force peaks about 2 ms after the first contact, then decays
+ * to the drop's weight as the drop spreads.
  *
  * Force and impulse. At every step the force the structure exerts on the fluid, F(t), is
  * read with mfree_system_get_wall_force (the sum of the plate's wall particles' shares)
@@ -62,7 +65,8 @@ static const double kG = 9.81, kRho0 = 1000.0, kGamma = 7.0, kV0 = 2.0;
 
 static void usage(FILE *f) {
   fprintf(f, "usage: mfree_impact [--nd N (40)] [--diameter D (0.05 m)] [--plate P (6 diameters)]\n"
-             "                    [--tend T (0.04 s)] [--cfl C (0.25)] [--mu MU (0.5)]\n"
+             "                    [--tend T (0.04 s)] [--cfl C (0.5)] [--mu MU (0.5)]\n"
+             "                    [--lumped-step 0|1 (0)] [--acoustic-step 0|1 (1)]\n"
              "                    [run options; --vtu-every in s, default 0.002]\n");
   fc_run_usage(f);
 }
@@ -96,16 +100,18 @@ static void write_rows(const char *path, const char *header, const fc_series_t *
 }
 
 int main(int argc, char **argv) {
-  int nd = 40;
-  double diameter = 0.05, plate = 6.0, t_end = 0.04, cfl = 0.25, mu = 0.5;
+  int nd = 40, lumped_step = 0, acoustic_step = 1;
+  double diameter = 0.05, plate = 6.0, t_end = 0.04, cfl = 0.5, mu = 0.5;
   fc_run_t ro;
   fc_run_init(&ro, "impact", 0.002);
   const fc_option_t opts[] = {{"--nd", 'i', &nd},     {"--diameter", 'd', &diameter}, {"--plate", 'd', &plate},
                               {"--tend", 'd', &t_end}, {"--cfl", 'd', &cfl},          {"--mu", 'd', &mu},
+                              {"--lumped-step", 'i', &lumped_step}, {"--acoustic-step", 'i', &acoustic_step},
                               {NULL, 0, NULL}};
   const int parsed = fc_parse(argc, argv, &ro, opts, usage);
   if (parsed) return parsed < 0 ? 0 : parsed;
-  if (nd < 6 || !(diameter > 0) || !(plate >= 2) || !(t_end > 0) || !(cfl > 0 && cfl <= 1) || !(mu >= 0)) {
+  if (nd < 6 || !(diameter > 0) || !(plate >= 2) || !(t_end > 0) || !(cfl > 0 && cfl <= 1) || !(mu >= 0) ||
+      (lumped_step != 0 && lumped_step != 1) || (acoustic_step != 0 && acoustic_step != 1)) {
     usage(stderr);
     return 2;
   }
@@ -137,6 +143,8 @@ int main(int argc, char **argv) {
   /* the particles stay above the plate's face and within reach of it */
   const double lo[2] = {-2.0 * half, -0.5 * d}, hi[2] = {2.0 * half, zc0 + 10.0 * diameter};
   CHECK(mfree_system_set_box(sys, lo, hi));
+  CHECK(mfree_system_set_lumped_mass_step(sys, lumped_step));
+  CHECK(mfree_system_set_acoustic_step(sys, acoustic_step));
 
   FILE *csv = fc_open_csv(&ro, "force.csv");
   if (!csv) return 1;
@@ -240,6 +248,8 @@ int main(int argc, char **argv) {
   fc_json_table(&js, "momentum", mom.n / 3, 3, mom.v);
   fc_json_num(&js, "sound_speed", c0);
   fc_json_num(&js, "cfl", cfl);
+  fc_json_int(&js, "lumped_mass_step", lumped_step);
+  fc_json_int(&js, "acoustic_step", acoustic_step);
   fc_json_num(&js, "wall_seconds", wall);
   if (fc_json_finish(&js, &ro)) return 1;
   if (!ro.json_stdout) {
