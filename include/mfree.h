@@ -1757,8 +1757,8 @@ MFREE_API mfree_status_t mfree_system_set_approximation(mfree_system_t *sys,
  * Dummy wall particles ([Adami2012]; not in [CuetoFelgueroso2004]): fixed particles
  * filling the solid past the walls, at least 4h - d deep, with the pressure
  * extrapolated from the fluid; they give fluid nodes near a wall full supports and the
- * wall traction (docs/fluid.md). May be combined with the wall force. Not for the fluid
- * on ranks (MFREE_ERR_UNSUPPORTED; docs/fluid-ranks.md).
+ * wall traction (docs/fluid.md). May be combined with the wall force. On ranks every rank passes the same dummies, all
+ * of them (bitwise one rank's); with density diffusion too the ghost layer must reach four support radii (docs/fluid-ranks.md).
  * @param[in] sys      a fluid system
  * @param[in] n        number of dummy particles; 0 removes them (the default)
  * @param[in] x        positions, dim per particle (AoS; copied)
@@ -2200,8 +2200,8 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * ghosts, in the host's order (owned first), with their global ids; the ghosts must
  * hold every particle within width of an owned particle, and width must reach two
  * support radii (2 R h: an owned particle's terms come from the rows of its neighbours,
- * which need their own neighbours). The per-particle setters (mfree_system_set_fluid,
- * mfree_system_set_masses) take the n_owned + n_ghost items in the host's order; the
+ * which need their own neighbours; four, 4 R h, with dummy particles and density diffusion together: docs/fluid-ranks.md).
+ * The per-particle setters (mfree_system_set_fluid, mfree_system_set_masses) take the n_owned + n_ghost items in the host's order; the
  * state y of this rank holds its owned particles only (positions, velocities, densities
  * of the owned items: neq = (2 dim + 1) n_owned). Every right-hand side and native step
  * is collective: it exchanges the ghosts' states through exchange and agrees on the
@@ -2216,8 +2216,8 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * Particles move between ranks with mfree_system_move_particles. A failure on one rank (a non-finite
  * state: MFREE_FAIL_NONFINITE; a NULL array or output passed to a collective call:
  * MFREE_ERR_NULL, the rank still taking part) is returned by every rank with that rank's
- * message ("rank R: ..."). Both native integrators; density diffusion, velocity smoothing,
- * consistent integration and the lumped-mass step as on one process; no dummy particles, open boundaries or
+ * message ("rank R: ..."). Both native integrators; dummy particles (the same on every rank), density diffusion, velocity smoothing,
+ * consistent integration and the lumped-mass step as on one process; no open boundaries or
  * acoustic step (MFREE_ERR_UNSUPPORTED at their setters). Outputs: the owned
  * particles' (docs/fluid-ranks.md); the consistent mass as products (mfree_system_apply_mass). Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.

@@ -15,7 +15,13 @@
  * of leap-frog. Then also, on every rank, the one-process fluid (mfree_system_create_fluid, 512
  * particles: one chunk of rows, its scatter in the rank's order) with the option takes
  * the same steps to the same bits as the one-rank run after every window, and without
- * the option it ends elsewhere (the option acts). */
+ * the option it ends elsewhere (the option acts).
+ *
+ * Built with FLUID_DUMMIES too (t176), the option "dummies" puts four layers of dummy
+ * particles past the floor and both end walls (no-slip walls, examples/fluid_common's
+ * tank), and options joined by '+' are set together ("dummies+diffusion"). With dummies
+ * and density diffusion the ghost layer is four support radii deep (a quarter spacing
+ * more), as the extrapolated densities the density gradients read need. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,6 +29,9 @@
 
 #include "mpimove.h"
 #include "mpitest.h"
+#ifdef FLUID_DUMMIES
+#include "fluid_common.h"
+#endif
 
 #ifndef TEST_NAME
 #define TEST_NAME "t189-mpifluid-migrate"
@@ -33,15 +42,29 @@ static const int64_t kWindow = 125;
 static mfree_integrator_t scheme = MFREE_INTEGRATOR_LEAPFROG;
 
 #ifdef FLUID_OPTIONS
-/* The option named opt set on sys (NULL: none). */
-static mfree_status_t set_option(mfree_system_t *sys, const char *opt) {
+/* The option named opt set on sys, the dam break b's (NULL: none). */
+static mfree_status_t set_option(mfree_system_t *sys, const damb_t *b, const char *opt) {
   if (!opt) return MFREE_SUCCESS;
+  const char *plus = strchr(opt, '+');
+  if (plus) {
+    char first[32];
+    const size_t len = (size_t)(plus - opt);
+    if (len >= sizeof first) return MFREE_ERR_ARG;
+    memcpy(first, opt, len);
+    first[len] = '\0';
+    const mfree_status_t st = set_option(sys, b, first);
+    return st == MFREE_SUCCESS ? set_option(sys, b, plus + 1) : st;
+  }
   if (!strcmp(opt, "all")) {
     static const char *each[4] = {"diffusion", "smoothing", "vci", "lumped-step"};
     mfree_status_t st = MFREE_SUCCESS;
-    for (int k = 0; k < 4 && st == MFREE_SUCCESS; ++k) st = set_option(sys, each[k]);
+    for (int k = 0; k < 4 && st == MFREE_SUCCESS; ++k) st = set_option(sys, b, each[k]);
     return st;
   }
+#ifdef FLUID_DUMMIES
+  /* the tank is 5 a long, its end walls 1.5 times the column high */
+  if (!strcmp(opt, "dummies")) return fc_dummy_tank(sys, 5 * NX, 3.0 * b->a, b->d);
+#endif
   if (!strcmp(opt, "diffusion")) return mfree_system_set_density_diffusion(sys, 0.1);
   if (!strcmp(opt, "smoothing")) return mfree_system_set_velocity_smoothing(sys, 0.1);
   if (!strcmp(opt, "vci")) return mfree_system_set_consistent_integration(sys, 1);
@@ -61,7 +84,7 @@ static int one_process_differs(mfree_context_t *ctx, const damb_t *b, const char
   mfree_status_t st = mfree_system_create_fluid(ctx, 2, n, &sys);
   if (st == MFREE_SUCCESS) st = damb_configure(b, sys);
   if (st == MFREE_SUCCESS) st = mfree_system_set_masses(sys, b->m, 1);
-  if (st == MFREE_SUCCESS) st = set_option(sys, opt);
+  if (st == MFREE_SUCCESS) st = set_option(sys, b, opt);
   int differs = 0;
   for (int w = 0; w < WINDOWS && st == MFREE_SUCCESS; ++w) {
     int64_t steps = 0;
@@ -86,13 +109,19 @@ int main(int argc, char **argv) {
   const int n = b.n;
   int *owner = calloc((size_t)n, sizeof *owner);
 
-  /* the reference: one rank, a deep layer, the same windows */
-  rankfluid_t ref;
-  mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, 4.0 * b.h + 4.0 * b.d, 0);
+  /* the ghost layer's depth the rows need: two support radii (2 h each), or four */
+  double radii = 2.0;
 #ifdef FLUID_OPTIONS
   const char *opt = argc > 1 ? argv[1] : "(none)";
   if (argc > 2 && !strcmp(argv[2], "pc")) scheme = MFREE_INTEGRATOR_PREDICTOR_CORRECTOR;
-  if (st == MFREE_SUCCESS) st = set_option(ref.sys, opt);
+  if (strstr(opt, "dummies") && (strstr(opt, "diffusion") || strstr(opt, "all"))) radii = 4.0;
+#endif
+
+  /* the reference: one rank, a deep layer, the same windows */
+  rankfluid_t ref;
+  mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, 2.0 * radii * b.h + 4.0 * b.d, 0);
+#ifdef FLUID_OPTIONS
+  if (st == MFREE_SUCCESS) st = set_option(ref.sys, &b, opt);
 #endif
   CHECK(st == MFREE_SUCCESS, "one-rank system: status %d: %s", (int)st, mpifluid_error(ctx));
   double *ref_y[WINDOWS], t_ref[WINDOWS];
@@ -113,13 +142,13 @@ int main(int argc, char **argv) {
     int p = (int)(b.y[2 * i] / b.a * size);
     owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
   }
-  const double width = 4.0 * b.h + 0.25 * b.d;
+  const double width = 2.0 * radii * b.h + 0.25 * b.d;
   rankfluid_t r;
   counted_t cw;
   st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
   if (st == MFREE_SUCCESS) st = mpimove_counted(&r, ctx, &b, width, &cw);
 #ifdef FLUID_OPTIONS
-  if (st == MFREE_SUCCESS) st = set_option(r.sys, opt);
+  if (st == MFREE_SUCCESS) st = set_option(r.sys, &b, opt);
 #endif
   CHECK(st == MFREE_SUCCESS, "system on the ranks: status %d: %s", (int)st, mpifluid_error(ctx));
   /* a state buffer for any owned count: no reallocation between windows */

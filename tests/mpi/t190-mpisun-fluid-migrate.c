@@ -7,7 +7,13 @@
  * HSFC with new regions, HSFC in the last regions), after which the host re-creates its
  * vector with the new length and the integrator (the one-rank run re-creates them at
  * the same times). Every particle's position, velocity and density, matched by global
- * id, and the steps of every window are bitwise those of the one-rank run. */
+ * id, and the steps of every window are bitwise those of the one-rank run.
+ *
+ * Built with FLUID_DUMMIES (t177), both systems have no-slip walls (four layers of dummy
+ * particles past the floor and both end walls, examples/fluid_common's tank) and density
+ * diffusion (delta 0.1), the ghost layer is four support radii and a quarter spacing
+ * deep, as the dummies' extrapolated densities with density diffusion need, and the
+ * windows are 25 ms (ERKStep's steps are longer there: still at least 500 in all). */
 #include <arkode/arkode_erkstep.h>
 #include <math.h>
 #include <stdio.h>
@@ -18,11 +24,40 @@
 #include "mfree_sundials_mpi.h"
 #include "mpimove.h"
 #include "mpitest.h"
+#ifdef FLUID_DUMMIES
+#include "fluid_common.h"
+#endif
+
+#ifndef TEST_NAME
+#define TEST_NAME "t190-mpisun-fluid-migrate"
+#endif
 
 enum { WINDOWS = 4 };
+#ifdef FLUID_DUMMIES
+static const double T_WINDOW = 25e-3, RTOL = 1e-3; /* (the walls' dummies allow longer steps) */
+#else
 static const double T_WINDOW = 10e-3, RTOL = 1e-3;
+#endif
 
 static void flag(int f, const char *what) { CHECK(f >= 0, "%s returned %d", what, f); }
+
+/* The ghost layer's depth in support radii (2 h each) and its margin in spacings, and the
+   options beyond 003 on sys. */
+#ifdef FLUID_DUMMIES
+static const double kRadii = 4.0, kMargin = 0.25;
+static mfree_status_t options(mfree_system_t *sys, const damb_t *b) {
+  mfree_status_t st = mfree_system_set_density_diffusion(sys, 0.1);
+  /* the tank is 5 a long, its end walls 1.5 times the column high */
+  if (st == MFREE_SUCCESS) st = fc_dummy_tank(sys, (int)lround(5.0 * b->a / b->d), 3.0 * b->a, b->d);
+  return st;
+}
+#else
+static const double kRadii = 2.0, kMargin = 0.02;
+static mfree_status_t options(mfree_system_t *sys, const damb_t *b) {
+  (void)sys, (void)b;
+  return MFREE_SUCCESS;
+}
+#endif
 
 /* One window of ERKStep from t0 on a fresh vector and integrator: y (the rank's state,
    5 n_owned) advanced to t0 + T_WINDOW; the steps. */
@@ -77,7 +112,8 @@ int main(int argc, char **argv) {
 
   /* the reference: one rank, the same windows */
   rankfluid_t ref;
-  mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, 4.0 * b.h + 4.0 * b.d, 0);
+  mfree_status_t st = rankfluid_make(&ref, ctx, MPI_COMM_SELF, &b, owner, 2.0 * kRadii * b.h + 4.0 * b.d, 0);
+  if (st == MFREE_SUCCESS) st = options(ref.sys, &b);
   CHECK(st == MFREE_SUCCESS, "one-rank system: status %d: %s", (int)st, mpifluid_error(ctx));
   double *ref_y[WINDOWS];
   long ref_steps[WINDOWS];
@@ -92,11 +128,12 @@ int main(int argc, char **argv) {
     int p = (int)(b.y[2 * i + 1] / (2.0 * b.a) * size);
     owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
   }
-  const double width = 4.0 * b.h + 0.02 * b.d;
+  const double width = 2.0 * kRadii * b.h + kMargin * b.d;
   rankfluid_t r;
   counted_t cw;
   st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
   if (st == MFREE_SUCCESS) st = mpimove_counted(&r, ctx, &b, width, &cw);
+  if (st == MFREE_SUCCESS) st = options(r.sys, &b);
   CHECK(st == MFREE_SUCCESS, "system on the ranks: status %d: %s", (int)st, mpifluid_error(ctx));
   double *y = malloc(5 * (size_t)n * sizeof *y);
   memcpy(y, r.y, 5 * (size_t)r.n_owned * sizeof *y);
@@ -123,8 +160,8 @@ int main(int argc, char **argv) {
   CHECK(fewest > WINDOWS, "the ghosts were rebuilt %d times", fewest);
   CHECK(total_steps >= 500, "%ld steps in all: too short a run", total_steps);
   if (rank == 0)
-    printf("t190: ERKStep on %d ranks: %ld steps in %d windows, %d ghost rebuilds\n", size, total_steps, WINDOWS,
-           cw.rebuilds);
+    printf("%s: ERKStep on %d ranks: %ld steps in %d windows, %d ghost rebuilds\n", TEST_NAME, size, total_steps,
+           WINDOWS, cw.rebuilds);
   mfree_migration_destroy(&mig);
   rankfluid_free(&r);
   rankfluid_free(&ref);
@@ -134,7 +171,7 @@ int main(int argc, char **argv) {
   SUNContext_Free(&self_ctx);
   SUNContext_Free(&sunctx);
   mfree_context_destroy(&ctx);
-  const int rc = mpitest_finish("t190-mpisun-fluid-migrate");
+  const int rc = mpitest_finish(TEST_NAME);
   MPI_Finalize();
   return rc;
 }

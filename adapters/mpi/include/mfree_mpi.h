@@ -504,7 +504,7 @@ MFREE_MPI_API mfree_status_t mfree_halo_create_elastodynamic(mfree_halo_t *halo,
  * up again inside the run), and migrates with mfree_halo_migrate_fluid.
  * @param[in]  halo   a set-up plan
  * @param[in]  dim    2 or 3 (the plan's dimension)
- * @param[in]  width  the width the plan was set up with (at least two support radii)
+ * @param[in]  width  the width the plan was set up with (at least two support radii; four with dummies and density diffusion)
  * @param[out] sys    the new system
  * @return as mfree_system_create_fluid_ranks; MFREE_ERR_NULL (local) for a NULL plan or
  *         output

@@ -204,6 +204,10 @@ class FluidSystem : public System {
   // fluid_wall.cpp. Nodes (and nodal quadrature points): the n_ fluid particles, then
   // the dummies. Without dummies the node arrays are the fluid's own.
   int32_t nq() const { return n_ + dummy_.n; }
+  // A new node set: the n_ fluid particles, then ndummy dummies of volumes dvol (the
+  // search lists, the tables and the fluid's volumes follow at the next prepare); on ranks
+  // also after the ghosts changed (the dummies stay).
+  void seat_nodes(int32_t ndummy, const double *dvol);
   const double *node_positions(const double *y);     // fluid positions + dummies
   const double *node_velocities(const double *v) const;  // v + zeros for the dummies
   const double *node_densities(const double *rho) const;  // rho + extrapolated (fills rho0, mass)

@@ -111,6 +111,18 @@ void FluidRanks::rows_done() {
     need_[k] = 1;
     for (int64_t e = rb_[k]; e < re_[k]; ++e) need_[cols_[e]] = 1;
   }
+  // With dummies and density diffusion, the density gradients at the needed nodes read
+  // the extrapolated densities of the dummies in their rows (a pass deeper, level 3 at
+  // most where the gradient weighs them), and these read the dummies of the pass before
+  // (level 2, from the fluid in their rows): those two sets of dummy rows stay too, and
+  // are complete with ghosts four support radii deep (depth()).
+  if (depth() > 2)
+    for (char level = 2; level <= 3; ++level)
+      for (int32_t k = 0; k < n; ++k) {
+        if (need_[k] != level - 1) continue;
+        for (int64_t e = rb_[k]; e < re_[k]; ++e)
+          if (cols_[e] >= n_ && !need_[cols_[e]]) need_[cols_[e]] = level;
+      }
   // The rows are the particle set's lists (re_ points into them): the emptied rows go
   // to a copy of the row ends, which the next candidates() replaces.
   re_need_.resize(n);
@@ -220,9 +232,9 @@ Report FluidRanks::prepare_rows(const double *ys, bool checked, double &limit, d
     }
     d2 = std::max(d2, s);
   }
-  // particles within 2 R h of an owned particle now were within 2 R h + 2 d of it at the
-  // first evaluation, when the ghost layer held every particle within the width
-  reach = -2.0 * (kernel_->radius() * h_ + std::sqrt(d2));
+  // particles within depth() R h of an owned particle now were within depth() R h + 2 d of
+  // it at the first evaluation, when the ghost layer held every particle within the width
+  reach = -(depth() * (kernel_->radius() * h_) + 2.0 * std::sqrt(d2));
   limit = stable_dt(ys);
   return r;
 }
@@ -231,8 +243,10 @@ void FluidRanks::check_reach(double reach, int64_t step) const {
   if (!(-reach > width_)) return;
   std::ostringstream s;
   if (step > 0) s << "step " << step << ": ";
-  s << "the ghost layer (width " << width_ << ") no longer reaches two support radii around every owned particle ("
-    << -reach << " with the particles' displacements): rebuild the halo and the system";
+  s << "the ghost layer (width " << width_ << ") no longer reaches "
+    << (depth() > 2 ? "four support radii (dummy particles with density diffusion)" : "two support radii")
+    << " around every owned particle (" << -reach << " with the particles' displacements): rebuild the halo and "
+    << "the system";
   throw Error(MFREE_ERR_HALO, s.str());
 }
 
@@ -637,7 +651,7 @@ void FluidRanks::wall_shares(bool galerkin, double *per_wall) {
   std::vector<double> m(n);
   for (int32_t k = 0; k < n; ++k) m[k] = galerkin ? acc_[static_cast<size_t>(k) * A + D + 1] : mass_[k];
   sync(m.data(), 1);
-  const double *vn = ys_.data() + static_cast<size_t>(D) * n;  // (no dummies on ranks)
+  const double *vn = node_velocities(ys_.data() + static_cast<size_t>(D) * n);
   std::vector<double> rec;  // (wall, row's global id, m_k f2) per term
   std::vector<std::pair<int32_t, double>> terms;
   for (int32_t k = 0; k < n && nw > 0; ++k) {

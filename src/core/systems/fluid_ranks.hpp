@@ -21,7 +21,8 @@ class FluidRanks final : public FluidSystem {
   // disagree on dim or width, throws the agreed error on every rank). ids: the global
   // ids of the n_owned + n_ghost local items, owned first (the host's order, which the
   // exchange callback uses); width: the depth of the ghost layer around the owned
-  // particles (at least two support radii; checked at every evaluation).
+  // particles (at least two support radii, four with dummies and density diffusion:
+  // depth(); checked at every evaluation).
   static std::unique_ptr<FluidRanks> create(int dim, int32_t n_owned, int32_t n_ghost, const int64_t *ids,
                                             double width, const Collective &coll);
 
@@ -71,6 +72,9 @@ class FluidRanks final : public FluidSystem {
   // MFREE_ERR_HALO on every rank when reach (agreed by agree_min) exceeds the width;
   // step > 0: integrate's step, named in the message.
   void check_reach(double reach, int64_t step) const;
+  // The ghost layer's depth in support radii: two for the rows of the owned particles'
+  // neighbours; four with dummies and density diffusion (rows_done).
+  int depth() const { return dummy_.n > 0 && delta_ > 0.0 ? 4 : 2; }
   // The outputs' evaluation at the owned state y: load, the tables (and with a, the
   // accelerations into a), agreed; refuse != MFREE_SUCCESS: this rank's error instead,
   // with the message why (every rank then returns it); y may be NULL on a rank that owns

@@ -65,20 +65,15 @@ void FluidRanks::reseat(int32_t n_owned, const double *xo, const int64_t *oid, c
     throw Error(agreed.status, agreed.message);
   }
   const Report seated = guarded([&] {
+    // (the dummies' volumes, after the fluid's, move to the new nodes)
+    const std::vector<double> dvol(vol_.begin() + n_, vol_.begin() + nq());
     n_own_ = n_owned;
     n_ghost_ = ng;
     n_ = n_owned + ng;
     number(ids);
     // a new particle set of the nodes (its search lists and the tables follow at the
     // next prepare), with the system's support
-    ps_ = ParticleSet(D, n_);
-    if (h_ > 0.0) ps_.set_support(&h_, 0, MFREE_COPY);
-    lists_valid_ = false;
-    cand_search_ = -1;
-    xbound_ = nullptr;
-    rb_ = re_ = nullptr;
-    cols_ = nullptr;
-    vol_.assign(n_ > 0 ? n_ : 1, 1.0);
+    seat_nodes(dummy_.n, dvol.data());
     xfirst_.clear();
     // the rest densities and masses to the nodes, the ghosts' from their owners
     buf_.resize(2 * static_cast<size_t>(n_));

@@ -38,9 +38,6 @@ struct NodeKernel {
 }  // namespace
 
 void FluidSystem::set_dummy_particles(int32_t n, const double *x, const double *vol, int64_t stride) {
-  // (a dummy's extrapolated density reads dummies up to three passes deep, fluid particles
-  // beyond the two support radii of ghosts a rank holds)
-  if (on_ranks()) throw Error(MFREE_ERR_UNSUPPORTED, "no dummy wall particles for the fluid on ranks");
   if (n < 0) throw Error(MFREE_ERR_ARG, "negative dummy particle count " + std::to_string(n));
   if (n > 0 && (!x || !vol)) throw Error(MFREE_ERR_NULL, "dummy positions or volumes are NULL");
   if (stride < 0) throw Error(MFREE_ERR_ARG, "negative stride");
@@ -49,7 +46,7 @@ void FluidSystem::set_dummy_particles(int32_t n, const double *x, const double *
   // Everything is built aside and swapped in when complete: running out of memory half
   // way leaves the system as it was.
   HVec<double> xd(static_cast<size_t>(n) * dim_);
-  HVec<double> vols(std::max<size_t>(static_cast<size_t>(n_) + n, 1), 1.0);
+  HVec<double> vols(std::max<int32_t>(n, 1));
   for (int32_t w = 0; w < n; ++w) {
     for (int c = 0; c < dim_; ++c) {
       xd[static_cast<size_t>(w) * dim_ + c] = x[static_cast<size_t>(w) * dim_ + c];
@@ -59,18 +56,29 @@ void FluidSystem::set_dummy_particles(int32_t n, const double *x, const double *
     const double v = vol[w * stride];
     if (!(std::isfinite(v) && v > 0.0))
       throw Error(MFREE_ERR_INPUT, "volume of dummy particle " + std::to_string(w) + " must be finite and > 0");
-    vols[static_cast<size_t>(n_) + w] = v;
+    vols[w] = v;
   }
-  // a particle set of the new size; the approximant is rebuilt on it at the next prepare
-  ParticleSet nodes(dim_, n_ + n);
-  if (h_ > 0.0) nodes.set_support(&h_, 0, MFREE_COPY);
   DummyWall dummy;
   dummy.n = n;
   dummy.xd.swap(xd);
-  lists_valid_ = false;
+  seat_nodes(n, vols.data());
+  dummy_ = std::move(dummy);
+}
+
+void FluidSystem::seat_nodes(int32_t ndummy, const double *dvol) {
+  const size_t nall = static_cast<size_t>(n_) + ndummy;
+  HVec<double> vols(std::max<size_t>(nall, 1), 1.0);
+  if (ndummy > 0) std::copy(dvol, dvol + ndummy, vols.begin() + n_);
+  // a particle set of the new size; the approximant is rebuilt on it at the next prepare
+  ParticleSet nodes(dim_, static_cast<int32_t>(nall));
+  if (h_ > 0.0) nodes.set_support(&h_, 0, MFREE_COPY);
   ps_ = std::move(nodes);
   vol_.swap(vols);
-  dummy_ = std::move(dummy);
+  lists_valid_ = false;
+  cand_search_ = -1;
+  xbound_ = nullptr;
+  rb_ = re_ = nullptr;
+  cols_ = nullptr;
 }
 
 void FluidSystem::set_density_diffusion(double delta) {
