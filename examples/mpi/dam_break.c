@@ -8,9 +8,12 @@
  * Set-up. Rank r first holds the particles with ids [r n / p, (r + 1) n / p) (rows of the
  * column, id q = j nx + i as examples/dam_break numbers them), a ghost layer of width
  * 4 h + 4 d (libmfree_mpi's halo: two support radii and a margin for the motion; the system
- * rebuilds it whenever the particles' displacements have used the margin up) and the fluid
- * on ranks over it. Zoltan then partitions the particles (RCB, or HSFC with --partitioner
- * hsfc, to --imbalance 1.05) through mfree_halo_migrate_fluid before the first step.
+ * rebuilds it whenever the particles' displacements have used the margin up; 8 h + 4 d, four
+ * radii, with --no-slip 1 and --diffusion D > 0 together) and the fluid on ranks over it.
+ * --no-slip 1 and --diffusion D as examples/dam_break's: four layers of dummy particles
+ * past the floor and both end walls, every rank holding all of them, and density diffusion.
+ * Zoltan then partitions the particles (RCB, or HSFC with --partitioner hsfc, to
+ * --imbalance 1.05) through mfree_halo_migrate_fluid before the first step.
  *
  * Windows. The run integrates from one front sample to the next, every 0.05 in T = t
  * sqrt(2 g / a), through the same integrate calls as examples/dam_break (so the same
@@ -31,7 +34,7 @@
  * front.png (gnuplot), and the summary mpi_dam_break.json (--json: on stdout too) with the
  * keys of examples/dam_break's ("front", "front_floor", their digests, "max_rel_dev",
  * "compared", "max_rel_dev_wide", "compared_wide", "time_offset", "particles", "steps",
- * "wall_seconds", "a", "nx", "cfl", "shepard_condition", "mu", "scheme", "status",
+ * "wall_seconds", "a", "nx", "cfl", "shepard_condition", "mu", "scheme", "status", "no_slip", "diffusion",
  * "error", "t_end", "head_speed", "head_speed_experiment", "head_fit_points"; "mass_rel_error" from the Galerkin lumped masses alone, summed over
  * the ranks, against the particles' total, 003 eq 57) and "ranks",
  * "partitioner", "window", "halo_width", "balance" ([T, max/mean, min/mean] after each
@@ -64,8 +67,8 @@
 static int g_rank = 0; /* usage on rank 0 only */
 
 typedef struct {
-  double a, tank, t_end, cfl, mu, strength, offset, shepard, window, imbalance;
-  int nx, scheme, lumping, partitioner;
+  double a, tank, t_end, cfl, mu, strength, offset, shepard, window, imbalance, diffusion;
+  int nx, scheme, lumping, partitioner, no_slip;
   const char *data;
   fc_run_t run;
 } options_t;
@@ -78,7 +81,9 @@ static void usage(FILE *f) {
   fc_dam_usage(f);
   fprintf(f, "  --partitioner P rcb (default) | hsfc: Zoltan's method\n"
              "  --imbalance R   the largest count / mean Zoltan may leave, in [1, 10] (default 1.05)\n"
-             "  --window W      repartition every W in T, a multiple of 0.05 (default 0.25)\n");
+             "  --window W      repartition every W in T, a multiple of 0.05 (default 0.25)\n"
+             "  --no-slip 0|1   no-slip floor and end walls: dummy particles past them (default 0)\n"
+             "  --diffusion D   density diffusion (delta-SPH) coefficient, >= 0 (default 0)\n");
   fc_run_usage(f);
 }
 
@@ -100,6 +105,8 @@ static int parse(int argc, char **argv, options_t *o) {
                               {"--partitioner", 's', &partitioner},
                               {"--imbalance", 'd', &o->imbalance},
                               {"--window", 'd', &o->window},
+                              {"--no-slip", 'i', &o->no_slip},
+                              {"--diffusion", 'd', &o->diffusion},
                               {NULL, 0, NULL}};
   const int parsed = fc_parse(argc, argv, &o->run, opts, usage);
   if (parsed) return parsed;
@@ -114,6 +121,7 @@ static int parse(int argc, char **argv, options_t *o) {
   const int ok = o->scheme >= 0 && o->lumping >= 0 && o->partitioner >= 0 && o->nx >= 2 && o->a > 0 &&
                  o->tank > 1 && o->t_end > 0 && o->cfl > 0 && o->cfl <= 1 && o->mu >= 0 && o->strength >= 0 &&
                  o->offset >= 0 && o->shepard >= 1 && o->imbalance >= 1 && o->imbalance <= 10 && windows >= 1 - 1e-9 &&
+                 (o->no_slip == 0 || o->no_slip == 1) && o->diffusion >= 0 &&
                  fabs(windows - floor(windows + 0.5)) < 1e-9;
   if (!ok) usage(stderr);
   return ok ? 0 : 2;
@@ -174,8 +182,12 @@ static mfree_status_t share_create(share_t *s, const fc_dam_t *dam, const option
   if (st == MFREE_SUCCESS) st = mfree_halo_exchange(s->halo, 1, m, 1);
   if (st == MFREE_SUCCESS) st = mfree_halo_create_fluid(s->halo, 2, width, &s->sys);
   if (st == MFREE_SUCCESS) {
-    const mfree_status_t mine =
+    mfree_status_t mine =
         fc_dam_configure(dam, s->sys, m, o->mu, o->strength, (mfree_lumping_t)o->lumping, o->shepard);
+    if (mine == MFREE_SUCCESS) mine = mfree_system_set_density_diffusion(s->sys, o->diffusion);
+    /* every rank the same dummies, all of them */
+    if (mine == MFREE_SUCCESS && o->no_slip)
+      mine = fc_dummy_tank(s->sys, (int)lround(dam->L / dam->d), 1.5 * dam->H, dam->d);
     if (mine != MFREE_SUCCESS) fprintf(stderr, "mfree_mpi_dam_break: rank %d: the fluid's settings failed\n", g_rank);
     if (any(mine != MFREE_SUCCESS)) st = mine != MFREE_SUCCESS ? mine : MFREE_ERR_ARG;
   }
@@ -323,8 +335,8 @@ int main(int argc, char **argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   g_rank = rank;
-  options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 100.0, 0.25, 1.05, 24, MFREE_INTEGRATOR_LEAPFROG,
-                 MFREE_LUMP_GALERKIN, MFREE_PARTITIONER_RCB, MFREE_DATA_DIR "/martin_moyce_1952.csv", {0}};
+  options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 100.0, 0.25, 1.05, 0.0, 24, MFREE_INTEGRATOR_LEAPFROG,
+                 MFREE_LUMP_GALERKIN, MFREE_PARTITIONER_RCB, 0, MFREE_DATA_DIR "/martin_moyce_1952.csv", {0}};
   fc_run_init(&o.run, "mpi_dam_break", 0.25);
   const int parsed = parse(argc, argv, &o);
   if (parsed) {
@@ -345,7 +357,9 @@ int main(int argc, char **argv) {
     MPI_Finalize();
     return 1;
   }
-  const double a = dam.a, d = dam.d, tscale = dam.tscale, width = 4.0 * dam.h + 4.0 * d;
+  /* two support radii (2 h each), four with dummies and density diffusion (docs/fluid-ranks.md) */
+  const double radii = o.no_slip && o.diffusion > 0.0 ? 4.0 : 2.0;
+  const double a = dam.a, d = dam.d, tscale = dam.tscale, width = 2.0 * radii * dam.h + 4.0 * d;
   const int n = dam.n;
   share_t s = {0};
   if (mfree_context_create(&s.ctx) != MFREE_SUCCESS) MPI_Abort(MPI_COMM_WORLD, 1);
@@ -453,6 +467,8 @@ int main(int argc, char **argv) {
     fc_json_str(&js, "partitioner", o.partitioner == MFREE_PARTITIONER_RCB ? "rcb" : "hsfc");
     fc_json_num(&js, "window", o.window);
     fc_json_num(&js, "halo_width", width);
+    fc_json_int(&js, "no_slip", o.no_slip);
+    fc_json_num(&js, "diffusion", o.diffusion);
     fc_json_table(&js, "balance", nbal, 3, balance);
     fc_json_num(&js, "max_count_ratio", nbal ? worst : NAN);
     fc_json_num(&js, "min_count_ratio", nbal ? least : NAN);

@@ -8,7 +8,8 @@
 # & Moyce, at least two Zoltan partitions, every rank's count within 10 % of the mean after
 # each, and particles moved between ranks on more than one rank. The head speed (the
 # slope of the front over 1 <= T <= 3) is the serial run's, and that within 10 % of the
-# same fit through the experiment's points. Then a run that fails on
+# same fit through the experiment's points. The same with no-slip walls (--no-slip 1:
+# dummy particles) on 2 ranks (RCB) against the serial no-slip run. Then a run that fails on
 # one rank (walls on the fluid's edge: a negative density after a few steps at the
 # particle next to the corner, owned by one rank) must exit 3 on every rank with the
 # agreed status in the summary, and a bad option must exit 2.
@@ -95,6 +96,8 @@ endforeach()
 ranks_run(${np_last} hsfc leapfrog)
 serial_reference(pc --scheme pc)
 ranks_run(2 hsfc pc --scheme pc)
+serial_reference(noslip --no-slip 1)
+ranks_run(2 rcb noslip --no-slip 1)
 
 # a failure on one rank: every rank stops with the same status
 set(dir "${OUT}/fault")
