@@ -37,6 +37,12 @@
  * and a later window give no convergent speed either. docs/fluid.md has the resolution
  * table and the reasons the speed does not come within 10 % of 0.217 m/s.
  *
+ * The paper's set-up read with its other experiments: --light 0.06 (Fig. 10's two labels
+ * as two compartments 0.06 m long) and --mu 0.5 (the viscosity of Sects. 7.1, 7.2 and
+ * 7.4 a), with --fit-to 0.2 (the head then still more than 0.4 D from the end wall) and
+ * --lumped-step 1: 0.233, 0.236, 0.233, 0.231, 0.234 m/s at nz = 26, 34, 41, 50, 58
+ * (1,352 to 6,728 particles), 7 % above eq 126 (with mu = 0.01 0.27-0.30, still rising).
+ *
  * Diagnostics (not in the paper): --heavy RHO2 (a smaller density difference, towards the
  * Boussinesq lock exchange whose inviscid current is Benjamin's), --lid 1 (a free-slip
  * lid of wall particles at z = D + d/2 in place of the free surface), --consistent 1
