@@ -1842,7 +1842,8 @@ MFREE_API mfree_status_t mfree_system_set_acoustic_step(mfree_system_t *sys, int
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL output */
 MFREE_API mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq);
 /** Spatial dimension and number of particles of a system, the sizes of get_pressure
- * (n values), get_velocity (dim n) and get_stress (n times 1, 3 or 6 for dim 1, 2, 3).
+ * (n values), get_velocity (dim n) and get_stress (n times 1, 3 or 6 for dim 1, 2, 3);
+ * on ranks n is the rank's owned particles.
  * @param[in] sys the system @param[out] dim, n either may be NULL, not both
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for two NULL outputs */
 MFREE_API mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, int32_t *dim,
@@ -2329,6 +2330,32 @@ typedef mfree_status_t (*mfree_particles_move_fn)(void *user, int32_t nrec, int3
 MFREE_API mfree_status_t mfree_system_move_particles(mfree_system_t *sys, int32_t n_new,
                                                      mfree_particles_move_fn move, void *move_user,
                                                      double *y, int64_t capacity);
+
+/**
+ * Make a fault found on this rank before a collective call the outcome of that call, for
+ * hosts and bindings that check what the C API cannot see (the Fortran module: an output
+ * array too short; libmfree_sundials: an N_Vector of another length), so that the rank
+ * still takes part instead of returning while the others wait. The next call on sys of
+ * those that are collective on ranks (mfree_system_rhs, _integrate, _assemble_mass,
+ * _assemble_interpolation, _apply_mass, _get_velocity, _get_wall_force, _get_stress,
+ * _move_particles) takes the fault: on this rank it reads and writes none of its arrays
+ * (they may be NULL, or any size); on ranks it takes part in the call's first agreement,
+ * and every rank returns status with this rank's message ("rank R: <message>"), nothing
+ * changed, as for a NULL argument; in one process, or where the call is local on ranks
+ * (an elastodynamic system's mass), it returns status and message on this rank at once.
+ * The fault is reported once: the call after it runs as usual. Other calls leave it
+ * pending; a second call of this function replaces it. Not collective.
+ * @param[in] sys      the system
+ * @param[in] status   the fault: a negative mfree_status_t; MFREE_SUCCESS clears a fault
+ *                     not yet taken (else MFREE_ERR_ARG)
+ * @param[in] message  why (copied), as "<reason>" or "mfree_<fn>: <reason>" (the leading
+ *                     "mfree_<fn>: " dropped: the collective call names itself); NULL:
+ *                     the status's mfree_status_string
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (without a message) for a NULL system;
+ *         MFREE_ERR_ARG for a status that is neither negative nor MFREE_SUCCESS, or unknown
+ */
+MFREE_API mfree_status_t mfree_system_set_pending_error(mfree_system_t *sys, mfree_status_t status,
+                                                        const char *message);
 
 #ifdef __cplusplus
 }

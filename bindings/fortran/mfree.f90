@@ -670,6 +670,14 @@ module mfree
       type(c_ptr) :: ctx
     end function mfree_system_get_context_c
 
+    integer(c_int) function mfree_system_set_pending_error_c(sys, status, message) &
+        bind(C, name="mfree_system_set_pending_error")
+      import :: c_int, c_ptr
+      type(c_ptr), value :: sys
+      integer(c_int), value :: status
+      type(c_ptr), value :: message
+    end function mfree_system_set_pending_error_c
+
     integer(c_int) function mfree_approximant_get_particles_c(a, ps) &
         bind(C, name="mfree_approximant_get_particles")
       import :: c_int, c_ptr
@@ -1629,6 +1637,7 @@ module mfree
   public :: mfree_particles_get_context_c, mfree_approximant_get_context_c
   public :: mfree_mesh_get_context_c, mfree_matrix_get_context_c
   public :: mfree_assembler_get_context_c, mfree_system_get_context_c
+  public :: mfree_system_set_pending_error_c
   public :: mfree_approximant_get_particles_c, mfree_mesh_get_particles_c
   public :: mfree_system_get_dimension_c
   public :: mfree_approximant_destroy_c, mfree_approximant_set_kernel_c
@@ -1760,6 +1769,7 @@ module mfree
   public :: mfree_particles_get_context, mfree_approximant_get_context
   public :: mfree_mesh_get_context, mfree_matrix_get_context
   public :: mfree_assembler_get_context, mfree_system_get_context
+  public :: mfree_system_set_pending_error
   public :: mfree_approximant_get_particles, mfree_mesh_get_particles
   public :: mfree_system_get_dimension
   public :: mfree_approximant_create, mfree_approximant_destroy
@@ -3914,7 +3924,27 @@ contains
     st = check_out(ctx, fn, what, contig, have, need)
   end function check_system_out
 
-  !> ydot must be contiguous and hold neq values (else MFREE_ERR_ARG).
+  !> A caller array's fault st that a system wrapper found (its message recorded on the
+  !> system's context) made pending on the system (mfree_system_set_pending_error): the
+  !> collective call the wrapper then still makes, on empty stand-ins of the faulty arrays,
+  !> returns st on every rank with this rank's message, so that no rank waits for this
+  !> one. .false. when it cannot be made pending (a NULL system): the wrapper returns st.
+  logical function pend_system_fault(sys, st) result(pending)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int), intent(in) :: st
+    character(kind=c_char), target :: msg(512)
+    type(c_ptr) :: ctx
+    pending = .false.
+    ctx = c_null_ptr
+    if (mfree_system_get_context_c(sys%ptr, ctx) /= MFREE_SUCCESS) return
+    msg = c_null_char
+    if (mfree_context_get_last_error_c(ctx, c_null_ptr, c_loc(msg), size(msg, kind=c_int64_t)) /= &
+        MFREE_SUCCESS) return
+    pending = mfree_system_set_pending_error_c(sys%ptr, st, c_loc(msg)) == MFREE_SUCCESS
+  end function pend_system_fault
+
+  !> ydot must be contiguous and hold neq values (else MFREE_ERR_ARG, on ranks on every
+  !> rank: the wrappers of collective calls hand the fault to the C call, pend_system_fault).
   integer(c_int) function mfree_system_rhs(sys, t, y, ydot) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: t
@@ -3922,7 +3952,10 @@ contains
     real(c_double), intent(out), target :: ydot(:)
     st = check_system_out(sys, 'mfree_system_rhs', 'ydot', is_contiguous(ydot), &
                           size(ydot, kind=c_int64_t), 0)
-    if (st /= MFREE_SUCCESS) return
+    if (st /= MFREE_SUCCESS) then
+      if (pend_system_fault(sys, st)) st = mfree_system_rhs_c(sys%ptr, t, y, empty_dbl)
+      return
+    end if
     st = mfree_system_rhs_c(sys%ptr, t, y, ydot)
   end function mfree_system_rhs
 
@@ -3937,7 +3970,7 @@ contains
     st = mfree_system_get_pressure_c(sys%ptr, y, p)
   end function mfree_system_get_pressure
 
-  !> vhat(dim, n), contiguous (else MFREE_ERR_ARG).
+  !> vhat(dim, n), contiguous (else MFREE_ERR_ARG, on ranks on every rank).
   integer(c_int) function mfree_system_get_velocity(sys, y, vhat) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: y(*)
@@ -3945,7 +3978,10 @@ contains
     real(c_double), pointer :: pv(:)
     st = check_system_out(sys, 'mfree_system_get_velocity', 'vhat', is_contiguous(vhat), &
                           size(vhat, kind=c_int64_t), -1)
-    if (st /= MFREE_SUCCESS) return
+    if (st /= MFREE_SUCCESS) then
+      if (pend_system_fault(sys, st)) st = mfree_system_get_velocity_c(sys%ptr, y, empty_dbl)
+      return
+    end if
     pv => empty_dbl
     if (size(vhat) > 0) call c_f_pointer(c_loc(vhat), pv, [size(vhat)])
     st = mfree_system_get_velocity_c(sys%ptr, y, pv)
@@ -3953,7 +3989,8 @@ contains
 
   !> The walls' force on the fluid at state y: total (dim values, contiguous) and, when
   !> present, per_wall(dim, nwall) for the system's nwall wall particles (contiguous;
-  !> its size a multiple of dim; else MFREE_ERR_ARG; an empty one is ignored).
+  !> its size a multiple of dim; else MFREE_ERR_ARG, on ranks on every rank; an empty one
+  !> is ignored).
   integer(c_int) function mfree_system_get_wall_force(sys, y, total, per_wall) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: y(*)
@@ -3968,18 +4005,22 @@ contains
     st = mfree_system_get_context_c(sys%ptr, ctx)
     st = check_out(ctx, 'mfree_system_get_wall_force', 'total', is_contiguous(total), &
                    size(total, kind=c_int64_t), int(dim, c_int64_t))
-    if (st /= MFREE_SUCCESS) return
     pw = c_null_ptr
     nwall = 0
-    if (present(per_wall)) then
+    if (st == MFREE_SUCCESS .and. present(per_wall)) then
       if (.not. is_contiguous(per_wall) .or. mod(size(per_wall), dim) /= 0) then
         st = wrapper_error(ctx, MFREE_ERR_ARG, 'mfree_system_get_wall_force: per_wall is not ' // &
                            'contiguous or its size ' // int_str(size(per_wall, kind=c_int64_t)) // &
                            ' is not a multiple of dim')
-        return
+      else
+        nwall = int(size(per_wall) / dim, c_int32_t)
+        if (size(per_wall) > 0) pw = c_loc(per_wall)
       end if
-      nwall = int(size(per_wall) / dim, c_int32_t)
-      if (size(per_wall) > 0) pw = c_loc(per_wall)
+    end if
+    if (st /= MFREE_SUCCESS) then
+      if (pend_system_fault(sys, st)) &
+        st = mfree_system_get_wall_force_c(sys%ptr, y, c_null_ptr, 0_c_int32_t, c_null_ptr)
+      return
     end if
     st = mfree_system_get_wall_force_c(sys%ptr, y, c_loc(total), nwall, pw)
   end function mfree_system_get_wall_force
@@ -4085,7 +4126,8 @@ contains
     st = mfree_system_get_outflow_c(sys%ptr, k, count, mass)
   end function mfree_system_get_outflow
 
-  !> Integrate y (neq values, contiguous: else MFREE_ERR_ARG) from t to t_end (both updated
+  !> Integrate y (neq values, contiguous: else MFREE_ERR_ARG, on ranks on every rank, y and t
+  !> unchanged) from t to t_end (both updated
   !> in place); progress (optional) is called after every accepted step; nsteps
   !> (optional) receives the number of steps.
   integer(c_int) function mfree_system_integrate(sys, scheme, y, t, t_end, cfl, dt_max, &
@@ -4102,11 +4144,16 @@ contains
     type(c_ptr) :: pn
     st = check_system_out(sys, 'mfree_system_integrate', 'y', is_contiguous(y), &
                           size(y, kind=c_int64_t), 0)
-    if (st /= MFREE_SUCCESS) return
     fp = c_null_funptr
     pn = c_null_ptr
     if (present(progress)) fp = c_funloc(progress)
     if (present(nsteps)) pn = c_loc(nsteps)
+    if (st /= MFREE_SUCCESS) then
+      if (pend_system_fault(sys, st)) &
+        st = mfree_system_integrate_c(sys%ptr, scheme, empty_dbl, t, t_end, cfl, dt_max, fp, &
+                                      user_ptr(user), pn)
+      return
+    end if
     st = mfree_system_integrate_c(sys%ptr, scheme, y, t, t_end, cfl, dt_max, fp, &
                                   user_ptr(user), pn)
   end function mfree_system_integrate
@@ -4129,7 +4176,7 @@ contains
   end function mfree_system_assemble_interpolation
 
   !> Mv = M(y) v (consistent: 0 lumped, nonzero consistent); Mv must be contiguous and
-  !> hold neq values (else MFREE_ERR_ARG).
+  !> hold neq values (else MFREE_ERR_ARG, on ranks on every rank).
   integer(c_int) function mfree_system_apply_mass(sys, y, consistent, v, Mv) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: y(*)
@@ -4138,7 +4185,10 @@ contains
     real(c_double), intent(out), target :: Mv(:)
     st = check_system_out(sys, 'mfree_system_apply_mass', 'Mv', is_contiguous(Mv), &
                           size(Mv, kind=c_int64_t), 0)
-    if (st /= MFREE_SUCCESS) return
+    if (st /= MFREE_SUCCESS) then
+      if (pend_system_fault(sys, st)) st = mfree_system_apply_mass_c(sys%ptr, y, consistent, v, empty_dbl)
+      return
+    end if
     st = mfree_system_apply_mass_c(sys%ptr, y, consistent, v, Mv)
   end function mfree_system_apply_mass
 
@@ -4168,7 +4218,9 @@ contains
   end function mfree_system_create_elastodynamic_ranks
 
   !> Typed wrapper of mfree_system_create_fluid_ranks (mfree.h): global_ids holds the
-  !> n_owned + n_ghost ids (checked); exchange and allgather as for
+  !> n_owned + n_ghost ids (checked: a shorter one is passed as n_ghost = -1 and no ids,
+  !> which every rank refuses alike with MFREE_ERR_ARG, no system made; this rank's
+  !> message then names global_ids); exchange and allgather as for
   !> mfree_system_create_elastodynamic_ranks; module mfree_mpi's mfree_halo_create_fluid
   !> passes libmfree_mpi's own.
   integer(c_int) function mfree_system_create_fluid_ranks(ctx, dim, n_owned, n_ghost, global_ids, &
@@ -4180,11 +4232,16 @@ contains
     type(c_funptr), intent(in) :: exchange, allgather
     type(c_ptr), intent(in) :: user
     type(mfree_system), intent(out) :: sys
+    integer(c_int64_t) :: none(1)
+    none = 0
     if (n_owned >= 0 .and. n_ghost >= 0 .and. &
         size(global_ids, kind=c_int64_t) < int(n_owned, c_int64_t) + int(n_ghost, c_int64_t)) then
-      st = wrapper_error(ctx%ptr, MFREE_ERR_ARG, 'mfree_system_create_fluid_ranks: global_ids holds ' // &
-                         int_str(size(global_ids, kind=c_int64_t)) // ' values, n_owned + n_ghost = ' // &
-                         int_str(int(n_owned, c_int64_t) + int(n_ghost, c_int64_t)))
+      st = mfree_system_create_fluid_ranks_c(ctx%ptr, dim, n_owned, -1_c_int32_t, none, width, exchange, &
+                                             allgather, user, sys%ptr)
+      if (st /= MFREE_SUCCESS) &
+        st = wrapper_error(ctx%ptr, st, 'mfree_system_create_fluid_ranks: global_ids holds ' // &
+                           int_str(size(global_ids, kind=c_int64_t)) // ' values, n_owned + n_ghost = ' // &
+                           int_str(int(n_owned, c_int64_t) + int(n_ghost, c_int64_t)))
       return
     end if
     st = mfree_system_create_fluid_ranks_c(ctx%ptr, dim, n_owned, n_ghost, global_ids, width, exchange, &
@@ -4253,7 +4310,7 @@ contains
   end function mfree_system_set_load_history
 
   !> Stress at the particles (1D: sigma(n); 2D: sigma(3, n) as xx, yy, xy) at time t;
-  !> sigma contiguous and large enough (else MFREE_ERR_ARG).
+  !> sigma contiguous and large enough (else MFREE_ERR_ARG, on ranks on every rank).
   integer(c_int) function mfree_system_get_stress(sys, t, y, sigma) result(st)
     type(mfree_system), intent(in) :: sys
     real(c_double), intent(in) :: t
@@ -4262,7 +4319,10 @@ contains
     real(c_double), pointer :: ps(:)
     st = check_system_out(sys, 'mfree_system_get_stress', 'sigma', is_contiguous(sigma), &
                           size(sigma, kind=c_int64_t), -2)
-    if (st /= MFREE_SUCCESS) return
+    if (st /= MFREE_SUCCESS) then
+      if (pend_system_fault(sys, st)) st = mfree_system_get_stress_c(sys%ptr, t, y, empty_dbl)
+      return
+    end if
     ps => empty_dbl
     if (size(sigma) > 0) call c_f_pointer(c_loc(sigma), ps, [size(sigma)])
     st = mfree_system_get_stress_c(sys%ptr, t, y, ps)
@@ -4274,6 +4334,21 @@ contains
     type(mfree_context), intent(out) :: ctx
     st = mfree_system_get_context_c(sys%ptr, ctx%ptr)
   end function mfree_system_get_context
+
+  !> Typed wrapper of mfree_system_set_pending_error (mfree.h): the next collective call
+  !> on sys returns status and message (absent: the status's description) on every rank.
+  integer(c_int) function mfree_system_set_pending_error(sys, status, message) result(st)
+    type(mfree_system), intent(in) :: sys
+    integer(c_int), intent(in) :: status
+    character(len=*), intent(in), optional :: message
+    character(kind=c_char), allocatable, target :: buf(:)
+    if (.not. present(message)) then
+      st = mfree_system_set_pending_error_c(sys%ptr, status, c_null_ptr)
+      return
+    end if
+    call to_c_chars(message, buf)
+    st = mfree_system_set_pending_error_c(sys%ptr, status, c_loc(buf))
+  end function mfree_system_set_pending_error
 
   !> Spatial dimension and number of particles of a system (each optional).
   integer(c_int) function mfree_system_get_dimension(sys, dim, n) result(st)

@@ -1,3 +1,5 @@
+#include <cstring>
+#include <string>
 #include <vector>
 
 #include "core/systems/elastodynamics.hpp"
@@ -11,6 +13,9 @@ struct mfree_system {
   mfree_assembler_t *as = nullptr;       // retained by elastodynamic systems
   mfree_assembler_t *mass_as = nullptr;  // retained by Galerkin elastodynamic systems
   std::unique_ptr<mfree::System> sys;
+  // The fault the host made pending (mfree_system_set_pending_error): the next call that
+  // is collective on ranks returns it
+  mfree::Report pending;
   mfree::System &core() { return *sys; }
   const mfree::System &core() const { return *sys; }
 };
@@ -32,14 +37,19 @@ const T &kind(const mfree::System &s, const char *what) {
 }
 
 // The arguments of a call that is collective for a system on ranks. A fault found here
-// (a NULL array or output) is thrown at once for a system in one process, as by any
-// call; on ranks the call goes on with stand-in buffers and the fault pending on the
+// (a NULL array or output), or one the host made pending on the system before the call
+// (mfree_system_set_pending_error), is thrown at once for a system in one process, as by
+// any call; on ranks the call goes on with stand-in buffers and the fault pending on the
 // system's collective operations, whose first agreement returns it on every rank, so
 // that no rank waits in a collective for one that returned. A fault that no agreement
 // took (the operation is local on ranks) is thrown when the call ends.
 class CollectiveArgs {
  public:
-  explicit CollectiveArgs(const mfree::System &s) : coll_(s.collective()) {}
+  explicit CollectiveArgs(mfree_system_t *h) : coll_(h->core().collective()) {
+    mfree::Report host;
+    std::swap(host, h->pending);  // (taken: reported once)
+    require(host.ok(), host.status, host.message.c_str());
+  }
   explicit CollectiveArgs(const mfree::Collective *coll) : coll_(coll) {}
   CollectiveArgs(const CollectiveArgs &) = delete;
   CollectiveArgs &operator=(const CollectiveArgs &) = delete;
@@ -54,10 +64,11 @@ class CollectiveArgs {
     coll_->set_pending(fault_);
   }
   bool faulty() const { return !fault_.ok(); }
-  // p, or after a fault, when p is NULL, a stand-in of n values.
+  // p, or after a fault a stand-in of n values (the faulty rank reads and writes none of
+  // the host's arrays).
   template <class T>
   T *stand_in(T *p, int64_t n) {
-    if (p || !faulty()) return p;
+    if (!faulty()) return p;
     stand_ins_.emplace_back(static_cast<size_t>(n > 0 ? n : 0) + 1, 0.0);
     return stand_ins_.back().data();
   }
@@ -79,7 +90,7 @@ class CollectiveArgs {
 template <class Fill>
 mfree_status_t fill_matrix(mfree_system_t *s, const char *fn, const double *y, mfree_matrix_t **M, Fill &&fill) {
   return mfree::with_handle(s, fn, [&](mfree::System &f) {
-    CollectiveArgs args(f);
+    CollectiveArgs args(s);
     args.require(y || f.neq() == 0, MFREE_ERR_NULL, "y is NULL");
     args.require(M, MFREE_ERR_NULL, "output pointer is NULL");
     y = args.stand_in(y, f.neq());
@@ -245,7 +256,7 @@ mfree_status_t mfree_system_get_size(const mfree_system_t *sys, int32_t *neq) {
 
 mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y, double *ydot) {
   return mfree::with_handle(sys, "mfree_system_rhs", [&](mfree::System &f) {
-    CollectiveArgs args(f);
+    CollectiveArgs args(sys);
     args.require((y && ydot) || f.neq() == 0, MFREE_ERR_NULL, "y or ydot is NULL");
     const mfree::Report rep = f.rhs(t, args.stand_in(y, f.neq()), args.stand_in(ydot, f.neq()));
     return args.done(mfree::finish(sys->ctx, "mfree_system_rhs", rep));
@@ -270,11 +281,11 @@ mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys, const do
 mfree_status_t mfree_system_apply_mass(mfree_system_t *sys, const double *y, int32_t consistent, const double *v,
                                        double *Mv) {
   return mfree::with_handle(sys, "mfree_system_apply_mass", [&](mfree::System &f) {
-    const auto *fl = dynamic_cast<const mfree::FluidSystem *>(&f);
-    // (on ranks the system agrees on its arguments: a rank that returned here alone
-    // would leave the others waiting in its exchanges)
-    MFREE_REQUIRE((y && v && Mv) || f.neq() == 0 || (fl && fl->on_ranks()), MFREE_ERR_NULL, "y, v or Mv is NULL");
-    return mfree::finish(sys->ctx, "mfree_system_apply_mass", f.apply_mass(y, consistent != 0, v, Mv));
+    CollectiveArgs args(sys);
+    args.require((y && v && Mv) || f.neq() == 0, MFREE_ERR_NULL, "y, v or Mv is NULL");
+    const mfree::Report rep = f.apply_mass(args.stand_in(y, f.neq()), consistent != 0, args.stand_in(v, f.neq()),
+                                           args.stand_in(Mv, f.neq()));
+    return args.done(mfree::finish(sys->ctx, "mfree_system_apply_mass", rep));
   });
 }
 
@@ -289,8 +300,8 @@ mfree_status_t mfree_system_get_pressure(const mfree_system_t *sys, const double
 
 mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, double *vhat) {
   return mfree::with_handle(sys, "mfree_system_get_velocity", [&](mfree::System &base) {
+    CollectiveArgs args(sys);
     auto &f = kind<mfree::FluidSystem>(base, "interpolated velocity (not a fluid)");
-    CollectiveArgs args(f);
     args.require((y && vhat) || f.neq() == 0, MFREE_ERR_NULL, "y or vhat is NULL");
     const mfree::Report rep =
         f.velocity(args.stand_in(y, f.neq()), args.stand_in(vhat, static_cast<int64_t>(f.dim()) * f.size()));
@@ -301,12 +312,13 @@ mfree_status_t mfree_system_get_velocity(mfree_system_t *sys, const double *y, d
 mfree_status_t mfree_system_get_wall_force(mfree_system_t *sys, const double *y, double *total, int32_t nwall,
                                           double *per_wall) {
   return mfree::with_handle(sys, "mfree_system_get_wall_force", [&](mfree::System &base) {
+    CollectiveArgs args(sys);
     auto &f = kind<mfree::FluidSystem>(base, "wall force (not a fluid)");
-    CollectiveArgs args(f);
     args.require(total || per_wall, MFREE_ERR_NULL, "total and per_wall are both NULL");
     args.require(y || f.neq() == 0, MFREE_ERR_NULL, "y is NULL");
     const mfree::Report rep =
-        f.wall_force(args.stand_in(y, f.neq()), args.stand_in(total, f.dim()), nwall, per_wall);
+        f.wall_force(args.stand_in(y, f.neq()), args.stand_in(total, f.dim()), nwall,
+                     args.stand_in(per_wall, static_cast<int64_t>(f.dim()) * nwall));
     return args.done(mfree::finish(sys->ctx, "mfree_system_get_wall_force", rep));
   });
 }
@@ -317,7 +329,7 @@ mfree_status_t mfree_system_integrate(mfree_system_t *sys, mfree_integrator_t sc
   // steps taken is written on every return, also when integrate throws part-way
   int64_t steps = 0;
   const mfree_status_t status = mfree::with_handle(sys, "mfree_system_integrate", [&](mfree::System &f) {
-    CollectiveArgs args(f);
+    CollectiveArgs args(sys);
     args.require(t && (y || f.neq() == 0), MFREE_ERR_NULL, "y or t is NULL");
     const mfree::Report rep = f.integrate(scheme, args.stand_in(y, f.neq()), *args.stand_in(t, 1), t_end, cfl,
                                           dt_max, progress, user, steps);
@@ -425,11 +437,11 @@ mfree_status_t mfree_system_set_load_history(mfree_system_t *sys, mfree_history_
 
 mfree_status_t mfree_system_get_stress(mfree_system_t *sys, double t, const double *y, double *sigma) {
   return mfree::with_handle(sys, "mfree_system_get_stress", [&](mfree::System &base) {
+    CollectiveArgs args(sys);
     const auto &e = kind<mfree::ElasticSystem>(base, "stress output (not elastodynamic)");
     MFREE_REQUIRE(!e.galerkin(), MFREE_ERR_UNSUPPORTED,
                   "no stress output for Galerkin systems: apply the trial approximant's gradient "
                   "(mfree_approximant_apply, MFREE_OP_GRADIENT) to the displacements");
-    CollectiveArgs args(e);
     args.require((y && sigma) || e.neq() == 0, MFREE_ERR_NULL, "y or sigma is NULL");
     e.stress(t, args.stand_in(y, e.neq()),
              args.stand_in(sigma, static_cast<int64_t>(e.stress_components()) * e.num_particles()));
@@ -443,7 +455,8 @@ mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, int32_t *di
     int32_t d = 0, np = 0;
     if (const auto *f = dynamic_cast<const mfree::FluidSystem *>(&base)) {
       d = f->dim();
-      np = f->size();
+      // (on ranks the outputs' particles are the owned ones, neq = (2 dim + 1) n_owned)
+      np = f->on_ranks() ? f->neq() / (2 * d + 1) : f->size();
     } else {
       const auto &e = kind<mfree::ElasticSystem>(base, "particles");
       d = e.dim();
@@ -451,6 +464,24 @@ mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, int32_t *di
     }
     if (dim) *dim = d;
     if (n) *n = np;
+    return MFREE_SUCCESS;
+  });
+}
+
+mfree_status_t mfree_system_set_pending_error(mfree_system_t *sys, mfree_status_t status, const char *message) {
+  return mfree::with_handle(sys, "mfree_system_set_pending_error", [&](mfree::System &) {
+    MFREE_REQUIRE(status <= MFREE_SUCCESS && std::strcmp(mfree_status_string(status), "unknown status") != 0,
+                  MFREE_ERR_ARG,
+                  "status " + std::to_string(static_cast<int>(status)) +
+                      " is not an error status (a negative mfree_status_t, or MFREE_SUCCESS to clear)");
+    mfree::Report fault;
+    if (status != MFREE_SUCCESS) {
+      // (the caller's "mfree_...: " prefix dropped: the collective call names itself)
+      const char *text = message ? message : mfree_status_string(status);
+      const char *colon = std::strstr(text, ": ");
+      fault.fail(status, colon && std::strncmp(text, "mfree_", 6) == 0 ? colon + 2 : text);
+    }
+    sys->pending = fault;
     return MFREE_SUCCESS;
   });
 }
@@ -493,9 +524,10 @@ mfree_status_t mfree_system_set_halo_rebuild(mfree_system_t *sys, mfree_halo_reb
 mfree_status_t mfree_system_move_particles(mfree_system_t *sys, int32_t n_new, mfree_particles_move_fn move,
                                            void *move_user, double *y, int64_t capacity) {
   return mfree::with_handle(sys, "mfree_system_move_particles", [&](mfree::System &base) {
+    CollectiveArgs args(sys);
     kind<mfree::FluidRanks>(base, "particle move (not a fluid on ranks)")
-        .move_particles(n_new, move, move_user, y, capacity);
-    return MFREE_SUCCESS;
+        .move_particles(n_new, move, move_user, args.stand_in(y, 0), capacity);
+    return args.done(MFREE_SUCCESS);
   });
 }
 

@@ -1286,6 +1286,20 @@ static void rows_system(void) {
       ROW(MFREE_ERR_NULL, mfree_system_apply_mass(fr, ys, 1, NULL, yd));
       ROW(MFREE_ERR_NULL, mfree_system_apply_mass(fr, ys, 0, ys, NULL));
       ROW(MFREE_SUCCESS, mfree_system_apply_mass(fr, ys, 1, ys, yd));
+      /* a fault made pending (as the Fortran wrappers' size checks do): the next collective call
+         returns it, its arrays unread (NULL here), once */
+      ROW0(MFREE_ERR_NULL, mfree_system_set_pending_error(NULL, MFREE_ERR_ARG, "x"));
+      ROW(MFREE_ERR_ARG, mfree_system_set_pending_error(fr, MFREE_FAIL_NONFINITE, "x"));
+      ROW(MFREE_ERR_ARG, mfree_system_set_pending_error(fr, (mfree_status_t)-50, "x"));
+      ROW(MFREE_SUCCESS, mfree_system_set_pending_error(fr, MFREE_ERR_ARG, "mfree_host: ydot holds 3 elements"));
+      ROW(MFREE_ERR_ARG, mfree_system_rhs(fr, 0.0, NULL, NULL));
+      ROW(MFREE_SUCCESS, mfree_system_rhs(fr, 0.0, ys, yd));
+      ROW(MFREE_SUCCESS, mfree_system_set_pending_error(fr, MFREE_ERR_MISMATCH, NULL));
+      ROW(MFREE_ERR_MISMATCH, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, NULL, NULL, 1e-3, 0.2, 0, NULL,
+                                                     NULL, &steps));
+      ROW(MFREE_SUCCESS, mfree_system_set_pending_error(fr, MFREE_ERR_ARG, NULL));
+      ROW(MFREE_SUCCESS, mfree_system_set_pending_error(fr, MFREE_SUCCESS, NULL));
+      ROW(MFREE_SUCCESS, mfree_system_rhs(fr, 0.0, ys, yd));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, (mfree_integrator_t)0, ys, &tf, 1e-3, 0.2, 0, NULL, NULL, &steps));
       ROW(MFREE_ERR_ARG, mfree_system_integrate(fr, MFREE_INTEGRATOR_LEAPFROG, ys, &tf, NAN, 0.2, 0, NULL, NULL, &steps));
       ys[7] = NAN;

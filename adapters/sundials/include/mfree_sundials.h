@@ -16,7 +16,13 @@
  * of N = mfree_system_get_size values through N_VGetArrayPointer (NVECTOR_SERIAL,
  * NVECTOR_OPENMP, NVECTOR_PTHREADS or a custom vector with nvgetarraypointer and
  * nvgetlength); values are read and written in place, never copied, except the state
- * kept for the mass function.
+ * kept for the mass function. A vector that fails these checks (NULL, another length, no
+ * array) on one rank of a system on ranks does not leave the other ranks waiting: the
+ * fault is made pending on the system (mfree_system_set_pending_error) and the callback
+ * still makes its system call, which returns the fault's status on every rank with this
+ * rank's message ("rank R: y has length ..."), nothing read or written; except a lumped
+ * mass product (mfree_sundials_mass_times) at a point whose mass is kept, which makes no
+ * system call: its fault is this rank's alone.
  *
  * Callback returns (int): 0 on success; a positive mfree status as it is (SUNDIALS'
  * "recoverable": IDA, CVODE and ARKStep's implicit stages retry with a smaller step;

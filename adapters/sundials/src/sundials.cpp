@@ -104,6 +104,41 @@ mfree_status_t vector_data(mfree_sundials_t *ad, const char *fn, const char *nam
   return MFREE_SUCCESS;
 }
 
+// A callback's vectors: their data, or this rank's first fault among them (vector_data's)
+// made pending on the system (mfree_system_set_pending_error), so that the system call the
+// callback still makes, on no data, returns it on every rank of a system on ranks instead
+// of leaving the others waiting in that call's collective (in one process the call
+// returns it at once).
+struct Vectors {
+  mfree_sundials_t *ad;
+  const char *fn;
+  mfree_status_t fault = MFREE_SUCCESS;
+  bool pending = false;
+
+  // *data: v's data, NULL after a fault.
+  void get(const char *name, N_Vector v, double **data) {
+    *data = nullptr;
+    if (fault == MFREE_SUCCESS) fault = vector_data(ad, fn, name, v, data);
+  }
+  bool faulty() const { return fault != MFREE_SUCCESS; }
+  // MFREE_SUCCESS when the callback goes on to its system calls (the fault, if any,
+  // pending); else the fault, returned at once (it cannot be made pending).
+  mfree_status_t go() {
+    if (!faulty()) return MFREE_SUCCESS;
+    char msg[512] = {0};
+    mfree_context_get_last_error(ad->ctx, nullptr, msg, sizeof msg);
+    pending = mfree_system_set_pending_error(ad->sys, fault, msg) == MFREE_SUCCESS;
+    return pending ? MFREE_SUCCESS : fault;
+  }
+  // The callback's outcome st; after a fault that no system call took (the callback made
+  // none: a kept lumped mass), the fault, cleared from the system.
+  mfree_status_t finish(mfree_status_t st) {
+    if (!pending) return st;
+    mfree_system_set_pending_error(ad->sys, MFREE_SUCCESS, nullptr);
+    return st != MFREE_SUCCESS ? st : fault;
+  }
+};
+
 // Remember y (and, from a right-hand side, its time and rate y') for the mass function.
 void keep_state(mfree_sundials_t *ad, const double *y, const double *rate, double t) {
   ad->state.assign(y, y + ad->neq);
@@ -309,11 +344,13 @@ mfree_status_t mfree_sundials_create_mass_matrix(mfree_sundials_t *ad, SUNContex
     *M = nullptr;
     if (!sunctx) return record(ad->ctx, MFREE_ERR_NULL, fn, "SUNContext is NULL");
     double *py = nullptr;
-    mfree_status_t st = vector_data(ad, fn, "y", y, &py);
+    Vectors vs{ad, fn};
+    vs.get("y", y, &py);
+    mfree_status_t st = vs.go();
     if (st != MFREE_SUCCESS) return st;
     ad->mass_gen = -1;
     st = mfree_system_assemble_mass(ad->sys, py, ad->consistent ? 1 : 0, &ad->mass);
-    if (st != MFREE_SUCCESS) return st;
+    if (st != MFREE_SUCCESS || vs.faulty()) return vs.finish(st);
     int32_t nr = 0, nc = 0;
     int64_t nnz = 0;
     st = mfree_matrix_get_size(ad->mass, &nr, &nc, &nnz);
@@ -354,12 +391,14 @@ int mfree_sundials_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void *user_data
   return callback(ad, fn, [&]() {
     ++ad->nrhs;
     double *py = nullptr, *pd = nullptr;
-    mfree_status_t st = vector_data(ad, fn, "y", y, &py);
-    if (st == MFREE_SUCCESS) st = vector_data(ad, fn, "ydot", ydot, &pd);
+    Vectors vs{ad, fn};
+    vs.get("y", y, &py);
+    vs.get("ydot", ydot, &pd);
+    mfree_status_t st = vs.go();
     if (st != MFREE_SUCCESS) return st;
     st = mfree_system_rhs(ad->sys, t, py, pd);  // records its own message
-    if (st == MFREE_SUCCESS) keep_state(ad, py, pd, t);
-    return st;
+    if (st == MFREE_SUCCESS && !vs.faulty()) keep_state(ad, py, pd, t);
+    return vs.finish(st);
   });
 }
 
@@ -369,12 +408,14 @@ int mfree_sundials_rhs_mass_form(sunrealtype t, N_Vector y, N_Vector F, void *us
   return callback(ad, fn, [&]() {
     ++ad->nrhs;
     double *py = nullptr, *pf = nullptr;
-    mfree_status_t st = vector_data(ad, fn, "y", y, &py);
-    if (st == MFREE_SUCCESS) st = vector_data(ad, fn, "F", F, &pf);
+    Vectors vs{ad, fn};
+    vs.get("y", y, &py);
+    vs.get("F", F, &pf);
+    mfree_status_t st = vs.go();
     if (st != MFREE_SUCCESS) return st;
-    st = mass_form(ad, t, py, pf);
-    if (st == MFREE_SUCCESS) keep_state(ad, py, ad->work.data(), t);  // work = f(t, y)
-    return st;
+    st = mass_form(ad, t, py, pf);  // (its first call, the right-hand side, takes a fault)
+    if (st == MFREE_SUCCESS && !vs.faulty()) keep_state(ad, py, ad->work.data(), t);  // work = f(t, y)
+    return vs.finish(st);
   });
 }
 
@@ -399,20 +440,23 @@ int mfree_sundials_mass_times(N_Vector v, N_Vector Mv, sunrealtype t, void *mtim
   return callback(ad, fn, [&]() {
     ++ad->nmass;
     double *pv = nullptr, *pm = nullptr;
-    mfree_status_t st = vector_data(ad, fn, "v", v, &pv);
-    if (st == MFREE_SUCCESS) st = vector_data(ad, fn, "Mv", Mv, &pm);
+    Vectors vs{ad, fn};
+    vs.get("v", v, &pv);
+    vs.get("Mv", Mv, &pm);
+    mfree_status_t st = vs.go();
     if (st != MFREE_SUCCESS) return st;
     if (ad->consistent) {
       // the system's own product: on ranks the consistent mass couples owned particles
       // to ghosts, which only the system exchanges; it keeps the mass of one state
       const double *at = nullptr;
       st = mass_state(ad, fn, t, &at);
-      if (st != MFREE_SUCCESS) return st;
-      return mfree_system_apply_mass(ad->sys, at, 1, pv, pm);
+      if (st == MFREE_SUCCESS) st = mfree_system_apply_mass(ad->sys, at, 1, pv, pm);
+      return vs.finish(st);
     }
+    // (a kept lumped mass makes no system call: a fault then stays on this rank)
     st = mass_at(ad, fn, t);
-    if (st != MFREE_SUCCESS) return st;
-    return mfree_matrix_apply(ad->mass, pv, pm);
+    if (st == MFREE_SUCCESS && !vs.faulty()) st = mfree_matrix_apply(ad->mass, pv, pm);
+    return vs.finish(st);
   });
 }
 
@@ -423,19 +467,21 @@ int mfree_sundials_residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r,
   return callback(ad, fn, [&]() {
     ++ad->nres;
     double *py = nullptr, *pp = nullptr, *pr = nullptr;
-    mfree_status_t st = vector_data(ad, fn, "y", y, &py);
-    if (st == MFREE_SUCCESS) st = vector_data(ad, fn, "yp", yp, &pp);
-    if (st == MFREE_SUCCESS) st = vector_data(ad, fn, "r", r, &pr);
+    Vectors vs{ad, fn};
+    vs.get("y", y, &py);
+    vs.get("yp", yp, &pp);
+    vs.get("r", r, &pr);
+    mfree_status_t st = vs.go();
     if (st != MFREE_SUCCESS) return st;
     if (!ad->consistent) {
       // M_L^{-1} (M_L y' - M_L f) = y' - f: the same roots, no mass assembly
       st = mfree_system_rhs(ad->sys, t, py, pr);
-      if (st != MFREE_SUCCESS) return st;
+      if (st != MFREE_SUCCESS || vs.faulty()) return vs.finish(st);
       for (int32_t q = 0; q < ad->neq; ++q) pr[q] = pp[q] - pr[q];
     } else {
       ad->force.resize(static_cast<size_t>(ad->neq));
       st = mass_form(ad, t, py, ad->force.data());
-      if (st != MFREE_SUCCESS) return st;
+      if (st != MFREE_SUCCESS || vs.faulty()) return vs.finish(st);
       ad->mass_gen = -1;
       st = mfree_system_assemble_mass(ad->sys, py, 1, &ad->mass);
       if (st != MFREE_SUCCESS) return st;

@@ -47,16 +47,18 @@ void FluidRanks::consistent_rows(SparseMatrix &M) const {
   std::copy(vals.begin(), vals.end(), M.values_mut().begin());
 }
 
-// Every rank agrees on the arguments and on whether its kept mass is M(y) (a rank that
-// assembled alone would wait in the exchange of the state), assembles when any rank
-// must, then applies: the lumped mass locally, the consistent mass to v's velocities
-// with the ghosts' from their owners (one exchange of dim values per item).
+// Every rank agrees on the outcome of its arguments (a fault pending on the collective
+// operations: the C API's) and on whether its kept mass is M(y) (a rank that assembled
+// alone would wait in the exchange of the state), assembles when any rank must, then
+// applies: the lumped mass locally, the consistent mass to v's velocities with the
+// ghosts' from their owners (one exchange of dim values per item).
 Report FluidRanks::apply_mass(const double *y, bool consistent, const double *v, double *Mv) {
   check_usable();
-  const bool null = (!y || !v || !Mv) && n_own_ > 0;
-  double same = !null && kept_mass_.holds(y, neq(), consistent, options_gen_) ? 1.0 : 0.0;
-  Report mine;
-  if (null) mine.fail(MFREE_ERR_NULL, "y, v or Mv is NULL");
+  double same = 0.0;
+  const Report mine = coll_.local([&] {
+    same = kept_mass_.holds(y, neq(), consistent, options_gen_) ? 1.0 : 0.0;
+    return Report();
+  });
   Report agreed = agree_min(mine, &same, 1);
   if (!agreed.ok()) return agreed;
   if (same == 0.0) {
