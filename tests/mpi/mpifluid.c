@@ -1,5 +1,7 @@
 #include "mpifluid.h"
 
+#include "mpitest.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,6 +60,22 @@ mfree_status_t damb_configure(const damb_t *b, mfree_system_t *sys) {
   if (st == MFREE_SUCCESS) st = mfree_system_set_gravity(sys, g);
   if (st == MFREE_SUCCESS) st = mfree_system_set_walls(sys, b->nwall, b->wx, b->wn, 0.7 * b->h, 10.0);
   return st;
+}
+
+void mpifluid_slabs(const damb_t *b, int size, int *owner) {
+  for (int i = 0; i < b->n; ++i) {
+    const int p = (int)(b->y[2 * i] / b->a * size);
+    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
+  }
+}
+
+mfree_context_t *mpifluid_start(int *argc, char ***argv, int *rank, int *size, damb_t *b, int nx, int nz,
+                                int **owner) {
+  mfree_context_t *ctx = mpitest_start(argc, argv, rank, size);
+  damb_make(b, nx, nz);
+  *owner = malloc(((size_t)b->n + 1) * sizeof **owner);
+  mpifluid_slabs(b, *size, *owner);
+  return ctx;
 }
 
 mfree_status_t rankfluid_make(rankfluid_t *r, mfree_context_t *ctx, MPI_Comm comm, const damb_t *b,

@@ -27,6 +27,15 @@ void damb_free(damb_t *b);
  * the walls (003 Sect. 6.2). */
 mfree_status_t damb_configure(const damb_t *b, mfree_system_t *sys);
 
+/* owner[i] = the rank of particle i by size slabs of the water block along x (the
+ * decomposition most fluid tests on ranks use). */
+void mpifluid_slabs(const damb_t *b, int size, int *owner);
+/* The start of those tests: mpitest_start (its context returned, this rank and the number
+ * of ranks of MPI_COMM_WORLD), the dam break of nx x nz particles in *b (damb_make) and
+ * *owner, b->n values by mpifluid_slabs over the ranks (to be freed). */
+mfree_context_t *mpifluid_start(int *argc, char ***argv, int *rank, int *size, damb_t *b, int nx, int nz,
+                                int **owner);
+
 /* The dam break on the ranks of comm: owner[i] is the rank owning particle i. The owned
  * items are listed in ascending id order, or descending with reverse (the local order
  * must not matter). */

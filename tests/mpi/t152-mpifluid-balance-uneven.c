@@ -19,15 +19,10 @@ static const int64_t kWindow = 100;
 
 int main(int argc, char **argv) {
   int rank = 0, size = 1;
-  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
   damb_t b;
-  damb_make(&b, NX, NZ);
+  int *owner = NULL;
+  mfree_context_t *ctx = mpifluid_start(&argc, &argv, &rank, &size, &b, NX, NZ, &owner);
   const int n = b.n;
-  int *owner = calloc((size_t)n, sizeof *owner);
-  for (int i = 0; i < n; ++i) {
-    int p = (int)(b.y[2 * i] / b.a * size);
-    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
-  }
   const double width = 4.0 * b.h + 2.0 * b.d;
   rankfluid_t r;
   mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);

@@ -66,18 +66,13 @@ static void failed(mfree_context_t *ctx, int ret, int bad, const char *name, int
 }
 
 int main(int argc, char **argv) {
-  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
+  damb_t b;
+  int *owner = NULL;
+  mfree_context_t *ctx = mpifluid_start(&argc, &argv, &rank, &size, &b, 12, 24, &owner);
   MPI_Comm world = MPI_COMM_WORLD;
   SUNContext sunctx = NULL;
   SUNContext_Create(&world, &sunctx);
-  damb_t b;
-  damb_make(&b, 12, 24);
   const double width = 4.0 * b.h + 2.0 * b.d;
-  int *owner = malloc((size_t)b.n * sizeof *owner);
-  for (int i = 0; i < b.n; ++i) {
-    int p = (int)(b.y[2 * i] / b.a * size);
-    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
-  }
   /* s: sees the faults (through ad); twin: the good calls only (through adt) */
   rankfluid_t s, twin;
   CHECK(rankfluid_make(&s, ctx, MPI_COMM_WORLD, &b, owner, width, 0) == MFREE_SUCCESS, "system");

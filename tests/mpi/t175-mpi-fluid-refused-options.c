@@ -15,15 +15,9 @@
 
 int main(int argc, char **argv) {
   int rank = 0, size = 1;
-  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
   damb_t b;
-  damb_make(&b, 12, 24);
-  const int n = b.n;
-  int *owner = malloc((size_t)n * sizeof *owner);
-  for (int i = 0; i < n; ++i) {
-    int p = (int)(b.y[2 * i] / b.a * size);
-    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
-  }
+  int *owner = NULL;
+  mfree_context_t *ctx = mpifluid_start(&argc, &argv, &rank, &size, &b, 12, 24, &owner);
   const double width = 4.0 * b.h + 2.0 * b.d;
   rankfluid_t r, fresh;
   mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);

@@ -138,10 +138,7 @@ int main(int argc, char **argv) {
   }
 
   /* on the ranks */
-  for (int i = 0; i < n; ++i) {
-    int p = (int)(b.y[2 * i] / b.a * size);
-    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
-  }
+  mpifluid_slabs(&b, size, owner);
   const double width = 2.0 * radii * b.h + 0.25 * b.d;
   rankfluid_t r;
   counted_t cw;
