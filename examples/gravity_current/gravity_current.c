@@ -39,9 +39,10 @@
  *
  * The paper's set-up read with its other experiments: --light 0.06 (Fig. 10's two labels
  * as two compartments 0.06 m long) and --mu 0.5 (the viscosity of Sects. 7.1, 7.2 and
- * 7.4 a), with --fit-to 0.2 (the head then still more than 0.4 D from the end wall) and
- * --lumped-step 1: 0.233, 0.236, 0.233, 0.231, 0.234 m/s at nz = 26, 34, 41, 50, 58
- * (1,352 to 6,728 particles), 7 % above eq 126 (with mu = 0.01 0.27-0.30, still rising).
+ * 7.4 a), with --fit-from 0.05 --fit-to 0.2 (the head then still more than 0.4 D from the
+ * end wall) and --lumped-step 1: 0.223, 0.223, 0.222, 0.221, 0.219, 0.219 m/s at nz = 26,
+ * 34, 41, 50, 58, 100 (1,352 to 20,000 particles), +0.9 % of eq 126 at 20,000 (over
+ * 0.1-0.2 s 0.231-0.240, the nose's unsteadiness; with mu = 0.01 0.25-0.26).
  *
  * Diagnostics (not in the paper): --heavy RHO2 (a smaller density difference, towards the
  * Boussinesq lock exchange whose inviscid current is Benjamin's), --lid 1 (a free-slip
