@@ -1858,8 +1858,9 @@ MFREE_API mfree_status_t mfree_system_get_dimension(const mfree_system_t *sys, i
 MFREE_API mfree_status_t mfree_system_rhs(mfree_system_t *sys, double t, const double *y,
                                           double *ydot);
 /** Mass matrix of the state: the identity except the velocity block, which holds the
- * lumped or consistent Galerkin mass: M y' = M f(t, y) (fluid on ranks: owned rows, lumped only;
- * the consistent mass's products: mfree_system_apply_mass).
+ * lumped or consistent Galerkin mass: M y' = M f(t, y) (fluid and Galerkin elastodynamics
+ * on ranks: owned rows, lumped only, MFREE_ERR_UNSUPPORTED for the consistent mass, whose
+ * products are mfree_system_apply_mass's).
  * @param[in]     sys         the system
  * @param[in]     y           state
  * @param[in]     consistent  0 lumped, nonzero consistent
@@ -1885,7 +1886,11 @@ MFREE_API mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys
  * same y (bit for bit), kind and options, so that the products of one solve assemble it
  * once. Fluid on ranks (collective, every rank alike): the rank's rows, bitwise one
  * rank's; the consistent mass, whose rows couple owned particles to ghosts, reads v's
- * velocities at the ghosts through one exchange (docs/fluid-ranks.md).
+ * velocities at the ghosts through one exchange (docs/fluid-ranks.md). Galerkin
+ * elastodynamics on ranks (collective): the lumped mass locally, the consistent mass of
+ * `density` on the stiffness's points (built at the first product) with v's velocities
+ * exchanged at the ghosts, bitwise the one-process system's with an MFREE_FORM_MASS
+ * assembler on the same points (docs/mpi.md).
  * @param[in]  sys         the system
  * @param[in]  y           state (neq values)
  * @param[in]  consistent  0 lumped, nonzero consistent
@@ -1893,8 +1898,7 @@ MFREE_API mfree_status_t mfree_system_assemble_interpolation(mfree_system_t *sys
  * @param[out] Mv          neq values (unspecified after a failure)
  * @return MFREE_SUCCESS; MFREE_ERR_NULL for a NULL array (on ranks: on every rank when
  *         one rank passes one); a positive status naming the particle for a non-finite
- *         or out-of-range state; MFREE_ERR_UNSUPPORTED as mfree_system_assemble_mass
- *         (elastodynamics on ranks has no consistent mass) */
+ *         or out-of-range state */
 MFREE_API mfree_status_t mfree_system_apply_mass(mfree_system_t *sys, const double *y,
                                                  int32_t consistent, const double *v,
                                                  double *Mv);
@@ -2177,8 +2181,10 @@ typedef mfree_status_t (*mfree_allgather_fn)(void *user, const double *in, int64
  * support radii, and its quadrature points (mfree_assembler_set_quadrature_points) and
  * boundary points are those within one support radius of the owned particles, in the same
  * global order on every rank (docs/mpi.md). MFREE_ERR_UNSUPPORTED on ranks: nodal
- * quadrature, an FE layer, consistent integration, Lagrange multipliers; no consistent
- * mass (its inverse couples every unknown at each evaluation).
+ * quadrature, an FE layer, consistent integration, Lagrange multipliers. The right-hand
+ * side divides by the lumped mass (a consistent mass's inverse would couple every unknown
+ * at each evaluation); the consistent mass is applied by mfree_system_apply_mass (for
+ * ARKStep's mass form with a Krylov mass solver), not handed out as a matrix.
  * libmfree_mpi's mfree_halo_create_elastodynamic supplies the callbacks from a halo plan.
  * @param[in]  ctx        context (kept alive); NULL: MFREE_ERR_NULL on this rank alone
  * @param[in]  as         a set-up collocation or Galerkin stiffness assembler over owned

@@ -245,6 +245,10 @@ void mpibar_collect(const mpibar_t *b, const double *vals, int ncomp, double *ou
 int serialbar_make(serialbar_t *b, mfree_context_t *ctx, int n) { return serialbar_make_kind(b, ctx, n, BAR_COLLOCATION); }
 
 int serialbar_make_kind(serialbar_t *b, mfree_context_t *ctx, int n, int kind) {
+  return serialbar_make_mass(b, ctx, n, kind, MFREE_FORM_MASS_LUMPED);
+}
+
+int serialbar_make_mass(serialbar_t *b, mfree_context_t *ctx, int n, int kind, mfree_form_t mass_form) {
   memset(b, 0, sizeof *b);
   const double dx = BAR_L / (n - 1), h = 1.5 * dx, vol = dx;
   b->x = malloc(sizeof(double) * (size_t)n);
@@ -261,11 +265,11 @@ int serialbar_make_kind(serialbar_t *b, mfree_context_t *ctx, int n, int kind) {
     st |= bar_operator(ctx, b->ps, n, id, n, &b->a, &b->as);
   } else {
     st |= bar_galerkin(ctx, b->ps, n, id, n, kind, &b->a, &b->as);
-    /* the lumped mass on the same points: the gauss points of every cell */
+    /* the mass on the same points: the gauss points of every cell */
     double *qx = malloc(sizeof(double) * 2 * (size_t)n), *qw = malloc(sizeof(double) * 2 * (size_t)n);
     for (int c = 0; c < n - 1; ++c)
       for (int g = 0; g < 2; ++g) gauss_point(c, g, dx, &qx[2 * c + g], &qw[2 * c + g]);
-    st |= mfree_assembler_create(ctx, b->a, NULL, MFREE_FORM_MASS_LUMPED, &b->mass);
+    st |= mfree_assembler_create(ctx, b->a, NULL, mass_form, &b->mass);
     st |= mfree_assembler_set_coefficient(b->mass, BAR_RHO);
     if (kind != BAR_GALERKIN_NODAL)
       st |= mfree_assembler_set_quadrature_points(b->mass, 2 * (n - 1), qx, MFREE_LAYOUT_AOS, 1, qw);

@@ -60,7 +60,8 @@ double mpibar_pulse(void *user, double t);
  * out[id * ncomp + c] on every rank (n ncomp values). Collective. */
 void mpibar_collect(const mpibar_t *b, const double *vals, int ncomp, double *out);
 /* The serial system of the same bar (mfree_system_create_elastodynamic, t703's; Galerkin:
- * mfree_system_create_elastodynamic_galerkin with a lumped mass assembler). */
+ * mfree_system_create_elastodynamic_galerkin with a lumped mass assembler on the same
+ * points). */
 typedef struct {
   mfree_particles_t *ps;
   mfree_approximant_t *a;
@@ -70,6 +71,9 @@ typedef struct {
 } serialbar_t;
 int serialbar_make(serialbar_t *b, mfree_context_t *ctx, int n);
 int serialbar_make_kind(serialbar_t *b, mfree_context_t *ctx, int n, int kind);
+/* The same Galerkin bar with the mass assembler's form (MFREE_FORM_MASS: the consistent
+ * mass, the one-process equal of the consistent mass's products on ranks). */
+int serialbar_make_mass(serialbar_t *b, mfree_context_t *ctx, int n, int kind, mfree_form_t mass_form);
 void serialbar_free(serialbar_t *b);
 
 #endif

@@ -303,7 +303,10 @@ Report ElasticSystem::rhs(double t, const double *y, double *ydot) {
 
 Report ElasticSystem::mass(const double *y, bool consistent, SparseMatrix &M) {
   (void)y;
-  (void)consistent;
+  if (ranks_ && galerkin_ && consistent)
+    throw Error(MFREE_ERR_UNSUPPORTED, "no consistent mass matrix for elastodynamics on ranks (its rows couple owned "
+                                       "particles to ghosts): use its products (mfree_system_apply_mass) or the "
+                                       "lumped mass");
   // y' = f is explicit for collocation: the identity. Galerkin: the velocity block holds
   // the mass the right-hand side divides by (lumped or consistent, as assembled) on the
   // free unknowns, the identity on the constrained ones. Constant: built once.

@@ -4,7 +4,8 @@
 // Galerkin: M u'' = g(t) f - K u with K and M from two assemblers (any approximant).
 // Both on ranks (elastodynamics_ranks.cpp): owned particles plus ghosts, the ghosts'
 // displacements exchanged and the boundary unknowns solved in global-id order on every
-// rank at each evaluation; Galerkin there with the lumped mass.
+// rank at each evaluation; Galerkin there with the lumped mass, and the consistent mass's
+// products (apply_mass: owned rows, v read at the ghosts through the exchange).
 #pragma once
 
 #include <Eigen/SparseCholesky>
@@ -41,6 +42,9 @@ class ElasticSystem : public System {
   int32_t neq() const override { return 2 * nd_; }
   Report rhs(double t, const double *y, double *ydot) override;
   Report mass(const double *y, bool consistent, SparseMatrix &M) override;
+  // On ranks (Galerkin): the consistent mass's product reads v's velocities at the
+  // ghosts (collective); elsewhere the mass of mass() applied.
+  Report apply_mass(const double *y, bool consistent, const double *v, double *Mv) override;
   Report integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                    mfree_progress_fn progress, void *user, int64_t &nsteps) override;
 
@@ -80,6 +84,9 @@ class ElasticSystem : public System {
   // An agreed outcome: thrown when it is an error (alike on every rank), else returned.
   static Report settle(const Report &agreed);
   void init_galerkin_mass(const Assembler *mass);
+  // On ranks: cmass_ = the consistent mass's owned rows (state layout over the local
+  // unknowns' displacements then velocities), built at the first product
+  void init_consistent_ranks();
   void enforce_boundary(double t, double *u) const;
   void accel(double t, const double *u, double *a) const;
   Report check(const double *y, const std::string &when) const;
@@ -119,6 +126,9 @@ class ElasticSystem : public System {
   std::vector<int64_t> cnt_, seg_;
   mutable std::vector<double> send_, gathered_;
   mutable Eigen::VectorXd rbe_;
+  SparseMatrix cmass_;
+  bool cmass_done_ = false;
+  std::vector<double> cw_;  // the product's operand: owned entries and ghosts' velocities
 };
 
 }  // namespace mfree

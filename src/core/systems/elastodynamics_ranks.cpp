@@ -11,7 +11,11 @@
 // Galerkin on ranks is the same system with K, f and the lumped mass from the assembler,
 // whose owned rows are bitwise the one-rank rows when its quadrature points are the
 // host's, given in the global order (nodal quadrature is refused: its points are the
-// set's non-ghosts). The lumped mass keeps every unknown's acceleration local.
+// set's non-ghosts). The lumped mass keeps every unknown's acceleration local: the
+// right-hand side divides by it. The consistent mass is applied, never inverted (its
+// inverse would couple every unknown): ARKStep's mass form M_C y' = M_L f solves for
+// g f - K u = M_L f on its velocity rows, the equation of the one-process system with a
+// consistent mass (M_C y' = M_C f there), with the products of apply_mass.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -57,7 +61,8 @@ ElasticSystem::ElasticSystem(const Assembler *as, double density, const Collecti
   // The lumped mass (rows summed: the mass is local to each unknown) of the stiffness's
   // approximants on its quadrature points. A consistent mass couples every unknown through
   // its inverse at each evaluation, a solve over all ranks whose sums would follow the
-  // partition: it runs on one process.
+  // partition: the right-hand side divides by the lumped mass, and the consistent one is
+  // applied only (apply_mass).
   init_galerkin_mass(as->mass_on_same_points(MFREE_FORM_MASS_LUMPED, density).get());
 }
 
@@ -235,6 +240,74 @@ Report ElasticSystem::fill_state(double t, const double *u, const Report &mine) 
   for (Eigen::Index q = 0; q < ub.size(); ++q)
     if (gb_local_[q] >= 0) work_[gb_local_[q]] = ub(q);
   return agreed;
+}
+
+// The velocity rows of the one-process system's mass (mass(): column d of M_ff, i.e. the
+// entries m_JK of every J for unknown K, in the order of J) from the consistent mass on
+// the stiffness's points: an owned K's column is complete here (every quadrature point
+// in its support is the rank's, every particle whose support reaches them one of its
+// particles), and each entry sums the points in the global order, so the rows are one
+// rank's bit for bit, listed in global-id order. Columns: the local unknowns'
+// displacements (nl_), then their velocities (nl_); constrained unknowns (here or on
+// their owner: bpos_) keep identity rows and are no column of a free row.
+void ElasticSystem::init_consistent_ranks() {
+  SparseMatrix Ms;
+  as_->mass_on_same_points(MFREE_FORM_MASS, rho_)->assemble_matrix(Ms);
+  const int32_t n = as_->particles().num_owned(), np = as_->particles().size();
+  std::vector<std::vector<std::pair<int64_t, std::pair<int32_t, double>>>> col(n);
+  for (int32_t J = 0; J < np; ++J)
+    for (int64_t k = Ms.rowptr()[J]; k < Ms.rowptr()[J + 1]; ++k) {
+      const int32_t K = Ms.colidx()[k];
+      if (K < n && Ms.values()[k] != 0.0) col[K].push_back({key(J * nc_), {J, Ms.values()[k]}});
+    }
+  std::vector<int64_t> rp(static_cast<size_t>(neq()) + 1, 0);
+  std::vector<int32_t> ci;
+  std::vector<double> va;
+  for (int32_t q = 0; q < neq(); ++q) {
+    const int32_t d = q - nd_;
+    if (d >= 0 && bpos_[d] < 0) {
+      auto &c = col[d / nc_];
+      std::sort(c.begin(), c.end());
+      const int a = d % nc_;
+      for (const auto &e : c) {
+        const int32_t u = e.second.first * nc_ + a;
+        if (bpos_[u] >= 0) continue;
+        ci.push_back(nl_ + u);
+        va.push_back(e.second.second);
+      }
+    } else {
+      ci.push_back(d >= 0 ? nl_ + d : q);
+      va.push_back(1.0);
+    }
+    rp[q + 1] = static_cast<int64_t>(ci.size());
+  }
+  cmass_.set_pattern(neq(), 2 * nl_, std::move(rp), std::move(ci));
+  cmass_.values_mut() = std::move(va);
+  cmass_done_ = true;
+}
+
+Report ElasticSystem::apply_mass(const double *y, bool consistent, const double *v, double *Mv) {
+  if (!ranks_) return System::apply_mass(y, consistent, v, Mv);
+  // one outcome for the arguments and the first product's set-up (the product is
+  // collective: no rank may leave before the exchange)
+  const bool cm = consistent && galerkin_;
+  Report rep = settle(coll_.agree(coll_.local([&] {
+    if ((!y || !v || !Mv) && nd_ > 0) throw Error(MFREE_ERR_NULL, "y, v or Mv is NULL");
+    if (cm && !cmass_done_) init_consistent_ranks();
+    return Report();
+  })));
+  if (!cm) {
+    SparseMatrix M;
+    mass(y, false, M);
+    M.apply(v, Mv);
+    return rep;
+  }
+  cw_.assign(2 * static_cast<size_t>(nl_), 0.0);
+  std::copy(v, v + nd_, cw_.begin());
+  std::copy(v + nd_, v + 2 * nd_, cw_.begin() + nl_);
+  coll_.exchange(nc_, cw_.data() + nl_, nc_);
+  cmass_.apply(cw_.data(), Mv);
+  return rep;
 }
 
 }  // namespace mfree
