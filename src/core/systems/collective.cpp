@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include "core/base/exact_sum.hpp"
+
 namespace mfree {
 
 namespace {
@@ -81,6 +83,26 @@ bool Collective::take_pending(Report &fault) const {
   fault = pending_;
   pending_ = Report();
   return true;
+}
+
+void Collective::exact_totals(ExactSum *s, int n, double *out) const {
+  const int W = ExactSum::kWords;
+  const size_t rec = static_cast<size_t>(n) * W;
+  std::vector<double> mine(rec);
+  for (int k = 0; k < n; ++k) {
+    s[k].normalise();  // (words below 2^53: exact as doubles)
+    for (int w = 0; w < W; ++w) mine[static_cast<size_t>(k) * W + w] = static_cast<double>(s[k].words()[w]);
+  }
+  const std::vector<double> all = allgather(mine.data(), static_cast<int64_t>(rec));
+  std::vector<int64_t> words(W);
+  for (int k = 0; k < n; ++k) {
+    ExactSum t;
+    for (size_t p = 0; rec > 0 && p < all.size() / rec; ++p) {
+      for (int w = 0; w < W; ++w) words[w] = static_cast<int64_t>(all[p * rec + static_cast<size_t>(k) * W + w]);
+      t.add_words(words.data());
+    }
+    out[k] = t.value();
+  }
 }
 
 Report Collective::agree(const Report &mine) const {

@@ -15,6 +15,8 @@
 
 namespace mfree {
 
+class ExactSum;
+
 // The outcome of local work as a report: a rank must reach the next agreement even when
 // its own part failed.
 template <class F>
@@ -70,6 +72,11 @@ class Collective {
     if (take_pending(r)) return r;
     return guarded(f);
   }
+
+  // The totals over every rank of n exact sums (each rank's s[k], normalised here, added
+  // limb by limb): out[k] the exact total of every rank's terms, rounded once, so the
+  // same bits on every rank whatever the partition. One all-gather.
+  void exact_totals(ExactSum *s, int n, double *out) const;
 
   // Integers travel through the all-gather as the bits of a double.
   static double pack(int64_t v);

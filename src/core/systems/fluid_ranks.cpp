@@ -617,24 +617,8 @@ Report FluidRanks::wall_force(const double *y, double *total, int32_t nwall, dou
     for (int c = 0; c < D; ++c) sums[c].add(m * rate_n_[static_cast<size_t>(k) * D + c]);
     sums[D].add(mass_[k]);
   }
-  const int W = ExactSum::kWords;
-  const size_t rec = static_cast<size_t>(D + 1) * W;
-  std::vector<double> mine(rec);
-  for (int c = 0; c <= D; ++c) {
-    sums[c].normalise();  // (words below 2^53: exact as doubles)
-    for (int w = 0; w < W; ++w) mine[c * W + w] = static_cast<double>(sums[c].words()[w]);
-  }
-  const std::vector<double> all = coll_.allgather(mine.data(), static_cast<int64_t>(rec));
   double f[4] = {0, 0, 0, 0};
-  std::vector<int64_t> words(W);
-  for (int c = 0; c <= D; ++c) {
-    ExactSum s;
-    for (size_t p = 0; p < all.size() / rec; ++p) {
-      for (int w = 0; w < W; ++w) words[w] = static_cast<int64_t>(all[p * rec + c * W + w]);
-      s.add_words(words.data());
-    }
-    f[c] = s.value();
-  }
+  coll_.exact_totals(sums.data(), D + 1, f);
   for (int c = 0; c < D; ++c) total[c] = f[c] - f[D] * g_[c];
   return agreed;
 }
