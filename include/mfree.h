@@ -1829,11 +1829,15 @@ MFREE_API mfree_status_t mfree_system_set_lumped_mass_step(mfree_system_t *sys, 
  * wall or in a crowded cluster have large gradients or small lumped masses
  * (docs/time-integration.md). The bound applies to a fixed step (cfl <= 0, dt_max) too.
  * Dummy particles are left out of the operator. With mfree_system_set_lumped_mass_step
- * as well, the smaller of the two steps.
+ * as well, the smaller of the two steps. The iteration's sums over the particles are
+ * exact (rounded once), so that on a fluid on ranks (mfree_system_create_fluid_ranks)
+ * omega and the steps are bitwise one rank's, whatever the partition: there the vector is
+ * exchanged at the ghosts before each product and travels with the particles through
+ * ghost rebuilds and mfree_system_move_particles; every rank must set the same (ranks
+ * that disagree make mfree_system_integrate return MFREE_ERR_ARG on every rank).
  * @param[in] sys  a fluid system
  * @param[in] on   0 (default: off) or 1; else MFREE_ERR_ARG
- * @return MFREE_SUCCESS, MFREE_ERR_UNSUPPORTED (on = 1) for a fluid on ranks, or a failure
- *         named with the parameters
+ * @return MFREE_SUCCESS, or a failure named with the parameters
  */
 MFREE_API mfree_status_t mfree_system_set_acoustic_step(mfree_system_t *sys, int32_t on);
 
@@ -2224,8 +2228,8 @@ MFREE_API mfree_status_t mfree_system_create_elastodynamic_ranks(
  * state: MFREE_FAIL_NONFINITE; a NULL array or output passed to a collective call:
  * MFREE_ERR_NULL, the rank still taking part) is returned by every rank with that rank's
  * message ("rank R: ..."). Both native integrators; dummy particles (the same on every rank), density diffusion, velocity smoothing,
- * consistent integration and the lumped-mass step as on one process; no open boundaries or
- * acoustic step (MFREE_ERR_UNSUPPORTED at their setters). Outputs: the owned
+ * consistent integration, the lumped-mass step and the acoustic step as on one process; no open
+ * boundaries (MFREE_ERR_UNSUPPORTED at their setters). Outputs: the owned
  * particles' (docs/fluid-ranks.md); the consistent mass as products (mfree_system_apply_mass). Creation is collective: bad input on one rank, or ranks that
  * disagree on dim or width, make every rank fail alike.
  * libmfree_mpi's mfree_halo_create_fluid supplies the callbacks from a halo plan.

@@ -20,7 +20,9 @@
  * steps), and every --window T (default 0.25) Zoltan repartitions the particles where they
  * are now: they move to their new owners with their state, masses and ids, and the ghosts
  * are rebuilt. After the first partition and after each repartition, the particle counts
- * per rank: their largest and smallest ratio to the mean.
+ * per rank: their largest and smallest ratio to the mean. --acoustic-step 1 bounds the step
+ * by the acoustic operator's largest frequency as examples/dam_break's option does (its
+ * power iteration's vector travels with the particles).
  *
  * Front. Z = (max x + d/2) / a, the maximum over the ranks' owned particles (MPI_MAX, exact
  * in any order); Z_floor over the particles with z < 1.5 d. The fluid on ranks gives every
@@ -40,7 +42,7 @@
  * "partitioner", "window", "halo_width", "balance" ([T, max/mean, min/mean] after each
  * partition), "max_count_ratio", "min_count_ratio", "balanced" (1 when every partition left
  * every rank within 10 % of the mean), "partitions", "moved" (particles sent to another
- * rank, summed over the partitions) and "migrate_seconds". With --vtu DIR (or --vtu-every
+ * rank, summed over the partitions), "migrate_seconds" and "acoustic_step". With --vtu DIR (or --vtu-every
  * T): DIR/dam_break.pvd indexing dam_break_NNNN.pvtu, each with one .vtu piece per rank
  * (position, velocity = interpolated v_hat, pressure, density, global id, rank) every 0.25
  * in T. Rank 0 alone draws the progress bar, on a terminal.
@@ -68,7 +70,7 @@ static int g_rank = 0; /* usage on rank 0 only */
 
 typedef struct {
   double a, tank, t_end, cfl, mu, strength, offset, shepard, window, imbalance, diffusion;
-  int nx, scheme, lumping, partitioner, no_slip;
+  int nx, scheme, lumping, partitioner, no_slip, acoustic_step;
   const char *data;
   fc_run_t run;
 } options_t;
@@ -83,7 +85,9 @@ static void usage(FILE *f) {
              "  --imbalance R   the largest count / mean Zoltan may leave, in [1, 10] (default 1.05)\n"
              "  --window W      repartition every W in T, a multiple of 0.05 (default 0.25)\n"
              "  --no-slip 0|1   no-slip floor and end walls: dummy particles past them (default 0)\n"
-             "  --diffusion D   density diffusion (delta-SPH) coefficient, >= 0 (default 0)\n");
+             "  --diffusion D   density diffusion (delta-SPH) coefficient, >= 0 (default 0)\n"
+             "  --acoustic-step 0|1  the step also at most 1.5 / omega, omega the acoustic operator's largest\n"
+             "                  frequency (mfree_system_set_acoustic_step; default 0)\n");
   fc_run_usage(f);
 }
 
@@ -107,6 +111,7 @@ static int parse(int argc, char **argv, options_t *o) {
                               {"--window", 'd', &o->window},
                               {"--no-slip", 'i', &o->no_slip},
                               {"--diffusion", 'd', &o->diffusion},
+                              {"--acoustic-step", 'i', &o->acoustic_step},
                               {NULL, 0, NULL}};
   const int parsed = fc_parse(argc, argv, &o->run, opts, usage);
   if (parsed) return parsed;
@@ -122,7 +127,8 @@ static int parse(int argc, char **argv, options_t *o) {
                  o->tank > 1 && o->t_end > 0 && o->cfl > 0 && o->cfl <= 1 && o->mu >= 0 && o->strength >= 0 &&
                  o->offset >= 0 && o->shepard >= 1 && o->imbalance >= 1 && o->imbalance <= 10 && windows >= 1 - 1e-9 &&
                  (o->no_slip == 0 || o->no_slip == 1) && o->diffusion >= 0 &&
-                 fabs(windows - floor(windows + 0.5)) < 1e-9;
+                 fabs(windows - floor(windows + 0.5)) < 1e-9 &&
+                 (o->acoustic_step == 0 || o->acoustic_step == 1);
   if (!ok) usage(stderr);
   return ok ? 0 : 2;
 }
@@ -188,6 +194,7 @@ static mfree_status_t share_create(share_t *s, const fc_dam_t *dam, const option
     /* every rank the same dummies, all of them */
     if (mine == MFREE_SUCCESS && o->no_slip)
       mine = fc_dummy_tank(s->sys, (int)lround(dam->L / dam->d), 1.5 * dam->H, dam->d);
+    if (mine == MFREE_SUCCESS) mine = mfree_system_set_acoustic_step(s->sys, o->acoustic_step);
     if (mine != MFREE_SUCCESS) fprintf(stderr, "mfree_mpi_dam_break: rank %d: the fluid's settings failed\n", g_rank);
     if (any(mine != MFREE_SUCCESS)) st = mine != MFREE_SUCCESS ? mine : MFREE_ERR_ARG;
   }
@@ -336,7 +343,7 @@ int main(int argc, char **argv) {
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   g_rank = rank;
   options_t o = {0.05715, 5.0, 3.2, 0.5, 0.5, 10.0, 0.5, 100.0, 0.25, 1.05, 0.0, 24, MFREE_INTEGRATOR_LEAPFROG,
-                 MFREE_LUMP_GALERKIN, MFREE_PARTITIONER_RCB, 0, MFREE_DATA_DIR "/martin_moyce_1952.csv", {0}};
+                 MFREE_LUMP_GALERKIN, MFREE_PARTITIONER_RCB, 0, 0, MFREE_DATA_DIR "/martin_moyce_1952.csv", {0}};
   fc_run_init(&o.run, "mpi_dam_break", 0.25);
   const int parsed = parse(argc, argv, &o);
   if (parsed) {
@@ -476,6 +483,7 @@ int main(int argc, char **argv) {
     fc_json_int(&js, "partitions", nbal);
     fc_json_int(&js, "moved", moved);
     fc_json_num(&js, "migrate_seconds", migrate_seconds);
+    fc_json_int(&js, "acoustic_step", o.acoustic_step);
     files_bad = fc_json_finish(&js, &o.run);
     if (!o.run.json_stdout) {
       printf("dam break on %d ranks: a = %g m, %d particles, %lld steps, %.1f s (%.2f s partitioning)\n", size, a, n,

@@ -1,7 +1,8 @@
 # The dam break on ranks (examples/mpi/dam_break) against examples/dam_break (cmake -P):
 # the serial example, then the MPI example on each of RANKS ranks (Zoltan RCB, and HSFC on
 # the largest count), the same ARGS, with leap-frog; then both with the predictor-corrector
-# (the MPI example on 2 ranks, HSFC). Each MPI run must exit 0 with status 0, its front
+# (the MPI example on 2 ranks, HSFC), and both with the acoustic step at CFL 0.75 (the MPI
+# example on the largest count, RCB). Each MPI run must exit 0 with status 0, its front
 # history Z(T), the floor's front and the sample times bitwise the serial run's (the
 # summaries' digests of the doubles; docs/fluid-ranks.md: up to 1,024 particles the fluid
 # on ranks is the one-process fluid bit for bit), the same steps and comparison with Martin
@@ -98,6 +99,9 @@ serial_reference(pc --scheme pc)
 ranks_run(2 hsfc pc --scheme pc)
 serial_reference(noslip --no-slip 1)
 ranks_run(2 rcb noslip --no-slip 1)
+# the acoustic step (its power iteration on ranks) at CFL 0.75, where it bounds the step
+serial_reference(acoustic --acoustic-step 1 --cfl 0.75)
+ranks_run(${np_last} rcb acoustic --acoustic-step 1 --cfl 0.75)
 
 # a failure on one rank: every rank stops with the same status
 set(dir "${OUT}/fault")

@@ -1,11 +1,12 @@
 /* The one-process fluid's options that the fluid on ranks refuses (label mpi), on 1, 2 and
  * 4 ranks: the open boundaries (active particles, an inflow gate, an outflow plane, their
- * update) and the acoustic step return MFREE_ERR_UNSUPPORTED on every rank with a message
- * that says why, and leave the system as it was; dummy wall particles are taken (t176
- * runs them), and removed again (count 0) they leave nothing behind: afterwards the
- * system takes 40 leap-frog steps to the same bits as a system that never saw any of
- * these. The active-particle query answers for the owned particles (all active), not for
- * the ghosts. */
+ * update) return MFREE_ERR_UNSUPPORTED on every rank with a message that says why, and
+ * leave the system as it was; dummy wall particles are taken (t176 runs them), and removed
+ * again (count 0) they leave nothing behind: afterwards the system takes 40 leap-frog
+ * steps to the same bits as a system that never saw any of these. The active-particle
+ * query answers for the owned particles (all active), not for the ghosts. The acoustic
+ * step is taken (t179 runs it); set on one rank only, the integration returns
+ * MFREE_ERR_ARG on every rank (its power iteration is collective) and takes no step. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,8 +41,18 @@ int main(int argc, char **argv) {
          "outflow plane");
   expect(ctx, mfree_system_update_open_boundaries(r.sys, 0.0, r.y), MFREE_ERR_UNSUPPORTED, "on ranks",
          "open boundaries' update");
-  expect(ctx, mfree_system_set_acoustic_step(r.sys, 1), MFREE_ERR_UNSUPPORTED, "acoustic step", "acoustic step");
+  expect(ctx, mfree_system_set_acoustic_step(r.sys, 1), MFREE_SUCCESS, NULL, "acoustic step");
   expect(ctx, mfree_system_set_acoustic_step(r.sys, 0), MFREE_SUCCESS, NULL, "acoustic step off");
+  if (size > 1) {
+    expect(ctx, mfree_system_set_acoustic_step(r.sys, rank == 0), MFREE_SUCCESS, NULL, "acoustic step on rank 0");
+    int64_t one = 1, none = -1;
+    double t0 = 0.0;
+    const mfree_status_t got = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t0, 1.0, 0.5, 0.0,
+                                                      mpifluid_stop_at, &one, &none);
+    expect(ctx, got, MFREE_ERR_ARG, "ranks disagree on the acoustic step", "the acoustic step on rank 0 only");
+    CHECK(none == 0 && t0 == 0.0, "the refused integration took %lld steps to t = %g", (long long)none, t0);
+    expect(ctx, mfree_system_set_acoustic_step(r.sys, 0), MFREE_SUCCESS, NULL, "acoustic step off again");
+  }
   /* the query: the owned particles, every one active */
   int32_t nactive = -1;
   int32_t *state = malloc(((size_t)r.n_owned + 1) * sizeof *state);

@@ -3,7 +3,8 @@
  * mfree_halo_migrate_fluid on one rank (a NULL system or neq, a capacity below the
  * current state, a capacity below the new state: MFREE_ERR_ARG with *neq set and nothing
  * moved), ranks that disagree on rebalance, bad arguments of mfree_system_move_particles
- * on one rank, a move callback that fails (the system and the state stay as they were), a
+ * on one rank, a move callback that fails (the system and the state stay as they were), the
+ * acoustic step switched off on one rank after a run (MFREE_ERR_ARG before the move), a
  * system without a rebuild callback (MFREE_ERR_HALO when the layer is too shallow, as
  * before), and a rebuild callback that fails inside a run (its status, then
  * MFREE_ERR_STATE from every evaluation). */
@@ -99,6 +100,23 @@ int main(int argc, char **argv) {
   same(mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &want, &steps),
        MFREE_SUCCESS, "a run after the failed move", ctx);
   CHECK(cw.rebuilds > 0 || size == 1, "no ghost rebuild in 40 steps");
+
+  /* the acoustic step switched off on one rank after a run (its records would be shorter
+     there): MFREE_ERR_ARG on every rank before the move */
+  same(mfree_system_set_acoustic_step(r.sys, 1), MFREE_SUCCESS, "the acoustic step", ctx);
+  want = 5;
+  same(mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &want, &steps),
+       MFREE_SUCCESS, "a run with the acoustic step", ctx);
+  same(rank == last ? mfree_system_set_acoustic_step(r.sys, 0) : MFREE_SUCCESS, MFREE_SUCCESS,
+       "the acoustic step off on one rank", ctx);
+  mfree_halo_get_size(r.halo, &no, NULL);
+  memcpy(y0, y, 5 * (size_t)no * sizeof *y);
+  same(mfree_system_move_particles(r.sys, no, failing_move, mig, y, cap), size > 1 ? MFREE_ERR_ARG : MFREE_ERR_INTERNAL,
+       "a move with the acoustic step off on one rank", ctx);
+  CHECK(size == 1 || strstr(mpifluid_error(ctx), "disagree on the acoustic step"), "the message: %s",
+        mpifluid_error(ctx));
+  CHECK(memcmp(y0, y, 5 * (size_t)no * sizeof *y) == 0, "a refused move changed the state");
+  same(mfree_system_set_acoustic_step(r.sys, 0), MFREE_SUCCESS, "the acoustic step off", ctx);
 
   /* without a rebuild callback: MFREE_ERR_HALO, as before */
   same(mfree_system_set_halo_rebuild(r.sys, NULL), MFREE_SUCCESS, "no rebuild", ctx);

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "core/base/exact_sum.hpp"
 #include "core/base/parallel.hpp"
 #include "core/base/simd.hpp"
 
@@ -119,10 +120,9 @@ void FluidSystem::set_lumped_mass_step(int on) {
 
 void FluidSystem::set_acoustic_step(int on) {
   if (on != 0 && on != 1) throw Error(MFREE_ERR_ARG, "acoustic step: 0 or 1, not " + std::to_string(on));
-  // its power iteration runs over this process's nodes; on ranks it needs the ghost exchange
-  if (on && on_ranks()) throw Error(MFREE_ERR_UNSUPPORTED, "no acoustic step for the fluid on ranks yet");
   acoustic_step_ = on != 0;
   pw_u_.clear();  // a fresh start of the power iteration
+  pw_started_ = false;
 }
 
 void FluidSystem::check_ready() const {
@@ -402,7 +402,12 @@ void FluidSystem::galerkin_lumped(std::vector<double> &m) const {
 // call so that a mode growing elsewhere (a cluster becoming ill-conditioned) always has a
 // share to grow from. The Rayleigh quotient in the M_L inner product (the operator is
 // self-adjoint in it) bounds omega^2 from below. Fluid particles only (no dummies); serial,
-// so the result does not depend on the thread count.
+// so the result does not depend on the thread count. On ranks the same: each node's
+// values are those of one rank (the ghosts' vector from their owners, the fixed vector
+// indexed by global id, the products summed over the rows in node order), and the sums
+// over the particles are exact (each particle's share rounded as on one rank, then added
+// without rounding over every rank's owned particles), so omega does not depend on the
+// partition.
 double FluidSystem::acoustic_omega2(const double *y, int iters) {
   const int D = dim_;
   const size_t nd = static_cast<size_t>(D) * n_;
@@ -410,19 +415,48 @@ double FluidSystem::acoustic_omega2(const double *y, int iters) {
   const bool galerkin = lump_ == MFREE_LUMP_GALERKIN;
   if (galerkin) galerkin_lumped(pw_m_);
   else pw_m_.assign(mass_.begin(), mass_.begin() + n_);
-  if (pw_u_.size() != nd) {  // first call (or the particles changed): converge from scratch
+  const Collective *coll = collective();
+  auto totals = [&](ExactSum *s, int ns, double *out) {
+    if (coll) coll->exact_totals(s, ns, out);
+    else
+      for (int k = 0; k < ns; ++k) out[k] = s[k].value();
+  };
+  // |u|^2, the unknowns' count and the ranks without a vector: the first call (or the
+  // particles changed) converges from scratch, on every rank alike
+  double uu[3];
+  {
+    const bool fresh = !pw_started_ || pw_u_.size() != nd;
+    ExactSum s[3];
+    for (int32_t i = 0; i < n_ && !fresh; ++i) {
+      if (!steps_by(i)) continue;
+      double ui = 0.0;
+      for (int c = 0; c < D; ++c) ui += pw_u_[static_cast<size_t>(i) * D + c] * pw_u_[static_cast<size_t>(i) * D + c];
+      s[0].add(ui);
+    }
+    for (int32_t i = 0; i < n_; ++i)
+      if (steps_by(i)) s[1].add(D);
+    s[2].add(fresh ? 1.0 : 0.0);
+    totals(s, 3, uu);
+  }
+  if (uu[2] > 0.0) {
     pw_u_.assign(nd, 0.0);
+    uu[0] = 0.0;
     iters = std::max(iters, 30);
   }
-  double uu = 0.0;
-  for (size_t q = 0; q < nd; ++q) uu += pw_u_[q] * pw_u_[q];
-  const double seed = uu > 0.0 ? 1e-3 * std::sqrt(uu / static_cast<double>(nd)) : 1.0;  // relative to u
-  for (size_t q = 0; q < nd; ++q)  // a fixed pseudo-random vector (Knuth's multiplicative hash)
-    pw_u_[q] += seed * (static_cast<double>((q * 2654435761u) % 1000) / 1000.0 - 0.5);
+  pw_started_ = true;
+  const double seed = uu[0] > 0.0 ? 1e-3 * std::sqrt(uu[0] / uu[1]) : 1.0;  // relative to u
+  for (int32_t i = 0; i < n_; ++i) {  // a fixed pseudo-random vector (Knuth's multiplicative hash)
+    if (!steps_by(i)) continue;
+    for (int c = 0; c < D; ++c) {
+      const size_t g = static_cast<size_t>(global_id(i)) * D + c;
+      pw_u_[static_cast<size_t>(i) * D + c] += seed * (static_cast<double>((g * 2654435761u) % 1000) / 1000.0 - 0.5);
+    }
+  }
   pw_w_.resize(nd);
   pw_div_.resize(n_);
   double lam = 0.0;
   for (int it = 0; it < iters; ++it) {
+    to_ghosts(pw_u_.data(), D);
     for (int32_t k = 0; k < n_; ++k) {  // M C B u
       double dv = 0.0;
       for (int64_t q = rb(k); q < re(k); ++q)
@@ -435,19 +469,30 @@ double FluidSystem::acoustic_omega2(const double *y, int iters) {
       for (int64_t q = rb(k); q < re(k); ++q)
         if (cols_[q] < n_)
           for (int c = 0; c < D; ++c) pw_w_[static_cast<size_t>(cols_[q]) * D + c] += pw_div_[k] * G_[q * D + c];
-    double num = 0.0, den = 0.0, nw = 0.0;
-    for (int32_t i = 0; i < n_; ++i)
+    ExactSum s[3];  // u.w, u.u M_L, w.w M_L with w = M_L^-1 B^T M C B u
+    for (int32_t i = 0; i < n_; ++i) {
+      if (!steps_by(i)) continue;
+      double num = 0.0, den = 0.0, nw = 0.0;
       for (int c = 0; c < D; ++c) {
         const size_t q = static_cast<size_t>(i) * D + c;
         num += pw_u_[q] * pw_w_[q];
-        den += pw_u_[q] * pw_u_[q] * pw_m_[i];
+        den += pw_u_[q] * pw_u_[q];
         pw_w_[q] /= pw_m_[i];
-        nw += pw_w_[q] * pw_w_[q] * pw_m_[i];
+        nw += pw_w_[q] * pw_w_[q];
       }
+      s[0].add(num);
+      s[1].add(den * pw_m_[i]);
+      s[2].add(nw * pw_m_[i]);
+    }
+    double tot[3];
+    totals(s, 3, tot);
+    const double den = tot[1], nw = tot[2];
     if (!(den > 0.0 && nw > 0.0 && std::isfinite(nw))) break;  // no fluid motion the rows see
-    lam = num / den;
-    const double s = 1.0 / std::sqrt(nw);
-    for (size_t q = 0; q < nd; ++q) pw_u_[q] = pw_w_[q] * s;
+    lam = tot[0] / den;
+    const double sc = 1.0 / std::sqrt(nw);
+    for (int32_t i = 0; i < n_; ++i)
+      if (steps_by(i))
+        for (int c = 0; c < D; ++c) pw_u_[static_cast<size_t>(i) * D + c] = pw_w_[static_cast<size_t>(i) * D + c] * sc;
   }
   return lam;
 }

@@ -99,10 +99,16 @@ class FluidSystem : public System {
   // After the rows of a prepare, before their statuses are checked: the rows a rank does
   // not need are dropped there, and its scatter runs in node order.
   virtual void rows_done() {}
-  // Whether stable_dt's lumped-mass scaling (set_lumped_mass_step) counts node i: on ranks
-  // only the owned nodes, whose lumped masses sum every row that holds them (a far
-  // ghost's rows are dropped, its sum incomplete; its owner counts it).
+  // Whether stable_dt's lumped-mass scaling (set_lumped_mass_step) and the power
+  // iteration's sums (set_acoustic_step) count node i: on ranks only the owned nodes,
+  // whose lumped masses sum every row that holds them (a far ghost's rows are dropped,
+  // its sum incomplete; its owner counts it).
   virtual bool steps_by(int32_t i) const { (void)i; return true; }
+  // The power iteration of set_acoustic_step on ranks: the owned nodes' values of a node
+  // array (na per node) to the ghosts (before each product), and node i's global id (the
+  // index of its share of the iteration's fixed vector).
+  virtual void to_ghosts(double *a, int na) { (void)a; (void)na; }
+  virtual int64_t global_id(int32_t i) const { return i; }
   // The mass matrix of mass() from the prepared tables, for np particles: the state's
   // particle i at node node[i], node k the state's particle part[k] (-1: none, its
   // terms dropped; nodes < n_).
@@ -294,6 +300,7 @@ class FluidSystem : public System {
   std::vector<double> lumped_;         // stable_dt's lumped masses (with lumped_step_)
   // set_acoustic_step: the power iteration's vector (kept between steps) and its scratch
   bool acoustic_step_ = false;
+  bool pw_started_ = false;  // pw_u_ holds the last call's vector
   std::vector<double> pw_u_, pw_w_, pw_div_, pw_m_;
   double acoustic_omega2(const double *y, int iters);  // on the prepared tables
   void galerkin_lumped(std::vector<double> &m) const;  // eq 56 on the prepared tables

@@ -418,22 +418,25 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
     return Report();
   });
   {
-    const double v[5] = {static_cast<double>(args.status), t, t_end, cfl, dt_max};
+    // (and the acoustic step's setting: its power iteration exchanges and gathers)
+    constexpr int V = 6;
+    const double v[V] = {static_cast<double>(args.status), t, t_end, cfl, dt_max, acoustic_step_ ? 1.0 : 0.0};
     const int np = coll_.size();
-    std::vector<double> all(static_cast<size_t>(np) * 5);
-    coll_.allgather(v, 5, all.data(), static_cast<int64_t>(all.size()));
+    std::vector<double> all(static_cast<size_t>(np) * V);
+    coll_.allgather(v, V, all.data(), static_cast<int64_t>(all.size()));
     std::vector<double> st(np);
-    for (int p = 0; p < np; ++p) st[p] = all[5 * static_cast<size_t>(p)];
+    for (int p = 0; p < np; ++p) st[p] = all[V * static_cast<size_t>(p)];
     const Report agreed = coll_.agree_from(st, args);
     if (!agreed.ok()) throw Error(agreed.status, agreed.message);
-    static const char *names[5] = {"", "t", "t_end", "cfl", "dt_max"};
+    static const char *names[V] = {"", "t", "t_end", "cfl", "dt_max", "the acoustic step"};
     for (int p = 1; p < np; ++p)
-      for (int k = 1; k < 5; ++k)
-        if (!(all[5 * static_cast<size_t>(p) + k] == all[k])) {
+      for (int k = 1; k < V; ++k)
+        if (!(all[V * static_cast<size_t>(p) + k] == all[k])) {
           std::ostringstream s;
           s.precision(17);
-          s << "ranks disagree on " << names[k] << ": rank 0 passes " << all[k] << ", rank " << p << " passes "
-            << all[5 * static_cast<size_t>(p) + k] << " (every rank must pass the same)";
+          s << "ranks disagree on " << names[k] << ": rank 0 " << (k < 5 ? "passes " : "sets ") << all[k] << ", rank "
+            << p << (k < 5 ? " passes " : " sets ") << all[V * static_cast<size_t>(p) + k] << " (every rank must "
+            << (k < 5 ? "pass" : "set") << " the same)";
           throw Error(MFREE_ERR_ARG, s.str());
         }
   }
@@ -470,7 +473,7 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
     rebuilt = false;
     check_reach(vals[1], nsteps + 1);
     double dt = 0.0;
-    agreed = step_size(vals[0], cfl, dt_max, t, t_end, nsteps, nullptr, dt);
+    agreed = step_size(vals[0], cfl, dt_max, t, t_end, nsteps, nullptr, dt, acoustic_cap(ys_.data()));
     if (!agreed.ok()) return agreed;
     const double *x = ys_.data(), *v = x + nd, *rho = v + nd;
     double *xn = yn_.data(), *vn = xn + nd, *rn = vn + nd;

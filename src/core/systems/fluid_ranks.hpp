@@ -53,6 +53,8 @@ class FluidRanks final : public FluidSystem {
   void to_nodes(HVec<double> &per_particle) const override;
   void rows_done() override;
   bool steps_by(int32_t i) const override { return is_owned_[i] != 0; }
+  void to_ghosts(double *a, int na) override { sync(a, na); }
+  int64_t global_id(int32_t i) const override { return gid_[i]; }
 
  private:
   FluidRanks(int dim, int32_t n_owned, int32_t n_ghost, const int64_t *ids, double width, const Collective &coll);
@@ -110,13 +112,15 @@ class FluidRanks final : public FluidSystem {
   // ids oid, per-particle data: rest density and mass, two per particle, host order) and
   // the system re-seated on them and the new ghosts (collective; a failure after the
   // host's rebuild leaves the system broken_: its ghosts no longer match the host's).
-  void reseat(int32_t n_owned, const double *xo, const int64_t *oid, const double *data);
+  // pw: the power iteration's vector at the owned particles (dim per particle, host
+  // order; with pw_started_), which the iteration carries on from.
+  void reseat(int32_t n_owned, const double *xo, const int64_t *oid, const double *data, const double *pw);
   // reseat around the owned particles' current positions (the first part of y).
   void rebuild_halo(const double *y);
   void check_usable() const;
   mfree_halo_rebuild_fn rebuild_ = nullptr;
   bool broken_ = false;
-  std::vector<double> mv_x_, mv_data_, mv_rec_;
+  std::vector<double> mv_x_, mv_data_, mv_rec_, mv_pw_;
   std::vector<int64_t> mv_id_;
 
   Collective coll_;

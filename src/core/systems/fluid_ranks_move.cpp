@@ -28,16 +28,19 @@ void FluidRanks::rebuild_halo(const double *y) {
   std::copy(y, y + static_cast<size_t>(D) * n_own_, mv_x_.begin());
   mv_id_.resize(static_cast<size_t>(n_own_) + 1);
   mv_data_.resize(2 * static_cast<size_t>(n_own_) + 1);
+  mv_pw_.resize(pw_started_ ? static_cast<size_t>(D) * n_own_ + 1 : 0);
   for (int32_t p = 0; p < n_own_; ++p) {
     const int32_t k = owned_[p];
     mv_id_[p] = gid_[k];
     mv_data_[2 * p] = rho0_[k];
     mv_data_[2 * p + 1] = mass_[k];
+    if (pw_started_) std::copy_n(&pw_u_[static_cast<size_t>(k) * D], D, &mv_pw_[static_cast<size_t>(p) * D]);
   }
-  reseat(n_own_, mv_x_.data(), mv_id_.data(), mv_data_.data());
+  reseat(n_own_, mv_x_.data(), mv_id_.data(), mv_data_.data(), mv_pw_.data());
 }
 
-void FluidRanks::reseat(int32_t n_owned, const double *xo, const int64_t *oid, const double *data) {
+void FluidRanks::reseat(int32_t n_owned, const double *xo, const int64_t *oid, const double *data,
+                        const double *pw) {
   const int D = dim();
   kept_mass_.valid = false;  // (apply_mass's columns are the nodes)
   int32_t ng = -1;
@@ -85,6 +88,13 @@ void FluidRanks::reseat(int32_t n_owned, const double *xo, const int64_t *oid, c
       rho0_[node_[p]] = buf_[2 * static_cast<size_t>(p)];
       mass_[node_[p]] = buf_[2 * static_cast<size_t>(p) + 1];
     }
+    // the power iteration goes on from the owned particles' vector, as on one rank (the
+    // ghosts' values come from their owners before each product)
+    if (pw_started_) {
+      pw_u_.assign(static_cast<size_t>(D) * n_, 0.0);
+      for (int32_t p = 0; p < n_owned; ++p)
+        std::copy_n(pw + static_cast<size_t>(p) * D, D, &pw_u_[static_cast<size_t>(node_[p]) * D]);
+    }
     return Report();
   });
   agreed = coll_.agree(seated);
@@ -96,7 +106,9 @@ void FluidRanks::reseat(int32_t n_owned, const double *xo, const int64_t *oid, c
 
 void FluidRanks::move_particles(int32_t n_new, mfree_particles_move_fn move, void *move_user, double *y,
                                 int64_t capacity) {
-  const int D = dim(), nrec = 2 * D + 4;
+  // records: x, v, rho, rest density, mass, the global id's bits, the power iteration's
+  // vector (with the acoustic step)
+  const int D = dim(), nrec = 2 * D + 4 + (pw_started_ ? D : 0);
   const Report args = coll_.local([&] {
     check_usable();
     if (!rebuild_) throw Error(MFREE_ERR_STATE, "no halo rebuild callback (mfree_system_set_halo_rebuild)");
@@ -113,9 +125,21 @@ void FluidRanks::move_particles(int32_t n_new, mfree_particles_move_fn move, voi
     check_ready();
     return Report();
   });
-  Report agreed = coll_.agree(args);
+  // the outcome, and whether the records carry the power iteration's vector: a record's
+  // length must be the same on every rank
+  const double mine[2] = {static_cast<double>(args.status), pw_started_ ? 1.0 : 0.0};
+  const std::vector<double> all = coll_.allgather(mine, 2);
+  std::vector<double> st(all.size() / 2);
+  bool differ = false;
+  for (size_t p = 0; p < st.size(); ++p) {
+    st[p] = all[2 * p];
+    differ = differ || all[2 * p + 1] != all[1];
+  }
+  Report agreed = coll_.agree_from(st, args);
   if (!agreed.ok()) throw Error(agreed.status, agreed.message);
-  // records: x, v, rho, rest density, mass, the global id's bits
+  if (differ)
+    throw Error(MFREE_ERR_ARG,
+                "ranks disagree on the acoustic step (mfree_system_set_acoustic_step): every rank must set the same");
   const size_t no = static_cast<size_t>(D) * n_own_;
   mv_rec_.resize(static_cast<size_t>(std::max(n_own_, n_new)) * nrec + 1);
   for (int32_t p = 0; p < n_own_; ++p) {
@@ -129,6 +153,7 @@ void FluidRanks::move_particles(int32_t n_new, mfree_particles_move_fn move, voi
     r[2 * D + 1] = rho0_[k];
     r[2 * D + 2] = mass_[k];
     r[2 * D + 3] = Collective::pack(gid_[k]);
+    if (pw_started_) std::copy_n(&pw_u_[static_cast<size_t>(k) * D], D, r + 2 * D + 4);
   }
   const Report moved = guarded([&] {
     const mfree_status_t st = move(move_user, nrec, n_own_, mv_rec_.data(), n_new);
@@ -142,14 +167,16 @@ void FluidRanks::move_particles(int32_t n_new, mfree_particles_move_fn move, voi
   mv_x_.resize(static_cast<size_t>(D) * n_new + 1);
   mv_id_.resize(static_cast<size_t>(n_new) + 1);
   mv_data_.resize(2 * static_cast<size_t>(n_new) + 1);
+  mv_pw_.resize(pw_started_ ? static_cast<size_t>(D) * n_new + 1 : 0);
   for (int32_t p = 0; p < n_new; ++p) {
     const double *r = &mv_rec_[static_cast<size_t>(p) * nrec];
     for (int c = 0; c < D; ++c) mv_x_[p * D + c] = r[c];
     mv_data_[2 * p] = r[2 * D + 1];
     mv_data_[2 * p + 1] = r[2 * D + 2];
     mv_id_[p] = Collective::unpack(r[2 * D + 3]);
+    if (pw_started_) std::copy_n(r + 2 * D + 4, D, &mv_pw_[static_cast<size_t>(p) * D]);
   }
-  reseat(n_new, mv_x_.data(), mv_id_.data(), mv_data_.data());
+  reseat(n_new, mv_x_.data(), mv_id_.data(), mv_data_.data(), mv_pw_.data());
   const size_t nn = static_cast<size_t>(D) * n_new;
   for (int32_t p = 0; p < n_new; ++p) {
     const double *r = &mv_rec_[static_cast<size_t>(p) * nrec];
