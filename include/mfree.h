@@ -1978,8 +1978,10 @@ MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
  * in y, get zero rates and take no part in the nodes, the checks or the step. The native
  * integrator updates the boundaries between steps; a host integrating with SUNDIALS calls
  * mfree_system_update_open_boundaries between its windows. The fluid on ranks has no open
- * boundaries: the setters and the update return MFREE_ERR_UNSUPPORTED there, and every
- * owned particle is active. */
+ * boundaries (its dormant pool would be spread over the ranks, an injected particle needs
+ * an owner near its gate, a removed one leaves ghosts behind): the setters and the update
+ * return MFREE_ERR_UNSUPPORTED there with a message that says so, and every owned particle
+ * is active; run open boundaries in one process. */
 
 /** States of a fluid's particles (mfree_system_get_active). */
 typedef enum {

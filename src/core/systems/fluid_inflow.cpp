@@ -65,10 +65,11 @@ void scatter_state(const std::vector<int32_t> &active, int dim, int32_t n, const
 }  // namespace
 
 FluidOpen &FluidSystem::open() {
-  // (a rank's particles are its owned ones and ghosts: an injected particle would need a
-  // global id no rank has, and a particle that leaves would leave ghosts behind)
   if (on_ranks())
-    throw Error(MFREE_ERR_UNSUPPORTED, "no open boundaries (active particles, inflow, outflow) for the fluid on ranks");
+    throw Error(MFREE_ERR_UNSUPPORTED,
+                "no open boundaries (active particles, inflow gates, outflow planes) for the fluid on ranks: the "
+                "dormant pool would be spread over the ranks, an injected particle needs an owner near its gate and "
+                "its ghosts, a removed one leaves ghosts behind; run them in one process (mfree_system_create_fluid)");
   if (!open_) {
     auto o = std::make_unique<FluidOpen>();
     o->state.assign(n_, kFluid);
