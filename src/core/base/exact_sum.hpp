@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace mfree {
 
@@ -22,15 +23,19 @@ class ExactSum {
   static constexpr int kWords = kLimbs + 3;
 
   void add(double x) {
-    if (!std::isfinite(x)) {
-      ++w_[kLimbs + (std::isnan(x) ? 2 : (x > 0 ? 0 : 1))];
+    // x's sign, exponent and mantissa from its bits (frexp and ldexp are library calls)
+    uint64_t b = 0;
+    std::memcpy(&b, &x, sizeof b);
+    const int ex = static_cast<int>((b >> 52) & 0x7ff);
+    uint64_t man = b & ((uint64_t{1} << 52) - 1);
+    if (ex == 0x7ff) {
+      ++w_[kLimbs + (man ? 2 : (b >> 63 ? 1 : 0))];
       return;
     }
-    if (x == 0.0) return;
-    int e = 0;
-    const double m = std::frexp(x, &e);  // x = m 2^e, 1/2 <= |m| < 1
-    const int64_t mi = static_cast<int64_t>(std::ldexp(m, 53));  // exact: x = mi 2^(e - 53)
-    const int pos = e - 53 + kBias;                               // >= 26 (subnormals included)
+    if (ex == 0 && man == 0) return;
+    if (ex != 0) man |= uint64_t{1} << 52;  // (subnormals: exponent 1, no hidden bit)
+    const int64_t mi = b >> 63 ? -static_cast<int64_t>(man) : static_cast<int64_t>(man);
+    const int pos = (ex == 0 ? 1 : ex) - 1075 + kBias;  // x = mi 2^(pos - kBias), pos >= 78
     const int k = pos / 32;
     // (a product, not a left shift: shifting a negative value is undefined before C++20)
     __int128 v = static_cast<__int128>(mi) * (static_cast<__int128>(1) << (pos % 32));
