@@ -2,19 +2,18 @@
  * paper 003, choices 2) by the Galerkin-SPH fluid of paper 003 with two fluids.
  *
  * Set-up. A tank of depth D = 0.06 m holds fluid 1 (rho0 = 1000 kg/m3) on the left over a
- * length --light (default 0.12 m = 2 D) and fluid 2 (rho0 = 1500 kg/m3) on the right over
- * 0.06 m (the paper's Fig. 10 labels "0.06 m", "0.06 m"), both filled to D. The lock
- * between them is gone at t = 0 and fluid 2 runs under fluid 1. --nz particles over the
- * depth (default 34: 3468 particles, near the paper's 5100), h = 1.5 d, MLS linear,
- * nodal integration, Galerkin lumped mass, leap-frog with CFL --cfl (default 0.25: at 0.5
- * the run stops at t ~ 0.2 s with a negative density where the free surface over the
- * draining heavy fluid sloshes against the right wall), wall particles at d/3
- * set back by d/2, r0 = 0.7 h, A = 10. Per-particle rest densities (mfree_system_set_fluid
- * with stride 1) and hydrostatic initial densities in each compartment (003 eq 65). The
- * paper gives neither kappa nor mu for this example: kappa = 100 rho2 (2 g D) / gamma
- * (eq 125 with the heavier fluid, so both stay within 1 % of their rest densities), and
- * mu = --mu (default 0.01 Pa s; with the 0.5 of the other examples the current's Reynolds
- * number U D / nu is about 30 and the head slower: 0.245 m/s at nz = 41 against 0.282).
+ * length --light (default 0.06 m) and fluid 2 (rho0 = 1500 kg/m3) on the right over
+ * 0.06 m (the paper's Fig. 10 labels "0.06 m", "0.06 m", read as two compartments), both
+ * filled to D. The lock between them is gone at t = 0 and fluid 2 runs under fluid 1.
+ * --nz particles over the depth (default 51: 5,202 particles, the paper's 5,100), h = 1.5 d,
+ * MLS linear, nodal integration, Galerkin lumped mass, leap-frog with CFL --cfl (default
+ * 0.5, the paper's), wall particles at d/3 set back by d/2, r0 = 0.7 h, A = 10.
+ * Per-particle rest densities (mfree_system_set_fluid with stride 1) and hydrostatic
+ * initial densities in each compartment (003 eq 65). The paper gives neither kappa nor mu
+ * for this example: kappa = 100 rho2 (2 g D) / gamma (eq 125 with the heavier fluid, so
+ * both stay within 1 % of their rest densities), and mu = --mu (default 0.5 Pa s, the
+ * viscosity of the paper's other viscous flows, Sects. 7.1, 7.2 and 7.4 a; the current's
+ * Reynolds number U D / nu is then about 30).
  *
  * Head. The head is the leading edge of the heavy layer: the leftmost x where fluid 2
  * fills at least 0.2 D of the depth over a width of 0.1 D (at least 0.02 D^2 of its
@@ -23,50 +22,50 @@
  * resolutions here) this is the leftmost particle to within a particle spacing.
  *
  * Head speed. The least-squares slope of the head's position, sampled every 0.005 s, over
- * the window 0.1 <= t <= 0.3 s (--fit-from, --fit-to; t (g'/D)^(1/2) from 0.9 to 2.7,
- * g' = g drho / rho1; other densities scale the default by (D / g')^(1/2)), the run
- * stopping at its end (or at --tend). Compared with Rottman & Simpson's v_h = 0.4 (g D
- * drho / rho0)^(1/2) = 0.217 m/s (003 eq 126, rho0 = rho1; the paper reports about
- * 0.2 m/s) and with Benjamin's (1968) energy-conserving half-depth current under a lid,
- * 0.5 (g D drho / rho1)^(1/2) = 0.271 m/s. The window holds the collapse of the lock, not
- * a constant-speed current: at nz = 26 to 41 the head runs at 0.30-0.32 m/s over 0.10 <=
- * t <= 0.15 s and at 0.17-0.23 m/s over 0.25 <= t <= 0.30 s. Over the window, with
- * --lumped-step 1, the speed converges: 0.280, 0.282, 0.281, 0.282 m/s at nz = 34, 41, 58,
- * 82 (3,468 to 20,172 particles), 30 % above 0.217 m/s. Later the particle arrangement
- * disintegrates (the nodal-integration instability of docs/fluid.md), so a longer tank
- * and a later window give no convergent speed either. docs/fluid.md has the resolution
- * table and the reasons the speed does not come within 10 % of 0.217 m/s.
+ * the window 0.05 <= t <= 0.2 s (--fit-from, --fit-to; t (g'/D)^(1/2) from 0.45 to 1.8,
+ * g' = g drho / rho1: from the end of the lock's first acceleration to the head 0.4 D from
+ * the end wall; other densities scale the default by (D / g')^(1/2)), the run stopping at
+ * its end (or at --tend). Compared with Rottman & Simpson's v_h = 0.4 (g D drho /
+ * rho0)^(1/2) = 0.217 m/s (003 eq 126, rho0 = rho1; the paper reports about 0.2 m/s) and
+ * with Benjamin's (1968) energy-conserving half-depth current under a lid, 0.5 (g D drho /
+ * rho1)^(1/2) = 0.271 m/s. The default run gives 0.2199 m/s, +1.3 % of eq 126; the
+ * speed converges with resolution, 0.222-0.223 m/s at nz = 26 to 41 and 0.218-0.221 m/s
+ * at nz = 51 to 100 (docs/fluid.md has the table, and the shorter window 0.1-0.2 s, over
+ * which the nose's unsteadiness gives 0.231-0.240 m/s).
  *
- * The paper's set-up read with its other experiments: --light 0.06 (Fig. 10's two labels
- * as two compartments 0.06 m long) and --mu 0.5 (the viscosity of Sects. 7.1, 7.2 and
- * 7.4 a), with --fit-from 0.05 --fit-to 0.2 (the head then still more than 0.4 D from the
- * end wall) and --lumped-step 1: 0.223, 0.223, 0.222, 0.221, 0.219, 0.219 m/s at nz = 26,
- * 34, 41, 50, 58, 100 (1,352 to 20,000 particles), +0.9 % of eq 126 at 20,000 (over
- * 0.1-0.2 s 0.231-0.240, the nose's unsteadiness; with mu = 0.01 0.25-0.26); at the
- * paper's CFL 0.5 (--cfl 0.5) it runs as it stands, 0.2199 m/s at nz = 51. The default
- * set-up stops at CFL 0.5 unless --acoustic-step 1 (mfree_system_set_acoustic_step).
+ * The long-tank set-up (fluid 1 2 D long, mu = 0.01: --light 0.12 --mu 0.01 --fit-from 0.1
+ * --fit-to 0.3 --cfl 0.25): over 0.1 <= t <= 0.3 s, the lock's collapse, the head runs at
+ * 0.30-0.32 m/s over 0.10 <= t <= 0.15 s and at 0.17-0.23 m/s over 0.25 <= t <= 0.30 s
+ * (nz = 26 to 41); with --lumped-step 1 the speed over the window converges to 0.28 m/s
+ * (0.280, 0.282, 0.281, 0.282 m/s at nz = 34, 41, 58, 82), 30 % above eq 126. Later the
+ * particle arrangement disintegrates (the nodal-integration instability of
+ * docs/fluid.md), so a longer tank and a later window give no convergent speed either. At
+ * CFL 0.5 this set-up stops with a negative density (t = 0.12 s at nz = 34) unless
+ * --acoustic-step 1 (mfree_system_set_acoustic_step).
  *
  * Diagnostics (not in the paper): --heavy RHO2 (a smaller density difference, towards the
  * Boussinesq lock exchange whose inviscid current is Benjamin's), --lid 1 (a free-slip
  * lid of wall particles at z = D + d/2 in place of the free surface), --consistent 1
  * (mfree_system_set_consistent_integration), --shepard-cond C and --lumped-step 1 (the
- * fluid's options of the same names; from nz = 58 the default stops with a non-positive
- * lumped mass, as the dam break did, and --lumped-step 1 runs). Density diffusion is not
- * offered: it diffuses rho itself and so mixes the two rest densities at the interface.
+ * fluid's options of the same names; in the long-tank set-up from nz = 58 the paper's step
+ * stops with a non-positive lumped mass, as the dam break did, and --lumped-step 1 runs).
+ * Density diffusion is not offered: it diffuses rho itself and so mixes the two rest
+ * densities at the interface.
  *
  * No-slip walls (--no-slip 1; not in the paper): four layers of dummy particles at spacing
  * d past the floor and the side walls (mfree_system_set_dummy_particles: zero velocity
  * parameters, so the interpolated velocity vanishes at the wall), the wall force kept.
- * Measured: 0.200, 0.230, 0.243, 0.265 m/s at nz = 12, 20, 26, 34, below the free-slip
- * values and not converged: the floor's boundary layer, (nu t)^(1/2) = 1.4 mm at t = 0.2 s,
- * is thinner than the particle spacing (1.8 mm at nz = 34), so its drag falls as d does.
+ * Measured in the long-tank set-up: 0.200, 0.230, 0.243, 0.265 m/s at nz = 12, 20, 26, 34,
+ * below the free-slip values and not converged: the floor's boundary layer, (nu t)^(1/2) =
+ * 1.4 mm at t = 0.2 s, is thinner than the particle spacing (1.8 mm at nz = 34), so its
+ * drag falls as d does.
  *
  * Output in --out DIR (default gravity_current_out): head.csv and head.png (the head's
  * travel against Rottman & Simpson's speed; gnuplot on PATH, not --no-plot), and the JSON
  * summary gravity_current.json (--json: on stdout too): {"status":..,"error":..,"t":..,
  * "steps":..,"particles":..,"head_speed":..,"reference":0.217,"rel_dev":..,
  * "inviscid_reference":0.271,"rel_dev_inviscid":..,"fit_points":..,"fit_window":[t0,t1]
- * (s),"head":[[t,x_head,x_leftmost],...],"mass_rel_error":..,"cfl":..,"no_slip":..,
+ * (s),"head":[[t,x_head,x_leftmost],...],"mass_rel_error":..,"cfl":..,"mu":..,"no_slip":..,
  * "heavy_density":..,"light_length":..,"lid":..,"consistent_integration":..,
  * "shepard_condition":..,"lumped_mass_step":..,"wall_seconds":..}
  * (head_speed and rel_dev null when fewer than 3 head positions fell in the window). With
@@ -88,7 +87,7 @@
 static const double kG = 9.81, kGamma = 7.0, kD = 0.06, kRho1 = 1000.0;
 /* the default fit window (s) at the paper's densities; other densities scale it by
  * (D / g')^(1/2), g' = g (rho2 - rho1) / rho1 */
-static const double kFit0 = 0.1, kFit1 = 0.3;
+static const double kFit0 = 0.05, kFit1 = 0.2;
 
 static int cmp_double(const void *a, const void *b) {
   const double x = *(const double *)a, z = *(const double *)b;
@@ -108,9 +107,9 @@ static double head_edge(const double *xs, int nh, double d) {
 }
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: mfree_gravity_current [--nz N (34)] [--light L1 (0.12 m)] [--tend T (s; default: the end\n"
-             "       of the fit window)] [--fit-from T0 (0.1 s)] [--fit-to T1 (0.3 s)] [--mu MU (0.01)]\n"
-             "       [--cfl C (0.25)] [--no-slip 0|1 (0)] [--heavy RHO2 (1500 kg/m3)] [--lid 0|1 (0)]\n"
+  fprintf(f, "usage: mfree_gravity_current [--nz N (51)] [--light L1 (0.06 m)] [--tend T (s; default: the end\n"
+             "       of the fit window)] [--fit-from T0 (0.05 s)] [--fit-to T1 (0.2 s)] [--mu MU (0.5 Pa s)]\n"
+             "       [--cfl C (0.5)] [--no-slip 0|1 (0)] [--heavy RHO2 (1500 kg/m3)] [--lid 0|1 (0)]\n"
              "       [--consistent 0|1 (0)] [--shepard-cond C (100)] [--lumped-step 0|1 (0)]\n"
              "       [--acoustic-step 0|1 (0)]\n"
              "       [run options; --vtu-every in s, default 0.05]\n");
@@ -118,8 +117,8 @@ static void usage(FILE *f) {
 }
 
 int main(int argc, char **argv) {
-  int nz = 34;
-  double light = 2.0 * kD, t_end = -1.0, fit0 = -1.0, fit1 = -1.0, mu = 0.01, cfl = 0.25;
+  int nz = 51;
+  double light = kD, t_end = -1.0, fit0 = -1.0, fit1 = -1.0, mu = 0.5, cfl = 0.5;
   int noslip = 0, lid = 0, consistent = 0, lumped_step = 0, acoustic_step = 0;
   double rho2 = 1500.0, shepard = 100.0;
   fc_run_t ro;
@@ -268,6 +267,7 @@ int main(int argc, char **argv) {
   fc_json_table(&js, "head", head.n / 3, 3, head.v);
   fc_json_num(&js, "mass_rel_error", merr);
   fc_json_num(&js, "cfl", cfl);
+  fc_json_num(&js, "mu", mu);
   fc_json_int(&js, "no_slip", noslip);
   fc_json_num(&js, "heavy_density", rho2);
   fc_json_num(&js, "light_length", light);

@@ -1,10 +1,10 @@
 # examples/gravity_current --json (paper 003 Sect. 7.3: lock exchange of fluids of 1000
 # and 1500 kg/m3 in a tank of depth D = 0.06 m): the run ends without a failure, the mass
-# is exact, and the head speed over the example's fit window (0.1 <= t <= 0.3 s unless EXTRA sets one) lies
+# is exact, and the head speed over the example's fit window (0.05 <= t <= 0.2 s unless EXTRA sets one) lies
 # within TOL of REF: "rs", Rottman & Simpson's 0.4 (g D drho / rho0)^(1/2) = 0.217 m/s (003
 # eq 126; the paper reports about 0.2 m/s), or "inviscid", Benjamin's half-depth current
-# 0.5 (g D drho / rho0)^(1/2) = 0.271 m/s, the value the example settles near over its
-# free-slip walls; the plot of the head's travel is written when gnuplot is installed.
+# 0.5 (g D drho / rho0)^(1/2) = 0.271 m/s, the value the long-tank set-up settles near over
+# its free-slip walls; the plot of the head's travel is written when gnuplot is installed.
 # EXTRA (optional): further options of the example in one string, e.g. the set-up and fit
 # window of another reading of the paper.
 # Usage: cmake -DEXE=<mfree_gravity_current> -DOUT=<dir> -DNZ=<n> -DREF=rs|inviscid -DTOL=<rel>
