@@ -20,9 +20,10 @@
  * array) on one rank of a system on ranks does not leave the other ranks waiting: the
  * fault is made pending on the system (mfree_system_set_pending_error) and the callback
  * still makes its system call, which returns the fault's status on every rank with this
- * rank's message ("rank R: y has length ..."), nothing read or written; except a lumped
- * mass product (mfree_sundials_mass_times) at a point whose mass is kept, which makes no
- * system call: its fault is this rank's alone.
+ * rank's message ("rank R: y has length ..."), nothing read or written. The same holds
+ * for the other arguments of mfree_sundials_create_mass_matrix (a NULL SUNContext or
+ * output pointer). Where the system call is local on ranks (an elastodynamic system's
+ * mfree_system_assemble_mass), the fault is this rank's alone, as the call's would be.
  *
  * Callback returns (int): 0 on success; a positive mfree status as it is (SUNDIALS'
  * "recoverable": IDA, CVODE and ARKStep's implicit stages retry with a smaller step;
@@ -169,7 +170,10 @@ MFREE_SUNDIALS_API mfree_status_t mfree_sundials_set_mass_solver(mfree_sundials_
  * @param[in]  y       state (N values; copied as the adapter's state)
  * @param[out] M       the new matrix, owned by the host (SUNMatDestroy); NULL on failure
  * @return MFREE_SUCCESS; a positive status when the system fails at y;
- *         MFREE_ERR_UNSUPPORTED when nnz does not fit sunindextype
+ *         MFREE_ERR_NULL for a NULL sunctx or M, MFREE_ERR_MISMATCH or
+ *         MFREE_ERR_UNSUPPORTED for a y as the callbacks refuse it (on ranks, where the
+ *         assembly is collective: on every rank, with the faulty rank's message, no
+ *         matrix made); MFREE_ERR_UNSUPPORTED when nnz does not fit sunindextype
  */
 MFREE_SUNDIALS_API mfree_status_t mfree_sundials_create_mass_matrix(mfree_sundials_t *ad,
                                                                     SUNContext sunctx,
@@ -272,12 +276,13 @@ MFREE_SUNDIALS_API int mfree_sundials_residual(sunrealtype t, N_Vector y, N_Vect
  * (ARKStepSetMassLinearSolver(mem, LS, NULL, ...), ARKStepSetMassTimes(mem, NULL,
  * mfree_sundials_mass_times, ad)), and for vectors over ranks (NVECTOR_PARALLEL: the
  * lumped mass of a system on ranks is block-diagonal by rank; collocation: the identity;
- * the fluid: its lumped mass, diagonal). The mass is assembled once per point: products
- * at the same t with no right-hand side (no new state) in between reuse it, as the
- * iterations of one mass solve do. With the consistent mass
- * (mfree_sundials_set_consistent_mass) the product is the system's own,
- * mfree_system_apply_mass at the same state: on ranks it couples owned particles to
- * ghosts and exchanges v there (collective), and it keeps the mass of one state.
+ * the fluid: its lumped mass, diagonal). The product is the system's own,
+ * mfree_system_apply_mass at that state, lumped or consistent
+ * (mfree_sundials_set_consistent_mass): the system keeps the mass of one state (except a
+ * fluid with open boundaries), so that products at the same t with no right-hand side (no
+ * new state) in between reuse it, as the iterations of one mass solve do. On ranks it is
+ * collective at every product (a vector's fault on one rank reaches every rank); the
+ * consistent mass couples owned particles to ghosts and exchanges v there.
  * @param[in]  v            the vector to multiply (the system's length on this rank)
  * @param[out] Mv           M v
  * @param[in]  t            time

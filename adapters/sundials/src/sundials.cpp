@@ -121,6 +121,10 @@ struct Vectors {
     if (fault == MFREE_SUCCESS) fault = vector_data(ad, fn, name, v, data);
   }
   bool faulty() const { return fault != MFREE_SUCCESS; }
+  // A fault of another argument, taken as a vector's (the first one counts).
+  void refuse(mfree_status_t st, const char *why) {
+    if (fault == MFREE_SUCCESS) fault = record(ad->ctx, st, fn, why);
+  }
   // MFREE_SUCCESS when the callback goes on to its system calls (the fault, if any,
   // pending); else the fault, returned at once (it cannot be made pending).
   mfree_status_t go() {
@@ -130,8 +134,8 @@ struct Vectors {
     pending = mfree_system_set_pending_error(ad->sys, fault, msg) == MFREE_SUCCESS;
     return pending ? MFREE_SUCCESS : fault;
   }
-  // The callback's outcome st; after a fault that no system call took (the callback made
-  // none: a kept lumped mass), the fault, cleared from the system.
+  // The callback's outcome st; after a fault that no system call took (the callback
+  // failed before its system call), the fault, cleared from the system.
   mfree_status_t finish(mfree_status_t st) {
     if (!pending) return st;
     mfree_system_set_pending_error(ad->sys, MFREE_SUCCESS, nullptr);
@@ -340,11 +344,14 @@ mfree_status_t mfree_sundials_create_mass_matrix(mfree_sundials_t *ad, SUNContex
   if (!ad) return MFREE_ERR_NULL;
   static const char *fn = "mfree_sundials_create_mass_matrix";
   return guarded(ad->ctx, fn, [&]() {
-    if (!M) return record(ad->ctx, MFREE_ERR_NULL, fn, "output pointer is NULL");
-    *M = nullptr;
-    if (!sunctx) return record(ad->ctx, MFREE_ERR_NULL, fn, "SUNContext is NULL");
-    double *py = nullptr;
+    // (every argument's fault is pending for the assembly: on ranks it is collective)
     Vectors vs{ad, fn};
+    if (M)
+      *M = nullptr;
+    else
+      vs.refuse(MFREE_ERR_NULL, "output pointer is NULL");
+    if (!sunctx) vs.refuse(MFREE_ERR_NULL, "SUNContext is NULL");
+    double *py = nullptr;
     vs.get("y", y, &py);
     mfree_status_t st = vs.go();
     if (st != MFREE_SUCCESS) return st;
@@ -445,17 +452,13 @@ int mfree_sundials_mass_times(N_Vector v, N_Vector Mv, sunrealtype t, void *mtim
     vs.get("Mv", Mv, &pm);
     mfree_status_t st = vs.go();
     if (st != MFREE_SUCCESS) return st;
-    if (ad->consistent) {
-      // the system's own product: on ranks the consistent mass couples owned particles
-      // to ghosts, which only the system exchanges; it keeps the mass of one state
-      const double *at = nullptr;
-      st = mass_state(ad, fn, t, &at);
-      if (st == MFREE_SUCCESS) st = mfree_system_apply_mass(ad->sys, at, 1, pv, pm);
-      return vs.finish(st);
-    }
-    // (a kept lumped mass makes no system call: a fault then stays on this rank)
-    st = mass_at(ad, fn, t);
-    if (st == MFREE_SUCCESS && !vs.faulty()) st = mfree_matrix_apply(ad->mass, pv, pm);
+    // The system's own product, which keeps the mass of one state: on ranks it is
+    // collective at every point (a fault here reaches every rank through it; a mass kept
+    // by the adapter would make no call), and the consistent mass couples owned particles
+    // to ghosts, which only the system exchanges.
+    const double *at = nullptr;
+    st = mass_state(ad, fn, t, &at);
+    if (st == MFREE_SUCCESS) st = mfree_system_apply_mass(ad->sys, at, ad->consistent ? 1 : 0, pv, pm);
     return vs.finish(st);
   });
 }
