@@ -3,6 +3,7 @@
 #include "mpitest.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -129,6 +130,23 @@ void rankfluid_free(rankfluid_t *r) {
   if (r->halo) mfree_halo_destroy(&r->halo);
   free(r->id), free(r->y);
   memset(r, 0, sizeof *r);
+}
+
+mfree_context_t *mpifluid_pair(int *argc, char ***argv, int *rank, int *size, damb_t *b, int **owner,
+                               double *width, rankfluid_t *s, rankfluid_t *twin) {
+  mfree_context_t *ctx = mpifluid_start(argc, argv, rank, size, b, 12, 24, owner);
+  const double w = 4.0 * b->h + 2.0 * b->d;
+  if (width) *width = w;
+  CHECK(rankfluid_make(s, ctx, MPI_COMM_WORLD, b, *owner, w, 0) == MFREE_SUCCESS, "system");
+  CHECK(rankfluid_make(twin, ctx, MPI_COMM_WORLD, b, *owner, w, 0) == MFREE_SUCCESS, "twin");
+  return ctx;
+}
+
+void mpifluid_pair_free(damb_t *b, int *owner, rankfluid_t *s, rankfluid_t *twin) {
+  free(owner);
+  rankfluid_free(s);
+  rankfluid_free(twin);
+  damb_free(b);
 }
 
 void mpifluid_collect(MPI_Comm comm, int n_owned, const int64_t *id, const double *vals, int per, double *out) {

@@ -51,6 +51,14 @@ mfree_status_t rankfluid_make(rankfluid_t *r, mfree_context_t *ctx, MPI_Comm com
                               const int *owner, double width, int reverse);
 void rankfluid_free(rankfluid_t *r);
 
+/* The fault tests' start: mpifluid_start with the dam break of 12 x 24 particles on slabs,
+ * the ghost layer 4 h + 2 d deep (*width, unless width is NULL), and two systems alike (rankfluid_make, ids
+ * ascending): *s, which sees the bad calls, and *twin, which sees only the good ones (a
+ * failed creation is a failed check). mpifluid_pair_free frees all but the context. */
+mfree_context_t *mpifluid_pair(int *argc, char ***argv, int *rank, int *size, damb_t *b, int **owner,
+                               double *width, rankfluid_t *s, rankfluid_t *twin);
+void mpifluid_pair_free(damb_t *b, int *owner, rankfluid_t *s, rankfluid_t *twin);
+
 /* Every owned item's per values (vals: per values per owned item, in the items' order),
  * gathered on every rank of comm by global id: out holds per values per particle. */
 void mpifluid_collect(MPI_Comm comm, int n_owned, const int64_t *id, const double *vals, int per, double *out);

@@ -14,12 +14,17 @@ void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const
   CHECK(!needle || strstr(msg, needle), "%s: message '%s' lacks '%s'", what, msg, needle);
 }
 
-void expect_agreed(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, int bad, const char *why,
-                   const char *what) {
-  int lo = 0, hi = 0, mine = (int)got;
+mfree_status_t mpitest_same_status(mfree_status_t st, const char *what) {
+  int mine = (int)st, lo = 0, hi = 0;
   MPI_Allreduce(&mine, &lo, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   MPI_Allreduce(&mine, &hi, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   CHECK(lo == hi, "%s: the ranks return statuses %d to %d", what, lo, hi);
+  return st;
+}
+
+void expect_agreed(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, int bad, const char *why,
+                   const char *what) {
+  mpitest_same_status(got, what);
   char needle[200];
   snprintf(needle, sizeof needle, "rank %d: %s", bad, why);
   expect(ctx, got, want, needle, what);

@@ -30,6 +30,10 @@ extern int mpitest_failures;
  * (NULL: any message); what names the case in a failed check. */
 void expect(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, const char *needle, const char *what);
 
+/* st, checked to be the same on every rank of MPI_COMM_WORLD (else one failed check naming
+ * what and the range of statuses). Collective. */
+mfree_status_t mpitest_same_status(mfree_status_t st, const char *what);
+
 /* expect for a collective call: got the same on every rank of MPI_COMM_WORLD, want, and a
  * message naming the rank that failed, "rank <bad>: <why>". Collective. */
 void expect_agreed(mfree_context_t *ctx, mfree_status_t got, mfree_status_t want, int bad, const char *why,

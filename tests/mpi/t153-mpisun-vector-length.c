@@ -140,15 +140,11 @@ static void bar_products(mfree_context_t *ctx, SUNContext sunctx, int kind) {
 int main(int argc, char **argv) {
   damb_t b;
   int *owner = NULL;
-  mfree_context_t *ctx = mpifluid_start(&argc, &argv, &rank, &size, &b, 12, 24, &owner);
+  rankfluid_t s, twin; /* s: sees the faults (through ad); twin: the good calls only (through adt) */
+  mfree_context_t *ctx = mpifluid_pair(&argc, &argv, &rank, &size, &b, &owner, NULL, &s, &twin);
   MPI_Comm world = MPI_COMM_WORLD;
   SUNContext sunctx = NULL;
   SUNContext_Create(&world, &sunctx);
-  const double width = 4.0 * b.h + 2.0 * b.d;
-  /* s: sees the faults (through ad); twin: the good calls only (through adt) */
-  rankfluid_t s, twin;
-  CHECK(rankfluid_make(&s, ctx, MPI_COMM_WORLD, &b, owner, width, 0) == MFREE_SUCCESS, "system");
-  CHECK(rankfluid_make(&twin, ctx, MPI_COMM_WORLD, &b, owner, width, 0) == MFREE_SUCCESS, "twin");
   mfree_sundials_t *ad = NULL, *adt = NULL;
   CHECK(mfree_sundials_create(ctx, s.sys, &ad) == MFREE_SUCCESS &&
             mfree_sundials_create(ctx, twin.sys, &adt) == MFREE_SUCCESS,
@@ -226,10 +222,7 @@ int main(int argc, char **argv) {
   bar_products(ctx, sunctx, BAR_GALERKIN);
   mfree_sundials_destroy(&ad);
   mfree_sundials_destroy(&adt);
-  free(owner);
-  rankfluid_free(&s);
-  rankfluid_free(&twin);
-  damb_free(&b);
+  mpifluid_pair_free(&b, owner, &s, &twin);
   SUNContext_Free(&sunctx);
   mfree_context_destroy(&ctx);
   const int rc = mpitest_finish("t153-mpisun-vector-length");

@@ -192,6 +192,11 @@ static void fluid_calls(mfree_context_t *ctx, rankfluid_t *s, rankfluid_t *twin,
   free(d1), free(d2), free(y0), free(v);
 }
 
+/* The bar's right-hand side at t = 1 us (stress 0) or its stress (stress 1). */
+static mfree_status_t bar_output(mfree_system_t *sys, int stress, const double *y, double *out) {
+  return stress ? mfree_system_get_stress(sys, 1e-6, y, out) : mfree_system_rhs(sys, 1e-6, y, out);
+}
+
 /* The elastodynamic bar on ranks: rhs, stress and integrate fail alike, then give what
  * they gave before the fault. */
 static void bar_calls(mfree_context_t *ctx, int turn) {
@@ -203,21 +208,17 @@ static void bar_calls(mfree_context_t *ctx, int turn) {
   const size_t neq = 2 * (size_t)b.n_owned, no = (size_t)b.n_owned;
   double *y = calloc(neq + 1, sizeof *y), *ref = malloc((neq + 1) * sizeof *ref), *d = malloc((neq + 1) * sizeof *d);
   for (size_t i = 0; i < no; ++i) y[i] = 1e-6 * sin(0.3 * (double)b.id[i]);
-  CHECK(mfree_system_rhs(b.sys, 1e-6, y, ref) == MFREE_SUCCESS, "bar rhs: %s", mpifluid_error(ctx));
-  fill(d, neq);
-  pend(ctx, b.sys, bad, st);
-  expect_agreed(ctx, mfree_system_rhs(b.sys, 1e-6, y, d), st, bad, why, "bar rhs");
-  untouched(d, neq, "bar rhs");
-  CHECK(mfree_system_rhs(b.sys, 1e-6, y, d) == MFREE_SUCCESS, "bar rhs after the fault: %s", mpifluid_error(ctx));
-  mpitest_same_bits(d, ref, (int64_t)neq, "bar rhs after the fault");
-
-  CHECK(mfree_system_get_stress(b.sys, 1e-6, y, ref) == MFREE_SUCCESS, "bar stress: %s", mpifluid_error(ctx));
-  fill(d, no);
-  pend(ctx, b.sys, bad, st);
-  expect_agreed(ctx, mfree_system_get_stress(b.sys, 1e-6, y, d), st, bad, why, "bar stress");
-  untouched(d, no, "bar stress");
-  CHECK(mfree_system_get_stress(b.sys, 1e-6, y, d) == MFREE_SUCCESS, "bar stress: %s", mpifluid_error(ctx));
-  mpitest_same_bits(d, ref, (int64_t)no, "bar stress after the fault");
+  for (int stress = 0; stress < 2; ++stress) { /* the right-hand side, then the stress */
+    const char *what = stress ? "bar stress" : "bar rhs";
+    const size_t nout = stress ? no : neq;
+    CHECK(bar_output(b.sys, stress, y, ref) == MFREE_SUCCESS, "%s: %s", what, mpifluid_error(ctx));
+    fill(d, nout);
+    pend(ctx, b.sys, bad, st);
+    expect_agreed(ctx, bar_output(b.sys, stress, y, d), st, bad, why, what);
+    untouched(d, nout, what);
+    CHECK(bar_output(b.sys, stress, y, d) == MFREE_SUCCESS, "%s after the fault: %s", what, mpifluid_error(ctx));
+    mpitest_same_bits(d, ref, (int64_t)nout, stress ? "bar stress after the fault" : "bar rhs after the fault");
+  }
 
   double t = 0.0;
   int64_t steps = -1;
@@ -274,21 +275,14 @@ static void one_process(mfree_context_t *ctx, const damb_t *b) {
 int main(int argc, char **argv) {
   damb_t b;
   int *owner = NULL;
-  mfree_context_t *ctx = mpifluid_start(&argc, &argv, &rank, &size, &b, 12, 24, &owner);
-  const double width = 4.0 * b.h + 2.0 * b.d;
-  /* s: sees the faults; twin: the good calls only */
-  rankfluid_t s, twin;
-  CHECK(rankfluid_make(&s, ctx, MPI_COMM_WORLD, &b, owner, width, 0) == MFREE_SUCCESS, "system");
-  CHECK(rankfluid_make(&twin, ctx, MPI_COMM_WORLD, &b, owner, width, 0) == MFREE_SUCCESS, "twin");
+  rankfluid_t s, twin; /* s: sees the faults; twin: the good calls only */
+  mfree_context_t *ctx = mpifluid_pair(&argc, &argv, &rank, &size, &b, &owner, NULL, &s, &twin);
   for (int turn = 0; turn < 2; ++turn) {
     fluid_calls(ctx, &s, &twin, turn);
     bar_calls(ctx, turn);
   }
   if (rank == 0) one_process(ctx, &b);
-  free(owner);
-  rankfluid_free(&s);
-  rankfluid_free(&twin);
-  damb_free(&b);
+  mpifluid_pair_free(&b, owner, &s, &twin);
   mfree_context_destroy(&ctx);
   const int rc = mpitest_finish("t154-mpi-pending-error");
   MPI_Finalize();

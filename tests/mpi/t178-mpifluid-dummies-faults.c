@@ -17,34 +17,19 @@
 #include "mpifluid.h"
 #include "mpitest.h"
 
-/* Every rank's status equals rank 0's; returns it. */
-static mfree_status_t same_status(mfree_status_t st, const char *what) {
-  int mine = (int)st, lo = 0, hi = 0;
-  MPI_Allreduce(&mine, &lo, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(&mine, &hi, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  CHECK(lo == hi, "%s: the ranks return statuses %d to %d", what, lo, hi);
-  return st;
-}
-
 int main(int argc, char **argv) {
   int rank = 0, size = 1;
-  mfree_context_t *ctx = mpitest_start(&argc, &argv, &rank, &size);
-  const int last = size - 1;
   damb_t b;
-  damb_make(&b, 12, 24);
-  const int n = b.n;
-  int *owner = malloc((size_t)n * sizeof *owner);
-  for (int i = 0; i < n; ++i) {
-    int p = (int)(b.y[2 * i] / b.a * size);
-    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
-  }
+  int *owner = NULL;
+  mfree_context_t *ctx = mpifluid_start(&argc, &argv, &rank, &size, &b, 12, 24, &owner);
+  const int last = size - 1;
   int64_t five = 5;
   char msg[512];
   rankfluid_t r;
   mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, 4.0 * b.h + 2.0 * b.d, 0);
   /* the tank is 5 a long, its end walls 1.5 times the column high */
   if (st == MFREE_SUCCESS) st = fc_dummy_tank(r.sys, 5 * 12, 3.0 * b.a, b.d);
-  CHECK(same_status(st, "creation") == MFREE_SUCCESS, "creation with the dummies: status %d", (int)st);
+  CHECK(mpitest_same_status(st, "creation") == MFREE_SUCCESS, "creation with the dummies: status %d", (int)st);
   if (st != MFREE_SUCCESS) MPI_Abort(MPI_COMM_WORLD, 1);
   const size_t ns = 5 * (size_t)r.n_owned;
   double *y0 = malloc((ns + 1) * sizeof *y0), *dot = malloc((ns + 1) * sizeof *dot);
@@ -57,22 +42,22 @@ int main(int argc, char **argv) {
   int64_t steps = 0;
   st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &five,
                               &steps);
-  CHECK(same_status(st, "run, two radii") == MFREE_ERR_HALO && steps == 0 && t == 0.0, "run: status %d, %lld steps",
+  CHECK(mpitest_same_status(st, "run, two radii") == MFREE_ERR_HALO && steps == 0 && t == 0.0, "run: status %d, %lld steps",
         (int)st, (long long)steps);
   CHECK(strstr(mpifluid_error(ctx), "four support radii (dummy particles with density diffusion)"),
         "run: message \"%s\"", mpifluid_error(ctx));
   CHECK(!memcmp(y0, r.y, ns * sizeof *y0), "the refused run changed the state");
   st = mfree_system_rhs(r.sys, 0.0, r.y, dot);
-  CHECK(same_status(st, "rhs, two radii") == MFREE_ERR_HALO, "rhs: status %d", (int)st);
+  CHECK(mpitest_same_status(st, "rhs, two radii") == MFREE_ERR_HALO, "rhs: status %d", (int)st);
   CHECK(strstr(mpifluid_error(ctx), "four support radii"), "rhs: message \"%s\"", mpifluid_error(ctx));
   st = mfree_system_get_velocity(r.sys, r.y, vhat);
-  CHECK(same_status(st, "velocity, two radii") == MFREE_ERR_HALO, "velocity: status %d", (int)st);
+  CHECK(mpitest_same_status(st, "velocity, two radii") == MFREE_ERR_HALO, "velocity: status %d", (int)st);
 
   /* ---- without the diffusion, two radii are enough ---- */
   expect(ctx, mfree_system_set_density_diffusion(r.sys, 0.0), MFREE_SUCCESS, NULL, "no density diffusion");
   st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &five,
                               &steps);
-  CHECK(same_status(st, "run, no diffusion") == MFREE_SUCCESS && steps == 5, "run: status %d, %lld steps: %s",
+  CHECK(mpitest_same_status(st, "run, no diffusion") == MFREE_SUCCESS && steps == 5, "run: status %d, %lld steps: %s",
         (int)st, (long long)steps, mpifluid_error(ctx));
 
   /* ---- a non-finite density on the last rank after the five steps: leap-frog, then the
@@ -83,7 +68,7 @@ int main(int argc, char **argv) {
     memcpy(y0, r.y, ns * sizeof *y0);
     st = mfree_system_integrate(r.sys, when ? MFREE_INTEGRATOR_PREDICTOR_CORRECTOR : MFREE_INTEGRATOR_LEAPFROG, r.y,
                                 &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &five, &steps);
-    CHECK(same_status(st, "non-finite") == MFREE_FAIL_NONFINITE, "non-finite density (%d): status %d", when, (int)st);
+    CHECK(mpitest_same_status(st, "non-finite") == MFREE_FAIL_NONFINITE, "non-finite density (%d): status %d", when, (int)st);
     snprintf(msg, sizeof msg, "%s", mpifluid_error(ctx));
     char want[32];
     snprintf(want, sizeof want, "rank %d: ", last);
@@ -91,7 +76,7 @@ int main(int argc, char **argv) {
     CHECK(steps == 0 && t == t0 && !memcmp(y0, r.y, ns * sizeof *y0),
           "non-finite density: %lld steps taken, or the state changed", (long long)steps);
     st = mfree_system_rhs(r.sys, 0.0, r.y, dot);
-    CHECK(same_status(st, "rhs") == MFREE_FAIL_NONFINITE, "rhs of a non-finite state: status %d", (int)st);
+    CHECK(mpitest_same_status(st, "rhs") == MFREE_FAIL_NONFINITE, "rhs of a non-finite state: status %d", (int)st);
   }
 
   free(y0), free(dot), free(vhat);

@@ -13,15 +13,6 @@
 #include "mpifluid.h"
 #include "mpitest.h"
 
-/* Every rank's status equals rank 0's; returns it. */
-static mfree_status_t same_status(mfree_status_t st, const char *what) {
-  int mine = (int)st, lo = 0, hi = 0;
-  MPI_Allreduce(&mine, &lo, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(&mine, &hi, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  CHECK(lo == hi, "%s: the ranks return statuses %d to %d", what, lo, hi);
-  return st;
-}
-
 static mfree_status_t noop_exchange(void *user, int32_t ncomp, double *field, int64_t ld) {
   (void)user, (void)ncomp, (void)field, (void)ld;
   return MFREE_SUCCESS;
@@ -36,22 +27,12 @@ static mfree_status_t self_allgather(void *user, const double *in, int64_t n, do
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
   int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  const int last = size - 1;
-  mfree_context_t *ctx = NULL;
-  mfree_context_create(&ctx);
   damb_t b;
-  damb_make(&b, 12, 24);
-  const int n = b.n;
+  int *owner = NULL;
+  mfree_context_t *ctx = mpifluid_start(&argc, &argv, &rank, &size, &b, 12, 24, &owner);
+  const int last = size - 1;
   const double width = 4.0 * b.h + 2.0 * b.d;
-  int *owner = malloc((size_t)n * sizeof *owner);
-  for (int i = 0; i < n; ++i) {
-    int p = (int)(b.y[2 * i] / b.a * size);
-    owner[i] = p < 0 ? 0 : p >= size ? size - 1 : p;
-  }
   int64_t five = 5;
   char msg[512];
 
@@ -60,13 +41,13 @@ int main(int argc, char **argv) {
   for (int when = 0; when < 2; ++when) {
     rankfluid_t r;
     mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
-    CHECK(same_status(st, "creation") == MFREE_SUCCESS, "creation status %d", (int)st);
+    CHECK(mpitest_same_status(st, "creation") == MFREE_SUCCESS, "creation status %d", (int)st);
     double t = 0.0;
     int64_t steps = 0;
     if (when == 1) {
       st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &five,
                                   &steps);
-      CHECK(same_status(st, "five steps") == MFREE_SUCCESS && steps == 5, "five steps: status %d, %lld steps",
+      CHECK(mpitest_same_status(st, "five steps") == MFREE_SUCCESS && steps == 5, "five steps: status %d, %lld steps",
             (int)st, (long long)steps);
     }
     if (rank == last && r.n_owned > 0) r.y[2 * (size_t)r.n_owned + 1] = NAN; /* v_z of its first particle */
@@ -75,7 +56,7 @@ int main(int argc, char **argv) {
     memcpy(y0, r.y, 5 * (size_t)r.n_owned * sizeof *y0);
     st = mfree_system_integrate(r.sys, when ? MFREE_INTEGRATOR_PREDICTOR_CORRECTOR : MFREE_INTEGRATOR_LEAPFROG, r.y,
                                 &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &five, &steps);
-    CHECK(same_status(st, "non-finite") == MFREE_FAIL_NONFINITE, "non-finite velocity (%d): status %d", when,
+    CHECK(mpitest_same_status(st, "non-finite") == MFREE_FAIL_NONFINITE, "non-finite velocity (%d): status %d", when,
           (int)st);
     snprintf(msg, sizeof msg, "%s", mpifluid_error(ctx));
     char want[32];
@@ -86,7 +67,7 @@ int main(int argc, char **argv) {
     /* the right-hand side as well */
     double *dot = malloc(5 * ((size_t)r.n_owned + 1) * sizeof *dot);
     st = mfree_system_rhs(r.sys, 0.0, r.y, dot);
-    CHECK(same_status(st, "rhs") == MFREE_FAIL_NONFINITE, "rhs of a non-finite state: status %d", (int)st);
+    CHECK(mpitest_same_status(st, "rhs") == MFREE_FAIL_NONFINITE, "rhs of a non-finite state: status %d", (int)st);
     free(dot), free(y0);
     rankfluid_free(&r);
   }
@@ -95,18 +76,18 @@ int main(int argc, char **argv) {
   {
     rankfluid_t r;
     mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
-    CHECK(same_status(st, "creation") == MFREE_SUCCESS, "creation status %d", (int)st);
+    CHECK(mpitest_same_status(st, "creation") == MFREE_SUCCESS, "creation status %d", (int)st);
     double t = 0.0;
     int64_t steps = 0;
     if (size > 1) {
       st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t, rank == last ? 2.0 : 1.0, 0.5, 0.0,
                                   mpifluid_stop_at, &five, &steps);
-      CHECK(same_status(st, "t_end") == MFREE_ERR_ARG && steps == 0, "disagreeing t_end: status %d", (int)st);
+      CHECK(mpitest_same_status(st, "t_end") == MFREE_ERR_ARG && steps == 0, "disagreeing t_end: status %d", (int)st);
       CHECK(strstr(mpifluid_error(ctx), "ranks disagree on t_end"), "message \"%s\"",
             mpifluid_error(ctx));
     }
     st = mfree_system_integrate(r.sys, (mfree_integrator_t)7, r.y, &t, 1.0, 0.5, 0.0, NULL, NULL, &steps);
-    CHECK(same_status(st, "scheme") == MFREE_ERR_ARG, "unknown integrator: status %d", (int)st);
+    CHECK(mpitest_same_status(st, "scheme") == MFREE_ERR_ARG, "unknown integrator: status %d", (int)st);
     /* (the distributed outputs: t197) */
     mfree_matrix_t *M = NULL;
     CHECK(mfree_system_assemble_mass(r.sys, r.y, 1, &M) == MFREE_ERR_UNSUPPORTED && !M, "consistent mass on ranks");
@@ -121,12 +102,12 @@ int main(int argc, char **argv) {
        particles would miss their own neighbours */
     rankfluid_t r;
     mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, 2.0 * b.h + b.d, 0);
-    CHECK(same_status(st, "creation") == MFREE_SUCCESS, "creation status %d", (int)st);
+    CHECK(mpitest_same_status(st, "creation") == MFREE_SUCCESS, "creation status %d", (int)st);
     double t = 0.0;
     int64_t steps = 0;
     st = mfree_system_integrate(r.sys, MFREE_INTEGRATOR_LEAPFROG, r.y, &t, 1.0, 0.5, 0.0, mpifluid_stop_at, &five,
                                 &steps);
-    CHECK(same_status(st, "shallow halo") == MFREE_ERR_HALO && steps == 0, "shallow halo: status %d", (int)st);
+    CHECK(mpitest_same_status(st, "shallow halo") == MFREE_ERR_HALO && steps == 0, "shallow halo: status %d", (int)st);
     rankfluid_free(&r);
   }
 
@@ -134,7 +115,7 @@ int main(int argc, char **argv) {
   {
     rankfluid_t r;
     mfree_status_t st = rankfluid_make(&r, ctx, MPI_COMM_WORLD, &b, owner, width, 0);
-    CHECK(same_status(st, "creation") == MFREE_SUCCESS, "creation status %d", (int)st);
+    CHECK(mpitest_same_status(st, "creation") == MFREE_SUCCESS, "creation status %d", (int)st);
     const int nl = r.n_owned + r.n_ghost;
     int64_t *ids = malloc(((size_t)nl + 2) * sizeof *ids);
     memcpy(ids, r.id, (size_t)nl * sizeof *ids);
@@ -143,30 +124,30 @@ int main(int argc, char **argv) {
     if (rank == last && nl >= 2) ids[1] = ids[0];
     st = mfree_system_create_fluid_ranks(ctx, 2, r.n_owned, r.n_ghost, ids, width, mfree_halo_exchange_callback,
                                          mfree_halo_allgather, r.halo, &sys);
-    CHECK(same_status(st, "twice") == (nl >= 2 || rank != last ? MFREE_ERR_INPUT : MFREE_SUCCESS) && !sys,
+    CHECK(mpitest_same_status(st, "twice") == (nl >= 2 || rank != last ? MFREE_ERR_INPUT : MFREE_SUCCESS) && !sys,
           "an id twice: status %d", (int)st);
     mfree_system_destroy(&sys);
     memcpy(ids, r.id, (size_t)nl * sizeof *ids);
     /* a negative count, a dimension of its own, a width of its own on the last rank */
     st = mfree_system_create_fluid_ranks(ctx, 2, rank == last ? -1 : r.n_owned, r.n_ghost, ids, width,
                                          mfree_halo_exchange_callback, mfree_halo_allgather, r.halo, &sys);
-    CHECK(same_status(st, "count") == MFREE_ERR_ARG && !sys, "negative count: status %d", (int)st);
+    CHECK(mpitest_same_status(st, "count") == MFREE_ERR_ARG && !sys, "negative count: status %d", (int)st);
     st = mfree_system_create_fluid_ranks(ctx, rank == last ? 4 : 2, r.n_owned, r.n_ghost, ids, width,
                                          mfree_halo_exchange_callback, mfree_halo_allgather, r.halo, &sys);
-    CHECK(same_status(st, "dimension") == MFREE_ERR_ARG && !sys, "bad dimension: status %d", (int)st);
+    CHECK(mpitest_same_status(st, "dimension") == MFREE_ERR_ARG && !sys, "bad dimension: status %d", (int)st);
     if (size > 1) {
       st = mfree_system_create_fluid_ranks(ctx, rank == last ? 3 : 2, r.n_owned, r.n_ghost, ids, width,
                                            mfree_halo_exchange_callback, mfree_halo_allgather, r.halo, &sys);
-      CHECK(same_status(st, "dimensions") == MFREE_ERR_ARG && !sys, "disagreeing dimensions: status %d", (int)st);
+      CHECK(mpitest_same_status(st, "dimensions") == MFREE_ERR_ARG && !sys, "disagreeing dimensions: status %d", (int)st);
       CHECK(strstr(mpifluid_error(ctx), "ranks disagree on the dimension"), "message \"%s\"",
             mpifluid_error(ctx));
       st = mfree_system_create_fluid_ranks(ctx, 2, r.n_owned, r.n_ghost, ids, rank == last ? 2 * width : width,
                                            mfree_halo_exchange_callback, mfree_halo_allgather, r.halo, &sys);
-      CHECK(same_status(st, "width") == MFREE_ERR_ARG && !sys, "disagreeing widths: status %d", (int)st);
+      CHECK(mpitest_same_status(st, "width") == MFREE_ERR_ARG && !sys, "disagreeing widths: status %d", (int)st);
     }
     st = mfree_system_create_fluid_ranks(ctx, 2, r.n_owned, r.n_ghost, ids, rank == last ? NAN : width,
                                          mfree_halo_exchange_callback, mfree_halo_allgather, r.halo, &sys);
-    CHECK(same_status(st, "NaN width") == MFREE_ERR_ARG && !sys, "NaN width: status %d", (int)st);
+    CHECK(mpitest_same_status(st, "NaN width") == MFREE_ERR_ARG && !sys, "NaN width: status %d", (int)st);
     /* local failures: no callbacks, no output (this rank alone; every rank here) */
     CHECK(mfree_system_create_fluid_ranks(ctx, 2, r.n_owned, r.n_ghost, ids, width, NULL, mfree_halo_allgather,
                                           r.halo, &sys) == MFREE_ERR_NULL,
