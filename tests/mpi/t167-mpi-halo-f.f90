@@ -16,6 +16,7 @@ program t167_mpi_halo_f
   use mpi
   use mfree
   use mfree_mpi
+  use mpitest_f
   implicit none
   integer, parameter :: per_rank = 50
   type(mfree_context) :: ctx
@@ -25,7 +26,7 @@ program t167_mpi_halo_f
   integer(c_int32_t) :: no, ng, nn
   integer(c_int64_t) :: off, total, ns, nr
   integer(c_int) :: st_
-  integer :: ierr, rank, nprocs, k, bad, allbad, last
+  integer :: rank, nprocs, k, last
   real(c_double) :: n
   integer(c_int64_t), allocatable :: short_ids(:)
   real(c_double), allocatable :: h(:), f(:, :)
@@ -35,10 +36,7 @@ program t167_mpi_halo_f
   real(c_double), allocatable :: hs(:), vs(:)
   character(len=16) :: who
 
-  call MPI_Init(ierr)
-  call MPI_Comm_rank(MPI_COMM_WORLD, rank, ierr)
-  call MPI_Comm_size(MPI_COMM_WORLD, nprocs, ierr)
-  bad = 0
+  call mpitest_start(rank, nprocs)
   n = real(per_rank * nprocs, c_double)
   call check(mfree_context_create(ctx) == MFREE_SUCCESS, 'context')
   call check(mfree_halo_create(ctx, MPI_COMM_WORLD, 1_c_int32_t, halo) == MFREE_SUCCESS, 'create')
@@ -200,20 +198,6 @@ program t167_mpi_halo_f
 
   call check(mfree_halo_destroy(halo) == MFREE_SUCCESS, 'destroy')
   call check(mfree_context_destroy(ctx) == MFREE_SUCCESS, 'context destroy')
-  call MPI_Allreduce(bad, allbad, 1, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD, ierr)
-  if (rank == 0) write (*, '(a,i0,a)') 't167-mpi-halo-f: ', allbad, ' failed checks'
-  call MPI_Finalize(ierr)
-  if (allbad /= 0) stop 1
-
-contains
-
-  subroutine check(cond, what)
-    logical, intent(in) :: cond
-    character(len=*), intent(in) :: what
-    if (.not. cond) then
-      write (*, '(a,i0,a,a)') 'rank ', rank, ': check failed: ', what
-      bad = bad + 1
-    end if
-  end subroutine check
+  call mpitest_finish('t167-mpi-halo-f')
 
 end program t167_mpi_halo_f

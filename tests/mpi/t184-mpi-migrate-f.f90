@@ -11,6 +11,7 @@ program t184_mpi_migrate_f
   use mpi
   use mfree
   use mfree_mpi
+  use mpitest_f
   implicit none
   integer, parameter :: per_rank = 40
   type(mfree_context) :: ctx
@@ -21,14 +22,11 @@ program t184_mpi_migrate_f
   integer(c_int32_t) :: no, n_new, cap, n_owned
   integer(c_int64_t) :: ns, nr
   integer(c_int) :: st_
-  integer :: ierr, rank, nprocs, k, bad, allbad, last, total
+  integer :: ierr, rank, nprocs, k, last, total
   real(c_double) :: n
   character(len=16) :: who
 
-  call MPI_Init(ierr)
-  call MPI_Comm_rank(MPI_COMM_WORLD, rank, ierr)
-  call MPI_Comm_size(MPI_COMM_WORLD, nprocs, ierr)
-  bad = 0
+  call mpitest_start(rank, nprocs)
   last = nprocs - 1
   write (who, '(a,i0,a)') 'rank ', last, ':'
   n = real(per_rank * nprocs, c_double)
@@ -91,10 +89,7 @@ program t184_mpi_migrate_f
 
   call check(mfree_migration_destroy(mig) == MFREE_SUCCESS, 'destroy')
   call check(mfree_context_destroy(ctx) == MFREE_SUCCESS, 'context destroy')
-  call MPI_Allreduce(bad, allbad, 1, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD, ierr)
-  if (rank == 0) write (*, '(a,i0,a)') 't184-mpi-migrate-f: ', allbad, ' failed checks'
-  call MPI_Finalize(ierr)
-  if (allbad /= 0) stop 1
+  call mpitest_finish('t184-mpi-migrate-f')
 
 contains
 
@@ -116,14 +111,5 @@ contains
     call MPI_Allreduce(int(no), total, 1, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD, ierr)
     call check(total == per_rank * nprocs, what//': the counts sum to the total')
   end subroutine fill_check
-
-  subroutine check(cond, what)
-    logical, intent(in) :: cond
-    character(len=*), intent(in) :: what
-    if (.not. cond) then
-      write (*, '(a,i0,a,a)') 'rank ', rank, ': check failed: ', what
-      bad = bad + 1
-    end if
-  end subroutine check
 
 end program t184_mpi_migrate_f

@@ -17,6 +17,7 @@ program t193_mpi_system_sizes_f
   use mpi
   use mfree
   use mfree_mpi
+  use mpitest_f
   implicit none
   integer, parameter :: nx = 6, nz = 8
   real(c_double), parameter :: d = 0.01_c_double, rho0 = 1000, sentinel = -12345.5_c_double
@@ -30,13 +31,10 @@ program t193_mpi_system_sizes_f
   type(c_funptr) :: exchange, allgather
   integer(c_int32_t) :: no, ng, neq
   integer(c_int64_t) :: nsteps
-  integer :: ierr, rank, nprocs, k, i, j, turn, badrank, nbad, allbad
+  integer :: ierr, rank, nprocs, k, i, j, turn, badrank
   character(len=16) :: who
 
-  call MPI_Init(ierr)
-  call MPI_Comm_rank(MPI_COMM_WORLD, rank, ierr)
-  call MPI_Comm_size(MPI_COMM_WORLD, nprocs, ierr)
-  nbad = 0
+  call mpitest_start(rank, nprocs)
   call check(mfree_context_create(ctx) == MFREE_SUCCESS, 'context')
   call check(mfree_halo_create(ctx, MPI_COMM_WORLD, 2_c_int32_t, halo) == MFREE_SUCCESS, 'halo')
   ! this rank's slab: columns rank * nx .. rank * nx + nx - 1 of an (nx nprocs) x nz lattice
@@ -173,21 +171,9 @@ program t193_mpi_system_sizes_f
   call check(mfree_system_destroy(sys) == MFREE_SUCCESS, 'destroy')
   call check(mfree_halo_destroy(halo) == MFREE_SUCCESS, 'halo destroy')
   call check(mfree_context_destroy(ctx) == MFREE_SUCCESS, 'context destroy')
-  call MPI_Allreduce(nbad, allbad, 1, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD, ierr)
-  if (rank == 0) write (*, '(a,i0,a)') 't193-mpi-system-sizes-f: ', allbad, ' failed checks'
-  call MPI_Finalize(ierr)
-  if (allbad /= 0) stop 1
+  call mpitest_finish('t193-mpi-system-sizes-f')
 
 contains
-
-  subroutine check(cond, what)
-    logical, intent(in) :: cond
-    character(len=*), intent(in) :: what
-    if (.not. cond) then
-      write (*, '(a,i0,a,a)') 'rank ', rank, ': check failed: ', what
-      nbad = nbad + 1
-    end if
-  end subroutine check
 
   !> st is want on every rank, and this rank's message names the faulty rank and why
   !> (why empty: only the status is checked).
