@@ -45,9 +45,12 @@
  * same fit through Martin & Moyce's points there, and max_rel_dev the largest
  * |Z - Z_exp| / Z_exp over the data points with 1 <= T <= 3 (Z linearly interpolated in
  * T; -1 when no data file), t_end the T reached and density_range the densities' extremes
- * at the output times (every 0.05 in T); "max_rel_dev_wide" and "compared_wide" the same
- * over 0.5 <= T <= 3, and "time_offset":[mean,min,max] the lag of the experiment there:
- * T_exp minus the T at which the simulated front reaches Z_exp, point by point; the
+ * at the output times (every 0.05 in T); "density_range_steps":[min,max] the extremes over
+ * every accepted step (t = 0 included), which also see what happens between two outputs,
+ * and "density_lowest":[T,particle,x,z] where that minimum was (docs/fluid.md: the no-slip
+ * run's low density); "max_rel_dev_wide" and "compared_wide" the same over 0.5 <= T <= 3,
+ * and "time_offset":[mean,min,max] the lag of the experiment there: T_exp minus the T at
+ * which the simulated front reaches Z_exp, point by point; the
  * settings as "a", "nx", "cfl", "mu", "shepard_condition", "lumped_mass_step", "no_slip",
  * "diffusion", "scheme".
  * With --vtu DIR (or --vtu-every T): dam_break.pvd indexing dam_break_NNNN.vtu
@@ -170,11 +173,13 @@ int main(int argc, char **argv) {
   mfree_status_t run = MFREE_SUCCESS;
   ex_progress_t prog;
   ex_progress_init(&prog, o.run.quiet, 0.0, o.t_end / tscale);
+  fc_density_watch_t watch;
+  fc_density_watch_init(&watch, y, n, 2, t, &prog);
   const double clock0 = fc_seconds();
   for (int io = 0; io <= nout; ++io) {
     const double T_target = io * o.out_dt;
     if (io > 0) {
-      run = fc_integrate(sys, (mfree_integrator_t)o.scheme, y, &t, T_target / tscale, o.cfl, &prog, &steps);
+      run = fc_integrate_watched(sys, (mfree_integrator_t)o.scheme, y, &t, T_target / tscale, o.cfl, &watch, &steps);
       if (run != MFREE_SUCCESS) break;
     }
     double xmax = -1e300, xfloor = -1e300;
@@ -216,6 +221,10 @@ int main(int argc, char **argv) {
   fc_json_num(&js, "mass_rel_error", mass_err);
   const double rho_range[2] = {rho_lo, rho_hi};
   fc_json_table(&js, "density_range", 2, 1, rho_range);
+  const double rho_steps[2] = {watch.lo, watch.hi};
+  fc_json_table(&js, "density_range_steps", 2, 1, rho_steps);
+  const double lowest[4] = {watch.t_lo * tscale, watch.q_lo, watch.x_lo[0], watch.x_lo[1]};
+  fc_json_table(&js, "density_lowest", 4, 1, lowest);
   fc_json_int(&js, "lumped_mass_step", o.lumped_step);
   fc_json_int(&js, "acoustic_step", o.acoustic_step);
   fc_json_int(&js, "no_slip", o.no_slip);
@@ -224,8 +233,10 @@ int main(int argc, char **argv) {
   if (!o.run.json_stdout) {
     printf("dam break: a = %g m, %d particles, %lld steps, %.1f s\n", a, n, (long long)steps, wall);
     fc_dam_print(nf, fT, fZ, &cmp);
-    printf("mass: relative error %.2e; densities %.1f to %.1f at the output times; output in %s\n", mass_err,
-           rho_lo, rho_hi, out_dir);
+    printf("mass: relative error %.2e; densities %.1f to %.1f at the output times, %.1f to %.1f over every step\n"
+           "(the lowest: particle %d at T = %.4f, x = %.5f m, z = %.5f m); output in %s\n",
+           mass_err, rho_lo, rho_hi, watch.lo, watch.hi, watch.q_lo, watch.t_lo * tscale, watch.x_lo[0],
+           watch.x_lo[1], out_dir);
   }
   mfree_system_destroy(&sys);
   mfree_context_destroy(&ctx);

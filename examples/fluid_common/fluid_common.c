@@ -435,13 +435,48 @@ void fc_json_run(fc_json_t *j, mfree_status_t run, const char *msg, double t, lo
   fc_json_int(j, "particles", n);
 }
 
-mfree_status_t fc_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t, double t_end,
-                            double cfl, ex_progress_t *p, int64_t *steps) {
+static mfree_status_t integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t, double t_end,
+                                double cfl, mfree_progress_fn fn, void *user, ex_progress_t *p, int64_t *steps) {
   int64_t k = 0;
-  const mfree_status_t st = mfree_system_integrate(sys, scheme, y, t, t_end, cfl, 0.0, ex_progress, p, &k);
+  const mfree_status_t st = mfree_system_integrate(sys, scheme, y, t, t_end, cfl, 0.0, fn, user, &k);
   *steps += k;
   ex_progress_steps(p, k);
   return st;
+}
+
+mfree_status_t fc_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t, double t_end,
+                            double cfl, ex_progress_t *p, int64_t *steps) {
+  return integrate(sys, scheme, y, t, t_end, cfl, ex_progress, p, p, steps);
+}
+
+static void density_scan(fc_density_watch_t *w, double t) {
+  const double *rho = w->y + 2 * (size_t)w->dim * w->n;
+  for (int q = 0; q < w->n; ++q) {
+    if (rho[q] > w->hi) w->hi = rho[q];
+    if (rho[q] < w->lo) {
+      w->lo = rho[q];
+      w->t_lo = t;
+      w->q_lo = q;
+      for (int c = 0; c < w->dim; ++c) w->x_lo[c] = w->y[(size_t)w->dim * q + c];
+    }
+  }
+}
+
+void fc_density_watch_init(fc_density_watch_t *w, const double *y, int n, int dim, double t, ex_progress_t *p) {
+  *w = (fc_density_watch_t){y, n, dim, INFINITY, -INFINITY, t, {0.0, 0.0, 0.0}, -1, p};
+  density_scan(w, t);
+}
+
+/* mfree_progress_fn: reads the state only, as the integrator allows. */
+static int32_t density_progress(void *user, int64_t step, double t, double dt) {
+  fc_density_watch_t *w = user;
+  density_scan(w, t);
+  return ex_progress(w->progress, step, t, dt);
+}
+
+mfree_status_t fc_integrate_watched(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t,
+                                    double t_end, double cfl, fc_density_watch_t *w, int64_t *steps) {
+  return integrate(sys, scheme, y, t, t_end, cfl, density_progress, w, w->progress, steps);
 }
 
 double fc_seconds(void) {

@@ -179,6 +179,23 @@ void fc_json_run(fc_json_t *j, mfree_status_t run, const char *msg, double t, lo
  * *steps. */
 mfree_status_t fc_integrate(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t, double t_end,
                             double cfl, ex_progress_t *p, int64_t *steps);
+/* The densities over every accepted step of a run, the initial state included: the
+ * output times alone can miss a short excursion (a period-two mode of the explicit step
+ * growing and dying between two outputs, docs/fluid.md). y is the state integrated, of
+ * n particles in dim dimensions; lo and hi the extremes, and at the lowest: the time t_lo,
+ * the particle q_lo and its position x_lo. */
+typedef struct {
+  const double *y;
+  int n, dim;
+  double lo, hi, t_lo, x_lo[3];
+  int q_lo;
+  ex_progress_t *progress; /* drawn after each scan */
+} fc_density_watch_t;
+/* Start the watch at the state y at time t (scanned now). */
+void fc_density_watch_init(fc_density_watch_t *w, const double *y, int n, int dim, double t, ex_progress_t *p);
+/* fc_integrate with the densities scanned after every accepted step. */
+mfree_status_t fc_integrate_watched(mfree_system_t *sys, mfree_integrator_t scheme, double *y, double *t,
+                                    double t_end, double cfl, fc_density_watch_t *w, int64_t *steps);
 /* Seconds of a monotonic clock, for the summaries' wall_seconds. */
 double fc_seconds(void);
 
