@@ -1977,11 +1977,15 @@ MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
  * (2 dim + 1) n (docs/fluid.md, "Inflow and outflow"). Dormant particles keep their entries
  * in y, get zero rates and take no part in the nodes, the checks or the step. The native
  * integrator updates the boundaries between steps; a host integrating with SUNDIALS calls
- * mfree_system_update_open_boundaries between its windows. The fluid on ranks has no open
- * boundaries (its dormant pool would be spread over the ranks, an injected particle needs
- * an owner near its gate, a removed one leaves ghosts behind): the setters and the update
- * return MFREE_ERR_UNSUPPORTED there with a message that says so, and every owned particle
- * is active; run open boundaries in one process. */
+ * mfree_system_update_open_boundaries between its windows. On ranks
+ * (mfree_system_create_fluid_ranks, docs/fluid-ranks.md) the capacity is every rank's
+ * particles, global ids 0 .. N - 1, particle i of the one-process fluid being global id i:
+ * every rank sets the same active count, gates and planes (the update and the integration
+ * agree on them: else MFREE_ERR_ARG), the update is collective, injected particles take
+ * the lowest dormant ids as in one process and belong to the rank that owns the id, a halo
+ * rebuild callback is required (MFREE_ERR_STATE), and the states, the right-hand side and
+ * the integration are bitwise the one-process fluid's. The matrices, interpolated
+ * velocities and wall force of such a system return MFREE_ERR_UNSUPPORTED on ranks. */
 
 /** States of a fluid's particles (mfree_system_get_active). */
 typedef enum {
@@ -1995,7 +1999,8 @@ typedef enum {
  * Only before the boundaries' first update (an integration or
  * mfree_system_update_open_boundaries); else MFREE_ERR_STATE.
  * @param[in] sys      a fluid system
- * @param[in] nactive  0 <= nactive <= n (else MFREE_ERR_ARG)
+ * @param[in] nactive  0 <= nactive <= n (else MFREE_ERR_ARG; on ranks n is every rank's
+ *                     particles, checked at the first update)
  * @return MFREE_SUCCESS, or a failure named with the parameters
  */
 MFREE_API mfree_status_t mfree_system_set_active(mfree_system_t *sys, int32_t nactive);
@@ -2049,8 +2054,9 @@ MFREE_API mfree_status_t mfree_system_set_outflow(mfree_system_t *sys, int32_t k
  * before integrating and between windows (a window longer than spacing / (2 speed) lets
  * rows join late, their mass counted all the same), and restarts its integrator there.
  * @param[in]     sys  a fluid system
+ * On ranks collective: every rank returns the same status.
  * @param[in]     t    time (finite, else MFREE_ERR_ARG)
- * @param[in,out] y    state of length (2 dim + 1) n
+ * @param[in,out] y    state of length (2 dim + 1) n (on ranks the owned particles')
  * @return MFREE_SUCCESS; MFREE_FAIL_CAPACITY when the dormant pool cannot supply a row
  *         (nothing changed; the message names the gate and the counts); MFREE_ERR_STATE
  *         when the masses or the smoothing length are not set
@@ -2350,7 +2356,7 @@ MFREE_API mfree_status_t mfree_system_move_particles(mfree_system_t *sys, int32_
  * still takes part instead of returning while the others wait. The next call on sys of
  * those that are collective on ranks (mfree_system_rhs, _integrate, _assemble_mass,
  * _assemble_interpolation, _apply_mass, _get_velocity, _get_wall_force, _get_stress,
- * _move_particles) takes the fault: on this rank it reads and writes none of its arrays
+ * _move_particles, _update_open_boundaries) takes the fault: on this rank it reads and writes none of its arrays
  * (they may be NULL, or any size); on ranks it takes part in the call's first agreement,
  * and every rank returns status with this rank's message ("rank R: <message>"), nothing
  * changed, as for a NULL argument; in one process, or where the call is local on ranks

@@ -352,9 +352,11 @@ mfree_status_t mfree_system_set_outflow(mfree_system_t *sys, int32_t k, const do
 
 mfree_status_t mfree_system_update_open_boundaries(mfree_system_t *sys, double t, double *y) {
   return mfree::with_handle(sys, "mfree_system_update_open_boundaries", [&](mfree::System &base) {
+    CollectiveArgs args(sys);  // (collective on ranks)
     auto &f = kind<mfree::FluidSystem>(base, "open boundaries (not a fluid)");
-    MFREE_REQUIRE(y || f.size() == 0, MFREE_ERR_NULL, "y is NULL");
-    return mfree::finish(sys->ctx, "mfree_system_update_open_boundaries", f.update_open(t, y));
+    args.require(y || f.neq() == 0, MFREE_ERR_NULL, "y is NULL");
+    const mfree::Report rep = f.update_open(t, args.stand_in(y, f.neq()));
+    return args.done(mfree::finish(sys->ctx, "mfree_system_update_open_boundaries", rep));
   });
 }
 

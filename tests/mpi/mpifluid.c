@@ -63,6 +63,45 @@ mfree_status_t damb_configure(const damb_t *b, mfree_system_t *sys) {
   return st;
 }
 
+/* The open channel (mpifluid_channel, mpifluid_open). */
+static const double kChanU = 1.0, kChanD = 0.01, kChanW = 0.06, kChanC0 = 10.0, kChanOut = 0.155;
+
+void mpifluid_channel(damb_t *b, int n) {
+  memset(b, 0, sizeof *b);
+  b->n = n;
+  b->a = 1.0;
+  b->d = kChanD;
+  b->h = 1.5 * kChanD;
+  b->kappa = kRho0 * kChanC0 * kChanC0 / kGamma;
+  b->y = calloc(5 * (size_t)n, sizeof *b->y);
+  b->m = malloc((size_t)n * sizeof *b->m);
+  for (int i = 0; i < n; ++i) {
+    b->y[2 * i] = -1.0 - i * kChanD; /* dormant: anywhere, here upstream */
+    b->y[2 * i + 1] = 0.5 * kChanW;
+    b->y[4 * (size_t)n + i] = kRho0;
+    b->m[i] = kRho0 * kChanD * kChanD;
+  }
+  const double ds = kChanD / 3.0;
+  const int per = (int)ceil(0.4 / ds) + 1;
+  b->wx = malloc(4 * sizeof(double) * (size_t)per);
+  b->wn = malloc(4 * sizeof(double) * (size_t)per);
+  for (int side = 0; side < 2; ++side)
+    for (int k = 0; k < per; ++k, ++b->nwall) {
+      b->wx[2 * b->nwall] = -0.1 + k * ds;
+      b->wx[2 * b->nwall + 1] = side ? kChanW + 0.5 * kChanD : -0.5 * kChanD;
+      b->wn[2 * b->nwall] = 0.0;
+      b->wn[2 * b->nwall + 1] = side ? -1.0 : 1.0;
+    }
+}
+
+mfree_status_t mpifluid_open(mfree_system_t *sys, double speed) {
+  const double o[2] = {0.0, 0.0}, e[2] = {0.0, kChanW}, nrm[2] = {1.0, 0.0}, p[2] = {kChanOut, 0.0};
+  mfree_status_t st = mfree_system_set_active(sys, 0);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_inflow(sys, 0, o, e, nrm, speed > 0.0 ? speed : kChanU, kRho0, kChanD);
+  if (st == MFREE_SUCCESS) st = mfree_system_set_outflow(sys, 0, p, nrm);
+  return st;
+}
+
 void mpifluid_slabs(const damb_t *b, int size, int *owner) {
   for (int i = 0; i < b->n; ++i) {
     const int p = (int)(b->y[2 * i] / b->a * size);

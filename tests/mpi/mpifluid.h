@@ -27,6 +27,16 @@ void damb_free(damb_t *b);
  * the walls (003 Sect. 6.2). */
 mfree_status_t damb_configure(const damb_t *b, mfree_system_t *sys);
 
+/* An open channel in the same structure (t195, t198): n particles, all dormant, spread
+ * far upstream (x = -1 - i d, d = 0.01 m), walls along y = -d/2 and y = W + d/2 (W = 0.06 m,
+ * spacing d/3), h = 1.5 d, sound speed 10 m/s; damb_configure sets the rest (gravity
+ * too). */
+void mpifluid_channel(damb_t *b, int n);
+/* The channel's open boundaries on sys: every particle dormant, an inflow gate of width W
+ * at x = 0 (six points, spacing d, water at speed m/s, or 1 m/s for speed <= 0) and an
+ * outflow plane at x = 0.155 m. */
+mfree_status_t mpifluid_open(mfree_system_t *sys, double speed);
+
 /* owner[i] = the rank of particle i by size slabs of the water block along x (the
  * decomposition most fluid tests on ranks use). */
 void mpifluid_slabs(const damb_t *b, int size, int *owner);

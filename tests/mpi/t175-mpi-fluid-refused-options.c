@@ -1,9 +1,7 @@
-/* The one-process fluid's options that the fluid on ranks refuses (label mpi), on 1, 2 and
- * 4 ranks: the open boundaries (active particles, an inflow gate, an outflow plane, their
- * update) return MFREE_ERR_UNSUPPORTED on every rank with a message that says why, and
- * leave the system as it was; dummy wall particles are taken (t176 runs them), and removed
- * again (count 0) they leave nothing behind: afterwards the system takes 40 leap-frog
- * steps to the same bits as a system that never saw any of these. The active-particle
+/* Options of the one-process fluid on ranks (label mpi), on 1, 2 and 4 ranks: dummy wall
+ * particles are taken (t176 runs them), and removed again (count 0) they leave nothing
+ * behind: afterwards the system takes 40 leap-frog steps to the same bits as a system that
+ * never saw any of these (open boundaries on ranks: t195, t198). The active-particle
  * query answers for the owned particles (all active), not for the ghosts. The acoustic
  * step is taken (t179 runs it); set on one rank only, the integration returns
  * MFREE_ERR_ARG on every rank (its power iteration is collective) and takes no step. */
@@ -32,15 +30,6 @@ int main(int argc, char **argv) {
   for (int k = 0; k < ND; ++k) xd[2 * k] = (k + 0.5) * b.d, xd[2 * k + 1] = -0.5 * b.d;
   expect(ctx, mfree_system_set_dummy_particles(r.sys, ND, xd, &vol, 0), MFREE_SUCCESS, NULL, "dummy particles");
   expect(ctx, mfree_system_set_dummy_particles(r.sys, 0, NULL, NULL, 0), MFREE_SUCCESS, NULL, "no dummy particles");
-  expect(ctx, mfree_system_set_active(r.sys, r.n_owned), MFREE_ERR_UNSUPPORTED, "open boundaries", "active count");
-  const double origin[2] = {0.0, 0.5 * b.a}, edge[2] = {0.0, 0.5 * b.a}, normal[2] = {1.0, 0.0};
-  expect(ctx, mfree_system_set_inflow(r.sys, 0, origin, edge, normal, 0.5, 1000.0, b.d), MFREE_ERR_UNSUPPORTED,
-         "open boundaries", "inflow gate");
-  const double point[2] = {4.0 * b.a, 0.0};
-  expect(ctx, mfree_system_set_outflow(r.sys, 0, point, normal), MFREE_ERR_UNSUPPORTED, "open boundaries",
-         "outflow plane");
-  expect(ctx, mfree_system_update_open_boundaries(r.sys, 0.0, r.y), MFREE_ERR_UNSUPPORTED, "on ranks",
-         "open boundaries' update");
   expect(ctx, mfree_system_set_acoustic_step(r.sys, 1), MFREE_SUCCESS, NULL, "acoustic step");
   expect(ctx, mfree_system_set_acoustic_step(r.sys, 0), MFREE_SUCCESS, NULL, "acoustic step off");
   if (size > 1) {

@@ -50,6 +50,8 @@ class Collective {
   int size() const;
   // The pointer the host gave with the callbacks (for its other callbacks).
   void *user() const { return user_; }
+  // The host's all-gather (a system over a subset of the items relays it unchanged).
+  mfree_allgather_fn allgather_fn() const { return ag_; }
   // The agreed outcome: the lowest rank holding an error (negative status) or, without
   // one, the lowest rank holding a failure (positive status); its status and "rank R:
   // <its message>". statuses: every rank's status, in rank order; mine: this rank's.

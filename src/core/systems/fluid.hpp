@@ -79,8 +79,9 @@ class FluidSystem : public System {
   void set_inflow(int32_t gate, const double *origin, const double *edges, const double *normal, double speed,
                   double density, double spacing);
   void set_outflow(int32_t k, const double *point, const double *normal);
-  Report update_open(double t, double *y);
-  int32_t active_states(int32_t n, int32_t *state) const;  // the active count; states if n > 0
+  virtual Report update_open(double t, double *y);
+  // The active count (on ranks the owned ones); states if n > 0.
+  virtual int32_t active_states(int32_t n, int32_t *state) const;
   void inflow_totals(int32_t gate, int64_t &count, double &mass) const;
   void outflow_totals(int32_t k, int64_t &count, double &mass) const;
   void options_changed() {  // after every setter
@@ -329,7 +330,14 @@ class FluidSystem : public System {
   Report open_wall_force(const double *y, double *total, int32_t nwall, double *per_wall);
   Report open_integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                         mfree_progress_fn progress, void *user, int64_t &nsteps);
+  void open_options(FluidSystem &in, const double *r0, const double *m) const;  // this system's, on in
+  // The decisions of an update (the counters, the state of every particle of the capacity)
+  // from the crossings out, in increasing particle order; fresh: the particles it
+  // activated, with their gates.
+  Report open_plan(double t, const std::vector<OutflowCrossing> &out, std::vector<std::pair<int32_t, int32_t>> &fresh);
+  void buffer_state(int32_t i, double t, double *x, double *v, double *rho) const;  // buffer particle i's
   void place_buffer(double t, double *y, bool compact) const;  // imposed state of the buffers
+  int32_t crossed_plane(const double *x) const;                // the first outflow x is past, or -1
   bool open_crossed(const double *y, bool compact) const;      // a fluid particle past an outflow
   static int32_t open_progress(void *u, int64_t step, double t, double dt);  // integrate's, per step
 };

@@ -21,6 +21,15 @@ namespace mfree {
 FluidOpen::FluidOpen() = default;
 FluidOpen::~FluidOpen() = default;
 
+void FluidOpen::index_active() {
+  active.clear();
+  for (size_t i = 0; i < state.size(); ++i)
+    if (state[i] != kDormant) active.push_back(static_cast<int32_t>(i));
+  slot.assign(state.size(), -1);
+  for (size_t a = 0; a < active.size(); ++a) slot[active[a]] = static_cast<int32_t>(a);
+  dirty = true;
+}
+
 namespace {
 
 double dot(const double *a, const double *b, int dim) {
@@ -39,16 +48,6 @@ void check_unit(const double *nrm, int dim, const char *what) {
   if (!(std::fabs(len - 1.0) < 1e-6)) throw Error(MFREE_ERR_ARG, std::string(what) + " is not a unit vector");
 }
 
-// The active list and the capacity -> compact map from the states.
-void index_active(FluidOpen &o, std::vector<int32_t> &slot) {
-  o.active.clear();
-  for (size_t i = 0; i < o.state.size(); ++i)
-    if (o.state[i] != kDormant) o.active.push_back(static_cast<int32_t>(i));
-  slot.assign(o.state.size(), -1);
-  for (size_t a = 0; a < o.active.size(); ++a) slot[o.active[a]] = static_cast<int32_t>(a);
-  o.dirty = true;
-}
-
 // A compact state or rate of the active particles written into the capacity's layout.
 void scatter_state(const std::vector<int32_t> &active, int dim, int32_t n, const double *src, double *dst) {
   const size_t na = active.size(), nd = static_cast<size_t>(dim) * n, ndc = na * dim;
@@ -65,31 +64,36 @@ void scatter_state(const std::vector<int32_t> &active, int dim, int32_t n, const
 }  // namespace
 
 FluidOpen &FluidSystem::open() {
-  if (on_ranks())
-    throw Error(MFREE_ERR_UNSUPPORTED,
-                "no open boundaries (active particles, inflow gates, outflow planes) for the fluid on ranks: the "
-                "dormant pool would be spread over the ranks, an injected particle needs an owner near its gate and "
-                "its ghosts, a removed one leaves ghosts behind; run them in one process (mfree_system_create_fluid)");
   if (!open_) {
     auto o = std::make_unique<FluidOpen>();
-    o->state.assign(n_, kFluid);
-    o->gate_of.assign(n_, -1);
-    o->row_of.assign(n_, 0);
-    o->base.assign(static_cast<size_t>(n_) * dim_, 0.0);
-    index_active(*o, o->slot);
+    // on ranks the per-particle fields are per global id, set up at the first collective call
+    if (!on_ranks()) {
+      o->state.assign(n_, kFluid);
+      o->gate_of.assign(n_, -1);
+      o->row_of.assign(n_, 0);
+      o->base.assign(static_cast<size_t>(n_) * dim_, 0.0);
+      o->index_active();
+    }
     open_ = std::move(o);
   }
   return *open_;
 }
 
 void FluidSystem::set_active(int32_t nactive) {
+  if (on_ranks()) {  // the capacity is every rank's items: checked at the first collective call
+    if (nactive < 0) throw Error(MFREE_ERR_ARG, "active count " + std::to_string(nactive) + " is negative");
+    if (open_ && open_->updated)
+      throw Error(MFREE_ERR_STATE, "the active particles are set before the open boundaries' first update");
+    open().pending_active = nactive;
+    return;
+  }
   if (nactive < 0 || nactive > n_)
     throw Error(MFREE_ERR_ARG, "active count " + std::to_string(nactive) + " outside [0, " + std::to_string(n_) + "]");
   if (open_ && open_->updated)
     throw Error(MFREE_ERR_STATE, "the active particles are set before the open boundaries' first update");
   FluidOpen &o = open();
   for (int32_t i = 0; i < n_; ++i) o.state[i] = i < nactive ? kFluid : kDormant;
-  index_active(o, o.slot);
+  o.index_active();
 }
 
 void FluidSystem::set_inflow(int32_t gate, const double *origin, const double *edges, const double *normal,
@@ -186,6 +190,17 @@ void FluidSystem::outflow_totals(int32_t k, int64_t &count, double &mass) const 
   mass = open_->outflows[k].mass_out;
 }
 
+void FluidSystem::buffer_state(int32_t i, double t, double *x, double *v, double *rho) const {
+  const FluidOpen &o = *open_;
+  const InflowGate &g = o.gates[o.gate_of[i]];
+  const double s = g.U * (t - g.t0) - (static_cast<double>(o.row_of[i]) + 0.5) * g.d;
+  for (int c = 0; c < dim_; ++c) {
+    x[c] = o.base[static_cast<size_t>(i) * dim_ + c] + s * g.nrm[c];
+    v[c] = g.U * g.nrm[c];
+  }
+  *rho = g.rho;
+}
+
 void FluidSystem::place_buffer(double t, double *y, bool compact) const {
   const FluidOpen &o = *open_;
   const int dim = dim_;
@@ -194,13 +209,19 @@ void FluidSystem::place_buffer(double t, double *y, bool compact) const {
     for (const auto &row : g.rows)
       for (int32_t i : row) {
         const size_t j = compact ? static_cast<size_t>(o.slot[i]) : static_cast<size_t>(i);
-        const double s = g.U * (t - g.t0) - (static_cast<double>(o.row_of[i]) + 0.5) * g.d;
-        for (int c = 0; c < dim; ++c) {
-          y[j * dim + c] = o.base[static_cast<size_t>(i) * dim + c] + s * g.nrm[c];
-          y[nd + j * dim + c] = g.U * g.nrm[c];
-        }
-        y[2 * nd + j] = g.rho;
+        buffer_state(i, t, y + j * dim, y + nd + j * dim, y + 2 * nd + j);
       }
+}
+
+int32_t FluidSystem::crossed_plane(const double *x) const {
+  const FluidOpen &o = *open_;
+  for (size_t k = 0; k < o.outflows.size(); ++k) {
+    const OutflowPlane &p = o.outflows[k];
+    double s = 0.0;
+    for (int c = 0; c < dim_; ++c) s += (x[c] - p.p[c]) * p.nrm[c];
+    if (s > 0.0) return static_cast<int32_t>(k);
+  }
+  return -1;
 }
 
 bool FluidSystem::open_crossed(const double *y, bool compact) const {
@@ -210,12 +231,7 @@ bool FluidSystem::open_crossed(const double *y, bool compact) const {
   for (size_t a = 0; a < o.active.size(); ++a) {
     const int32_t i = o.active[a];
     if (o.state[i] != kFluid) continue;
-    const double *x = y + (compact ? a : static_cast<size_t>(i)) * dim;
-    for (const OutflowPlane &p : o.outflows) {
-      double s = 0.0;
-      for (int c = 0; c < dim; ++c) s += (x[c] - p.p[c]) * p.nrm[c];
-      if (s > 0.0) return true;
-    }
+    if (crossed_plane(y + (compact ? a : static_cast<size_t>(i)) * dim) >= 0) return true;
   }
   return false;
 }
@@ -224,25 +240,33 @@ Report FluidSystem::update_open(double t, double *y) {
   if (!std::isfinite(t)) throw Error(MFREE_ERR_ARG, "time must be finite");
   check_ready();
   FluidOpen &o = open();
-  const int dim = dim_;
-  // The plan first, applied only when the pool holds every particle it needs.
-  std::vector<std::pair<int32_t, int32_t>> out;  // (particle, plane)
+  std::vector<OutflowCrossing> out;
   for (int32_t i : o.active) {
     if (o.state[i] != kFluid) continue;
-    for (size_t k = 0; k < o.outflows.size(); ++k) {
-      const OutflowPlane &p = o.outflows[k];
-      double s = 0.0;
-      for (int c = 0; c < dim; ++c) s += (y[static_cast<size_t>(i) * dim + c] - p.p[c]) * p.nrm[c];
-      if (s > 0.0) {
-        out.push_back({i, static_cast<int32_t>(k)});
-        break;
-      }
-    }
+    const int32_t k = crossed_plane(y + static_cast<size_t>(i) * dim_);
+    if (k >= 0) out.push_back({i, k, mass_[i]});
   }
+  std::vector<std::pair<int32_t, int32_t>> fresh;
+  Report rep = open_plan(t, out, fresh);
+  if (!rep.ok()) return rep;
+  for (const auto &q : fresh) {
+    rho0_[q.first] = o.gates[q.second].rho;
+    mass_[q.first] = o.gates[q.second].mass_each;
+  }
+  place_buffer(t, y, false);
+  return Report();
+}
+
+Report FluidSystem::open_plan(double t, const std::vector<OutflowCrossing> &out,
+                              std::vector<std::pair<int32_t, int32_t>> &fresh) {
+  FluidOpen &o = *open_;
+  const int dim = dim_;
+  const int64_t cap = static_cast<int64_t>(o.state.size());
+  // The plan first, applied only when the pool holds every particle it needs.
   const double R = Kernel::support_radius(kernel_id_, kernel_param_) * h_;
   std::vector<InflowGate> plan = o.gates;  // the gates' counters after the update
   std::vector<int64_t> first_new(plan.size());
-  int64_t dormant = static_cast<int64_t>(n_) - static_cast<int64_t>(o.active.size()) + static_cast<int64_t>(out.size());
+  int64_t dormant = cap - static_cast<int64_t>(o.active.size()) + static_cast<int64_t>(out.size());
   int64_t need = 0;
   for (size_t k = 0; k < plan.size(); ++k) {
     InflowGate &g = plan[k];
@@ -260,18 +284,18 @@ Report FluidSystem::update_open(double t, double *y) {
     if (need > dormant) {
       std::ostringstream s;
       s << "the pool of dormant particles is exhausted at t = " << t << ": gate " << k << " needs a row of "
-        << g.per_row() << " particles, " << dormant - (need - g.per_row())
-        << " are left (capacity " << n_ << ", " << o.active.size() << " active)";
+        << g.per_row() << " particles, " << dormant - (need - g.per_row()) << " are left (capacity " << cap << ", "
+        << o.active.size() << " active)";
       Report rep;
       rep.fail(MFREE_FAIL_CAPACITY, s.str());
       return rep;
     }
   }
   // apply: outflow, then the new rows from the lowest dormant indices, then releases
-  for (auto &q : out) {
-    o.state[q.first] = kDormant;
-    o.outflows[q.second].removed += 1;
-    o.outflows[q.second].mass_out += mass_[q.first];
+  for (const OutflowCrossing &q : out) {
+    o.state[q.i] = kDormant;
+    o.outflows[q.plane].removed += 1;
+    o.outflows[q.plane].mass_out += q.mass;
   }
   int32_t cursor = 0;
   bool changed = !out.empty();
@@ -290,8 +314,7 @@ Report FluidSystem::update_open(double t, double *y) {
           for (int c = 0; c < dim; ++c)
             o.base[static_cast<size_t>(i) * dim + c] = g.o[c] + (j0 + 0.5) / g.m[0] * g.e[0][c] +
                                                        (dim == 3 ? (j1 + 0.5) / g.m[1] * g.e[1][c] : 0.0);
-          rho0_[i] = g.rho;
-          mass_[i] = g.mass_each;
+          fresh.push_back({i, static_cast<int32_t>(k)});
           row.push_back(i);
         }
       g.rows.push_back(std::move(row));
@@ -311,8 +334,7 @@ Report FluidSystem::update_open(double t, double *y) {
   }
   o.gates.swap(plan);
   o.updated = true;
-  if (changed) index_active(o, o.slot);
-  place_buffer(t, y, false);
+  if (changed) o.index_active();
   return Report();
 }
 
@@ -327,35 +349,39 @@ FluidSystem &FluidSystem::open_inner() const {
     m[a] = mass_[o.active[a]];
   }
   auto in = std::make_unique<FluidSystem>(dim_, na);
-  if (na > 0) {
-    in->set_fluid(r0.data(), 1, kappa_, gamma_, mu_);
-    in->set_masses(m.data(), 1);
+  open_options(*in, r0.data(), m.data());
+  o.inner = std::move(in);
+  o.dirty = false;
+  return *o.inner;
+}
+
+void FluidSystem::open_options(FluidSystem &in, const double *r0, const double *m) const {
+  if (in.n_ > 0) {
+    in.set_fluid(r0, 1, kappa_, gamma_, mu_);
+    in.set_masses(m, 1);
   } else {
-    in->kappa_ = kappa_, in->gamma_ = gamma_, in->mu_ = mu_;
-    in->mass_.clear();
+    in.kappa_ = kappa_, in.gamma_ = gamma_, in.mu_ = mu_;
+    in.mass_.clear();
   }
-  in->set_smoothing(h_);
-  in->set_gravity(g_);
-  in->set_lumping(lump_);
+  in.set_smoothing(h_);
+  in.set_gravity(g_);
+  in.set_lumping(lump_);
   if (walls_) {
     const int32_t nw = walls_->size();
     std::vector<double> xw(static_cast<size_t>(nw) * dim_);
     for (int32_t w = 0; w < nw; ++w)
       for (int c = 0; c < dim_; ++c) xw[static_cast<size_t>(w) * dim_ + c] = walls_->x(w, c);
-    in->set_walls(nw, xw.data(), wall_n_.data(), r0_, strength_);
+    in.set_walls(nw, xw.data(), wall_n_.data(), r0_, strength_);
   }
-  if (box_) in->set_box(lo_, hi_);
-  in->set_shepard_condition(shepard_cond_);
-  in->set_approximation(method_, order_, kernel_id_, kernel_param_);
-  if (dummy_.n > 0) in->set_dummy_particles(dummy_.n, dummy_.xd.data(), vol_.data() + n_, 1);
-  in->set_density_diffusion(delta_);
-  in->set_consistent_integration(vci_ ? 1 : 0);
-  in->set_velocity_smoothing(vsmooth_);
-  in->set_lumped_mass_step(lumped_step_ ? 1 : 0);
-  in->set_acoustic_step(acoustic_step_ ? 1 : 0);
-  o.inner = std::move(in);
-  o.dirty = false;
-  return *o.inner;
+  if (box_) in.set_box(lo_, hi_);
+  in.set_shepard_condition(shepard_cond_);
+  in.set_approximation(method_, order_, kernel_id_, kernel_param_);
+  if (dummy_.n > 0) in.set_dummy_particles(dummy_.n, dummy_.xd.data(), vol_.data() + n_, 1);
+  in.set_density_diffusion(delta_);
+  in.set_consistent_integration(vci_ ? 1 : 0);
+  in.set_velocity_smoothing(vsmooth_);
+  in.set_lumped_mass_step(lumped_step_ ? 1 : 0);
+  in.set_acoustic_step(acoustic_step_ ? 1 : 0);
 }
 
 const double *FluidSystem::open_gather(const double *y) const {
@@ -375,8 +401,9 @@ const double *FluidSystem::open_gather(const double *y) const {
 }
 
 Report FluidSystem::open_result(Report r) const {
-  // the inner fluid names its particles by their place among the active ones
-  if (r.ok()) return r;
+  // the inner fluid names its particles by their place among the active ones (on ranks
+  // it names their global ids itself)
+  if (r.ok() || on_ranks()) return r;
   const std::string key = "particle ";
   std::string msg;
   size_t pos = 0;

@@ -54,6 +54,7 @@ struct OutflowPlane {
 struct FluidOpen {
   FluidOpen();
   ~FluidOpen();  // in fluid_inflow.cpp, where FluidSystem is complete
+  void index_active();  // the active list and slot from the states (the inner fluid then dirty)
   std::vector<int8_t> state;       // per particle of the capacity
   std::vector<int32_t> active;     // the active particles in increasing order: the inner fluid's
   std::vector<int32_t> slot;       // per particle: its place in active, -1 if dormant
@@ -68,6 +69,18 @@ struct FluidOpen {
   std::unique_ptr<FluidSystem> inner;
   bool dirty = true;
   std::vector<double> yc, rc;      // compact state and rates
+  // On ranks (fluid_ranks_open.cpp) the fields above are per global id over every rank's
+  // items, ids 0 .. N - 1, and the same on every rank: set up by the first collective
+  // call (`global`); set_active's count waits for it in pending_active (-1: none).
+  bool global = false;
+  int32_t pending_active = -1;
+};
+
+// An active fluid particle past an outflow plane: its index in the capacity (on ranks its
+// global id), the plane, its mass.
+struct OutflowCrossing {
+  int32_t i = 0, plane = 0;
+  double mass = 0.0;
 };
 
 }  // namespace mfree

@@ -301,6 +301,7 @@ Report FluidRanks::named(Report r) const {
 Report FluidRanks::rhs(double t, const double *y, double *ydot) {
   (void)t;
   check_usable();
+  if (open_) return open_rhs_ranks(y, ydot);
   const int D = dim();
   // (a second pass on the ghosts the host rebuilt when the layer was too shallow)
   for (int pass = 0;; ++pass) {
@@ -419,8 +420,9 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
   });
   {
     // (and the acoustic step's setting: its power iteration exchanges and gathers)
-    constexpr int V = 6;
-    const double v[V] = {static_cast<double>(args.status), t, t_end, cfl, dt_max, acoustic_step_ ? 1.0 : 0.0};
+    constexpr int V = 7;
+    const double v[V] = {static_cast<double>(args.status), t, t_end, cfl, dt_max, acoustic_step_ ? 1.0 : 0.0,
+                         open_ ? 1.0 : 0.0};
     const int np = coll_.size();
     std::vector<double> all(static_cast<size_t>(np) * V);
     coll_.allgather(v, V, all.data(), static_cast<int64_t>(all.size()));
@@ -428,7 +430,7 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
     for (int p = 0; p < np; ++p) st[p] = all[V * static_cast<size_t>(p)];
     const Report agreed = coll_.agree_from(st, args);
     if (!agreed.ok()) throw Error(agreed.status, agreed.message);
-    static const char *names[V] = {"", "t", "t_end", "cfl", "dt_max", "the acoustic step"};
+    static const char *names[V] = {"", "t", "t_end", "cfl", "dt_max", "the acoustic step", "open boundaries"};
     for (int p = 1; p < np; ++p)
       for (int k = 1; k < V; ++k)
         if (!(all[V * static_cast<size_t>(p) + k] == all[k])) {
@@ -441,6 +443,7 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
         }
   }
   check_usable();
+  if (open_) return open_integrate_ranks(scheme, y, t, t_end, cfl, dt_max, progress, user, nsteps);
   const int D = dim();
   // node arrays for the current nodes (again after a rebuild of the ghosts)
   auto seat = [&] {
@@ -496,6 +499,8 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
     agreed = agree_min(bad, nullptr, 0);
     if (!agreed.ok()) return agreed;  // y keeps the last good state
     ys_.swap(yn_);
+    const double t_next = (t_end - t <= dt) ? t_end : t + dt;
+    if (place_) place_(t_next, n, gid_.data(), ys_.data());
     const size_t no = static_cast<size_t>(D) * n_own_;
     for (int32_t p = 0; p < n_own_; ++p) {
       const size_t k = owned_[p];
@@ -505,7 +510,7 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
       }
       y[2 * no + p] = ys_[2 * nd + k];
     }
-    t = (t_end - t <= dt) ? t_end : t + dt;
+    t = t_next;
     ++nsteps;
     if (progress && progress(user, nsteps, t, dt)) break;
   }
@@ -531,6 +536,10 @@ Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t ref
     for (int k = 0; k < nwant; ++k) vals[2 + k] = want[k];
     const Report mine = coll_.local([&] {
       if (refuse != MFREE_SUCCESS) throw Error(refuse, why);
+      if (open_)
+        throw Error(MFREE_ERR_UNSUPPORTED, "no matrices, interpolated velocities or wall forces of a fluid with open "
+                                           "boundaries on ranks yet: its right-hand side, integration and pressures "
+                                           "only");
       check_ready();
       return a ? prepare_accel(ys_.data(), false, a, vals[0], vals[1])
                : prepare_rows(ys_.data(), false, vals[0], vals[1]);
@@ -570,7 +579,8 @@ void FluidRanks::lumped_rows(SparseMatrix &M) const {
 // Local: the owned particles' densities and rest densities.
 void FluidRanks::pressure(const double *y, double *p) const {
   const double *rho = y + 2 * static_cast<size_t>(dim()) * n_own_;
-  for (int32_t i = 0; i < n_own_; ++i) p[i] = pressure_at(rho[i], rho0_[owned_[i]]);
+  for (int32_t i = 0; i < n_own_; ++i)
+    p[i] = item_state(i) == kDormant ? 0.0 : pressure_at(rho[i], rho0_[owned_[i]]);
 }
 
 Report FluidRanks::velocity(const double *y, double *vhat) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -48,6 +49,12 @@ class FluidRanks final : public FluidSystem {
   // through the host's move, the halo rebuilt around the n_new particles that arrive, the
   // system re-seated on them and their state written to y (capacity doubles).
   void move_particles(int32_t n_new, mfree_particles_move_fn move, void *move_user, double *y, int64_t capacity);
+
+  // Open boundaries on ranks (fluid_ranks_open.cpp): the capacity is every rank's items,
+  // global ids 0 .. N - 1; the bookkeeping is per global id and the same on every rank,
+  // the update collective; the owned items' states.
+  Report update_open(double t, double *y) override;
+  int32_t active_states(int32_t n, int32_t *state) const override;
 
  protected:
   void to_nodes(HVec<double> &per_particle) const override;
@@ -122,6 +129,38 @@ class FluidRanks final : public FluidSystem {
   bool broken_ = false;
   std::vector<double> mv_x_, mv_data_, mv_rec_, mv_pw_;
   std::vector<int64_t> mv_id_;
+
+  // ---- Open boundaries on ranks (fluid_ranks_open.cpp) ----
+  // The evaluations run on an inner FluidRanks of the active items, whose callbacks relay
+  // to this system's host: its items are this system's active owned items, then its
+  // active ghosts (host order), and an exchange expands them into the host's items.
+  struct OpenLink {
+    FluidRanks *outer = nullptr;
+    std::vector<int32_t> item;  // inner item -> this system's host item
+    int32_t n_own = 0;          // the active owned items among them
+    std::vector<int64_t> ids;   // their global ids
+    std::vector<double> buf;    // the host's items for an exchange
+    std::vector<double> xo;     // this system's owned positions (host order): the halo's rebuild
+  };
+  OpenLink link_;
+  // On an inner system: after each step of integrate, the buffer particles' imposed state
+  // at the new time, at every node (the one-process fluid places them between steps).
+  std::function<void(double t, int32_t n, const int64_t *gid, double *ys)> place_;
+  void open_init();                                  // the bookkeeping per global id (collective)
+  void open_items();                                 // link_ from the current items
+  FluidRanks &open_ranks_inner(const double *y);     // built when dirty (collective)
+  const double *open_ranks_gather(const double *y);  // the inner's owned state
+  void open_ranks_scatter(const double *yc, double *y) const;
+  Report open_rhs_ranks(const double *y, double *ydot);
+  Report open_integrate_ranks(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
+                              mfree_progress_fn progress, void *user, int64_t &nsteps);
+  int8_t item_state(int32_t p) const;  // host item p's state
+  static mfree_status_t open_exchange(void *u, int32_t ncomp, double *field, int64_t ld);
+  static mfree_status_t open_allgather(void *u, const double *in, int64_t n, double *out, int64_t cap,
+                                       int64_t *total);
+  static mfree_status_t open_rebuild(void *u, int32_t n_owned, const double *x, int64_t ld, const int64_t *ids,
+                                     double width, int32_t *n_ghost, const int64_t **all_ids);
+  static int32_t open_progress_ranks(void *u, int64_t step, double t, double dt);
 
   Collective coll_;
   int32_t n_own_ = 0, n_ghost_ = 0;

@@ -177,6 +177,7 @@ void FluidRanks::move_particles(int32_t n_new, mfree_particles_move_fn move, voi
     if (pw_started_) std::copy_n(r + 2 * D + 4, D, &mv_pw_[static_cast<size_t>(p) * D]);
   }
   reseat(n_new, mv_x_.data(), mv_id_.data(), mv_data_.data(), mv_pw_.data());
+  if (open_) open_->dirty = true;  // (the inner system's items are the moved ones)
   const size_t nn = static_cast<size_t>(D) * n_new;
   for (int32_t p = 0; p < n_new; ++p) {
     const double *r = &mv_rec_[static_cast<size_t>(p) * nrec];
