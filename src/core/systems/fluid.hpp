@@ -340,6 +340,14 @@ class FluidSystem : public System {
   int32_t crossed_plane(const double *x) const;                // the first outflow x is past, or -1
   bool open_crossed(const double *y, bool compact) const;      // a fluid particle past an outflow
   static int32_t open_progress(void *u, int64_t step, double t, double dt);  // integrate's, per step
+  // The integration in windows between the gates' releases, updated between them, on the
+  // inner fluid (fluid_inflow.cpp); its three steps, which a fluid on ranks replaces: the
+  // inner fluid with its state in open_->yc, that state back into y, the per-step callback.
+  Report open_windows(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
+                      mfree_progress_fn progress, void *user, int64_t &nsteps);
+  virtual FluidSystem &open_stage(const double *y);
+  virtual void open_unstage(const double *yc, double *y) const;
+  virtual mfree_progress_fn open_stepper() const { return &FluidSystem::open_progress; }
 };
 
 }  // namespace mfree

@@ -541,25 +541,22 @@ Report FluidSystem::open_wall_force(const double *y, double *total, int32_t nwal
   return open_result(in.wall_force(yc, total, nwall, per_wall));
 }
 
-namespace {
-struct OpenProgress {
-  const FluidSystem *sys;
-  double *yc;
-  mfree_progress_fn fn;
-  void *user;
-  int64_t base;
-  bool user_stop = false, crossed = false;
-};
-}  // namespace
-
 int32_t FluidSystem::open_progress(void *u, int64_t step, double t, double dt) {
   auto &p = *static_cast<OpenProgress *>(u);
   // the buffers move as imposed, whatever the step did to them
   p.sys->place_buffer(t, p.yc, true);
-  p.crossed = p.sys->open_crossed(p.yc, true);
+  const bool crossed = p.sys->open_crossed(p.yc, true);
   if (p.fn && p.fn(p.user, p.base + step, t, dt)) p.user_stop = true;
-  return p.user_stop || p.crossed;
+  return p.user_stop || crossed;
 }
+
+FluidSystem &FluidSystem::open_stage(const double *y) {
+  FluidSystem &in = open_inner();
+  open_gather(y);
+  return in;
+}
+
+void FluidSystem::open_unstage(const double *yc, double *y) const { scatter_state(open_->active, dim_, n_, yc, y); }
 
 Report FluidSystem::open_integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                                    mfree_progress_fn progress, void *user, int64_t &nsteps) {
@@ -572,24 +569,28 @@ Report FluidSystem::open_integrate(int scheme, double *y, double &t, double t_en
     open_gather(y);
     in.integrate(scheme, open_->yc.data(), t0, t0, cfl, dt_max, nullptr, nullptr, k);
   }
+  return open_windows(scheme, y, t, t_end, cfl, dt_max, progress, user, nsteps);
+}
+
+Report FluidSystem::open_windows(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
+                                 mfree_progress_fn progress, void *user, int64_t &nsteps) {
+  nsteps = 0;
   Report rep = update_open(t, y);
   if (!rep.ok()) return rep;
   FluidOpen &o = *open_;
   while (t < t_end) {
     double t_stop = t_end;
     for (const InflowGate &g : o.gates) t_stop = std::min(t_stop, g.release_time(g.released_rows));
-    FluidSystem &in = open_inner();
-    open_gather(y);
-    const size_t na = o.active.size();
+    FluidSystem &in = open_stage(y);
     OpenProgress p{this, o.yc.data(), progress, user, nsteps};
     int64_t k = 0;
-    if (na > 0) {
-      rep = in.integrate(scheme, o.yc.data(), t, t_stop, cfl, dt_max, &FluidSystem::open_progress, &p, k);
+    if (!o.active.empty()) {
+      rep = in.integrate(scheme, o.yc.data(), t, t_stop, cfl, dt_max, open_stepper(), &p, k);
     } else {
       t = t_stop;  // nothing to integrate until a gate injects
     }
     nsteps += k;
-    scatter_state(o.active, dim_, n_, o.yc.data(), y);
+    open_unstage(o.yc.data(), y);
     if (!rep.ok()) return open_result(rep);
     if (p.user_stop) break;
     rep = update_open(t, y);

@@ -11,6 +11,8 @@
 #include <memory>
 #include <vector>
 
+#include "mfree.h"
+
 namespace mfree {
 
 class FluidSystem;
@@ -74,6 +76,17 @@ struct FluidOpen {
   // call (`global`); set_active's count waits for it in pending_active (-1: none).
   bool global = false;
   int32_t pending_active = -1;
+};
+
+// The integration's progress callback's data, per window (sys's open_stepper()): yc the
+// inner fluid's state, fn and user the host's callback, base the steps of earlier windows.
+struct OpenProgress {
+  const FluidSystem *sys;
+  double *yc;
+  mfree_progress_fn fn;
+  void *user;
+  int64_t base;
+  bool user_stop = false;
 };
 
 // An active fluid particle past an outflow plane: its index in the capacity (on ranks its

@@ -443,7 +443,7 @@ Report FluidRanks::integrate(int scheme, double *y, double &t, double t_end, dou
         }
   }
   check_usable();
-  if (open_) return open_integrate_ranks(scheme, y, t, t_end, cfl, dt_max, progress, user, nsteps);
+  if (open_) return open_windows(scheme, y, t, t_end, cfl, dt_max, progress, user, nsteps);
   const int D = dim();
   // node arrays for the current nodes (again after a rebuild of the ghosts)
   auto seat = [&] {

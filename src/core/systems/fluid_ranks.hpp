@@ -152,8 +152,9 @@ class FluidRanks final : public FluidSystem {
   const double *open_ranks_gather(const double *y);  // the inner's owned state
   void open_ranks_scatter(const double *yc, double *y) const;
   Report open_rhs_ranks(const double *y, double *ydot);
-  Report open_integrate_ranks(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
-                              mfree_progress_fn progress, void *user, int64_t &nsteps);
+  FluidSystem &open_stage(const double *y) override;  // (open_windows' steps)
+  void open_unstage(const double *yc, double *y) const override { open_ranks_scatter(yc, y); }
+  mfree_progress_fn open_stepper() const override { return &FluidRanks::open_progress_ranks; }
   int8_t item_state(int32_t p) const;  // host item p's state
   static mfree_status_t open_exchange(void *u, int32_t ncomp, double *field, int64_t ld);
   static mfree_status_t open_allgather(void *u, const double *in, int64_t n, double *out, int64_t cap,

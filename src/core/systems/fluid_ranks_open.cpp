@@ -268,20 +268,9 @@ mfree_status_t FluidRanks::open_rebuild(void *u, int32_t n_owned, const double *
   return MFREE_SUCCESS;
 }
 
-namespace {
-struct OpenProgressRanks {
-  const FluidRanks *sys;
-  const double *yc;
-  mfree_progress_fn fn;
-  void *user;
-  int64_t base;
-  bool user_stop = false;
-};
-}  // namespace
-
 int32_t FluidRanks::open_progress_ranks(void *u, int64_t step, double t, double dt) {
-  auto &p = *static_cast<OpenProgressRanks *>(u);
-  const FluidRanks &s = *p.sys;
+  auto &p = *static_cast<OpenProgress *>(u);
+  const auto &s = static_cast<const FluidRanks &>(*p.sys);
   const FluidOpen &o = *s.open_;
   if (p.fn && p.fn(p.user, p.base + step, t, dt)) p.user_stop = true;
   if (o.outflows.empty()) return p.user_stop;
@@ -295,32 +284,10 @@ int32_t FluidRanks::open_progress_ranks(void *u, int64_t step, double t, double 
   return p.user_stop || crossed != 0.0;
 }
 
-Report FluidRanks::open_integrate_ranks(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
-                                        mfree_progress_fn progress, void *user, int64_t &nsteps) {
-  nsteps = 0;
-  Report rep = update_open(t, y);
-  if (!rep.ok()) return rep;
-  FluidOpen &o = *open_;
-  while (t < t_end) {
-    double t_stop = t_end;
-    for (const InflowGate &g : o.gates) t_stop = std::min(t_stop, g.release_time(g.released_rows));
-    FluidRanks &in = open_ranks_inner(y);
-    open_ranks_gather(y);
-    OpenProgressRanks p{this, o.yc.data(), progress, user, nsteps};
-    int64_t k = 0;
-    if (!o.active.empty()) {
-      rep = in.integrate(scheme, o.yc.data(), t, t_stop, cfl, dt_max, &FluidRanks::open_progress_ranks, &p, k);
-    } else {
-      t = t_stop;  // nothing to integrate until a gate injects
-    }
-    nsteps += k;
-    open_ranks_scatter(o.yc.data(), y);
-    if (!rep.ok()) return rep;
-    if (p.user_stop) break;
-    rep = update_open(t, y);
-    if (!rep.ok()) return rep;
-  }
-  return rep;
+FluidSystem &FluidRanks::open_stage(const double *y) {
+  FluidRanks &in = open_ranks_inner(y);
+  open_ranks_gather(y);
+  return in;
 }
 
 Report FluidRanks::open_rhs_ranks(const double *y, double *ydot) {
