@@ -291,6 +291,9 @@ FluidSystem &FluidRanks::open_stage(const double *y) {
 }
 
 Report FluidRanks::open_rhs_ranks(const double *y, double *ydot) {
+  // a fault pending on one rank, before the halo is rebuilt around its (stand-in) state
+  const Report agreed = coll_.agree(coll_.local([] { return Report(); }));
+  if (!agreed.ok()) return agreed;
   FluidOpen &o = open();
   open_init();
   FluidRanks &in = open_ranks_inner(y);
