@@ -14,7 +14,9 @@
  *   with the one-process message, at the same time and with the same counts;
  * - the outputs not offered for open systems on ranks (interpolated velocities, the lumped
  *   mass matrix and its products, the interpolation matrix, the wall force):
- *   MFREE_ERR_UNSUPPORTED naming the open boundaries. */
+ *   MFREE_ERR_UNSUPPORTED naming the open boundaries;
+ * - a fault pending on the last rank (mfree_system_set_pending_error): the right-hand side
+ *   returns it on every rank, and the next one runs. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -123,6 +125,12 @@ int main(int argc, char **argv) {
   expect(ctx, mfree_system_apply_mass(r.sys, r.y, 0, v, Mv), MFREE_ERR_UNSUPPORTED, why, "its products");
   expect(ctx, mfree_system_assemble_interpolation(r.sys, r.y, &M), MFREE_ERR_UNSUPPORTED, why, "interpolation");
   expect(ctx, mfree_system_get_wall_force(r.sys, r.y, total, 0, NULL), MFREE_ERR_UNSUPPORTED, why, "wall force");
+  /* a fault pending on one rank (a host's check): the right-hand side returns it on every
+     rank, and the next one runs */
+  if (rank == last) mfree_system_set_pending_error(r.sys, MFREE_ERR_INPUT, "a host's fault");
+  expect_agreed(ctx, mfree_system_rhs(r.sys, t, r.y, Mv), MFREE_ERR_INPUT, last, "a host's fault",
+                "a fault pending in the right-hand side");
+  expect(ctx, mfree_system_rhs(r.sys, t, r.y, Mv), MFREE_SUCCESS, NULL, "the right-hand side after the fault");
   if (M) mfree_matrix_destroy(&M);
   free(v), free(Mv);
   rankfluid_free(&r);
