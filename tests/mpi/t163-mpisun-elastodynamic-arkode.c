@@ -210,7 +210,10 @@ int main(int argc, char **argv) {
         "negative count on one rank");
   CHECK(mfree_sundials_mpi_sum(ctx, MPI_COMM_WORLD, rank == 0 ? NULL : vals, 1, &s0) == MFREE_ERR_NULL,
         "NULL values on rank 0");
-  CHECK(mfree_sundials_mpi_sum(NULL, MPI_COMM_WORLD, vals, 1, &s0) == MFREE_ERR_NULL, "NULL context (local)");
+  CHECK(mfree_sundials_mpi_sum(NULL, MPI_COMM_WORLD, vals, 1, &s0) == MFREE_ERR_NULL, "NULL context everywhere");
+  /* a NULL context on one rank takes part in the reduction: every rank fails, none waits */
+  CHECK(mfree_sundials_mpi_sum(rank == size - 1 ? NULL : ctx, MPI_COMM_WORLD, vals, 1, &s0) == MFREE_ERR_NULL,
+        "NULL context on the last rank");
   N_Vector ser = N_VNew_Serial(4, sunctx);
   CHECK(mfree_sundials_mpi_set_reproducible(ctx, ser) == MFREE_ERR_UNSUPPORTED, "a serial vector");
   CHECK(mfree_sundials_mpi_set_reproducible(ctx, NULL) == MFREE_ERR_NULL, "NULL vector");
@@ -218,6 +221,10 @@ int main(int argc, char **argv) {
   N_Vector y = NULL;
   CHECK(mfree_sundials_mpi_create_vector(ctx, NULL, MPI_COMM_WORLD, sunctx, &y) == MFREE_ERR_NULL && !y,
         "NULL system");
+  /* (with the old early return the other ranks waited in the reduction) */
+  CHECK(mfree_sundials_mpi_create_vector(rank == size - 1 ? NULL : ctx, NULL, MPI_COMM_WORLD, sunctx, &y) ==
+                MFREE_ERR_NULL && !y,
+        "NULL context on the last rank");
 
   SUNContext_Free(&self_ctx);
   SUNContext_Free(&sunctx);

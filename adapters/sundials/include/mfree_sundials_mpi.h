@@ -75,9 +75,9 @@ MFREE_SUNDIALS_MPI_API mfree_status_t mfree_sundials_mpi_set_reproducible(mfree_
  * @param[in]  comm    the system's ranks
  * @param[in]  sunctx  the SUNDIALS context
  * @param[out] v       the new vector (the host destroys it with N_VDestroy); NULL on failure
- * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_NULL (a NULL system, SUNContext or
- *         output on some rank), MFREE_ERR_ALLOC, MFREE_ERR_INTERNAL (an MPI failure); a
- *         NULL ctx: MFREE_ERR_NULL on this rank alone
+ * @return MFREE_SUCCESS; on every rank alike: MFREE_ERR_NULL (a NULL ctx, system,
+ *         SUNContext or output on some rank; the rank with the NULL ctx gets no message),
+ *         MFREE_ERR_ALLOC, MFREE_ERR_INTERNAL (an MPI failure)
  */
 MFREE_SUNDIALS_MPI_API mfree_status_t mfree_sundials_mpi_create_vector(mfree_context_t *ctx, mfree_system_t *sys,
                                                                        MPI_Comm comm, SUNContext sunctx,
@@ -93,7 +93,8 @@ MFREE_SUNDIALS_MPI_API mfree_status_t mfree_sundials_mpi_create_vector(mfree_con
  * @param[in]  x     this rank's n values (may be NULL when n is 0)
  * @param[in]  n     this rank's count (>= 0)
  * @param[out] sum   the total
- * @return MFREE_SUCCESS; MFREE_ERR_NULL, MFREE_ERR_ARG (a negative n) on every rank alike;
+ * @return MFREE_SUCCESS; MFREE_ERR_NULL (a NULL ctx, x or sum on some rank; the rank with
+ *         the NULL ctx gets no message), MFREE_ERR_ARG (a negative n) on every rank alike;
  *         MFREE_ERR_INTERNAL for an MPI failure
  */
 MFREE_SUNDIALS_MPI_API mfree_status_t mfree_sundials_mpi_sum(mfree_context_t *ctx, MPI_Comm comm, const double *x,

@@ -71,7 +71,10 @@ sunrealtype l1norm(N_Vector x) {
   return global_sum(x, [&](sunindextype i) { return std::fabs(a[i]); });
 }
 
+// st with its message on ctx; a NULL ctx (a collective call's fault taken part in the
+// reductions, so the other ranks do not wait) gets st without one.
 mfree_status_t record(mfree_context_t *ctx, mfree_status_t st, const char *fn, const std::string &msg) {
+  if (!ctx) return st;
   const std::string text = std::string(fn) + ": " + msg;
   return mfree_context_set_error(ctx, st, text.c_str());
 }
@@ -108,12 +111,11 @@ mfree_status_t mfree_sundials_mpi_set_reproducible(mfree_context_t *ctx, N_Vecto
 mfree_status_t mfree_sundials_mpi_create_vector(mfree_context_t *ctx, mfree_system_t *sys, MPI_Comm comm,
                                                 SUNContext sunctx, N_Vector *v) {
   static const char *fn = "mfree_sundials_mpi_create_vector";
-  if (!ctx) return MFREE_ERR_NULL;
   if (v) *v = nullptr;
-  // this rank's fault and length, seen by every rank in one reduction
+  // this rank's fault and length, seen by every rank in one reduction (a NULL ctx too)
   int32_t neq = 0;
   int64_t mine[2] = {0, 0};  // (faulty ranks, local length)
-  if (!sys || !sunctx || !v || mfree_system_get_size(sys, &neq) != MFREE_SUCCESS)
+  if (!ctx || !sys || !sunctx || !v || mfree_system_get_size(sys, &neq) != MFREE_SUCCESS)
     mine[0] = 1;
   else
     mine[1] = neq;
@@ -122,7 +124,7 @@ mfree_status_t mfree_sundials_mpi_create_vector(mfree_context_t *ctx, mfree_syst
     return record(ctx, MFREE_ERR_INTERNAL, fn, "MPI_Allreduce failed");
   if (all[0] > 0)
     return record(ctx, MFREE_ERR_NULL, fn,
-                  std::to_string(all[0]) + " rank(s) passed a NULL system, SUNContext or output" +
+                  std::to_string(all[0]) + " rank(s) passed a NULL context, system, SUNContext or output" +
                       (mine[0] ? " (this one among them)" : ""));
   N_Vector y = N_VNew_Parallel(comm, neq, all[1], sunctx);
   int64_t bad = y ? 0 : 1, any = 0;
@@ -139,14 +141,13 @@ mfree_status_t mfree_sundials_mpi_create_vector(mfree_context_t *ctx, mfree_syst
 mfree_status_t mfree_sundials_mpi_sum(mfree_context_t *ctx, MPI_Comm comm, const double *x, int64_t n,
                                       double *sum) {
   static const char *fn = "mfree_sundials_mpi_sum";
-  if (!ctx) return MFREE_ERR_NULL;
   ExactSum s;
-  // a bad argument on any rank: no data reduced, every rank fails alike
-  const bool bad = n < 0 || (n > 0 && !x) || !sum;
+  // a bad argument on any rank (a NULL ctx too): no data reduced, every rank fails alike
+  const bool bad = !ctx || n < 0 || (n > 0 && !x) || !sum;
   if (!bad)
     for (int64_t i = 0; i < n; ++i) s.add(x[i]);
   // (the most negative status of the ranks: MFREE_ERR_ARG before MFREE_ERR_NULL)
-  int64_t fault = !bad ? 0 : (n < 0 ? MFREE_ERR_ARG : MFREE_ERR_NULL), worst = 0;
+  int64_t fault = !bad ? 0 : (ctx && n < 0 ? MFREE_ERR_ARG : MFREE_ERR_NULL), worst = 0;
   if (MPI_Allreduce(&fault, &worst, 1, MPI_INT64_T, MPI_MIN, comm) != MPI_SUCCESS)
     return record(ctx, MFREE_ERR_INTERNAL, fn, "MPI_Allreduce failed");
   if (worst < 0)
