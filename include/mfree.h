@@ -1984,8 +1984,8 @@ MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
  * agree on them: else MFREE_ERR_ARG), the update is collective, injected particles take
  * the lowest dormant ids as in one process and belong to the rank that owns the id, a halo
  * rebuild callback is required (MFREE_ERR_STATE), and the states, the right-hand side and
- * the integration are bitwise the one-process fluid's. The matrices, interpolated
- * velocities and wall force of such a system return MFREE_ERR_UNSUPPORTED on ranks. */
+ * the integration are bitwise the one-process fluid's. The mass and interpolation
+ * matrices and the mass products of such a system return MFREE_ERR_UNSUPPORTED on ranks. */
 
 /** States of a fluid's particles (mfree_system_get_active). */
 typedef enum {

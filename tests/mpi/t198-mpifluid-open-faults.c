@@ -12,8 +12,8 @@
  * - no halo rebuild callback: MFREE_ERR_STATE;
  * - a capacity of 60 particles: the integration stops with MFREE_FAIL_CAPACITY on every rank
  *   with the one-process message, at the same time and with the same counts;
- * - the outputs not offered for open systems on ranks (interpolated velocities, the lumped
- *   mass matrix and its products, the interpolation matrix, the wall force):
+ * - the outputs not offered for open systems on ranks (the lumped mass matrix and its
+ *   products, the interpolation matrix):
  *   MFREE_ERR_UNSUPPORTED naming the open boundaries;
  * - a fault pending on the last rank (mfree_system_set_pending_error): the right-hand side
  *   returns it on every rank, and the next one runs. */
@@ -118,13 +118,10 @@ int main(int argc, char **argv) {
   /* the outputs not offered */
   const char *why = "open boundaries";
   double *v = calloc(5 * ((size_t)r.n_owned + 1), sizeof *v), *Mv = calloc(5 * ((size_t)r.n_owned + 1), sizeof *Mv);
-  double total[2];
   mfree_matrix_t *M = NULL;
-  expect(ctx, mfree_system_get_velocity(r.sys, r.y, v), MFREE_ERR_UNSUPPORTED, why, "interpolated velocities");
   expect(ctx, mfree_system_assemble_mass(r.sys, r.y, 0, &M), MFREE_ERR_UNSUPPORTED, why, "the lumped mass");
   expect(ctx, mfree_system_apply_mass(r.sys, r.y, 0, v, Mv), MFREE_ERR_UNSUPPORTED, why, "its products");
   expect(ctx, mfree_system_assemble_interpolation(r.sys, r.y, &M), MFREE_ERR_UNSUPPORTED, why, "interpolation");
-  expect(ctx, mfree_system_get_wall_force(r.sys, r.y, total, 0, NULL), MFREE_ERR_UNSUPPORTED, why, "wall force");
   /* a fault pending on one rank (a host's check): the right-hand side returns it on every
      rank, and the next one runs */
   if (rank == last) mfree_system_set_pending_error(r.sys, MFREE_ERR_INPUT, "a host's fault");

@@ -537,9 +537,8 @@ Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t ref
     const Report mine = coll_.local([&] {
       if (refuse != MFREE_SUCCESS) throw Error(refuse, why);
       if (open_)
-        throw Error(MFREE_ERR_UNSUPPORTED, "no matrices, interpolated velocities or wall forces of a fluid with open "
-                                           "boundaries on ranks yet: its right-hand side, integration and pressures "
-                                           "only");
+        throw Error(MFREE_ERR_UNSUPPORTED, "no mass or interpolation matrices (or mass products) of a fluid with "
+                                           "open boundaries on ranks yet");
       check_ready();
       return a ? prepare_accel(ys_.data(), false, a, vals[0], vals[1])
                : prepare_rows(ys_.data(), false, vals[0], vals[1]);
@@ -584,6 +583,7 @@ void FluidRanks::pressure(const double *y, double *p) const {
 }
 
 Report FluidRanks::velocity(const double *y, double *vhat) {
+  if (open_) return open_velocity_ranks(y, vhat);
   const Report agreed = output_prepare(y, nullptr, MFREE_SUCCESS, "");
   if (!agreed.ok()) return agreed;
   const int D = dim();
@@ -600,6 +600,7 @@ Report FluidRanks::velocity(const double *y, double *vhat) {
 // integers), so that every rank gets the same bits, whatever the partition; per_wall:
 // wall_shares.
 Report FluidRanks::wall_force(const double *y, double *total, int32_t nwall, double *per_wall) {
+  if (open_) return open_wall_force_ranks(y, total, nwall, per_wall);
   const int D = dim();
   const size_t nd = static_cast<size_t>(D) * size();
   rate_n_.resize(nd);

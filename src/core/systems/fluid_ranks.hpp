@@ -151,7 +151,13 @@ class FluidRanks final : public FluidSystem {
   FluidRanks &open_ranks_inner(const double *y);     // built when dirty (collective)
   const double *open_ranks_gather(const double *y);  // the inner's owned state
   void open_ranks_scatter(const double *yc, double *y) const;
+  // An evaluation's start (collective): a pending fault agreed, the bookkeeping set up, the
+  // inner system in, its state in open_->yc.
+  Report open_begin(const double *y, FluidRanks *&in);
+  const InflowGate *buffer_gate(int32_t p) const;  // owned item p's gate if a buffer particle
   Report open_rhs_ranks(const double *y, double *ydot);
+  Report open_velocity_ranks(const double *y, double *vhat);
+  Report open_wall_force_ranks(const double *y, double *total, int32_t nwall, double *per_wall);
   FluidSystem &open_stage(const double *y) override;  // (open_windows' steps)
   void open_unstage(const double *yc, double *y) const override { open_ranks_scatter(yc, y); }
   mfree_progress_fn open_stepper() const override { return &FluidRanks::open_progress_ranks; }

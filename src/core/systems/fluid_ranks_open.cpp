@@ -290,31 +290,70 @@ FluidSystem &FluidRanks::open_stage(const double *y) {
   return in;
 }
 
-Report FluidRanks::open_rhs_ranks(const double *y, double *ydot) {
+Report FluidRanks::open_begin(const double *y, FluidRanks *&in) {
   // a fault pending on one rank, before the halo is rebuilt around its (stand-in) state
   const Report agreed = coll_.agree(coll_.local([] { return Report(); }));
   if (!agreed.ok()) return agreed;
-  FluidOpen &o = open();
+  open();
   open_init();
-  FluidRanks &in = open_ranks_inner(y);
-  const double *yc = open_ranks_gather(y);
+  in = &open_ranks_inner(y);
+  open_ranks_gather(y);
+  return agreed;
+}
+
+const InflowGate *FluidRanks::buffer_gate(int32_t p) const {
+  const FluidOpen &o = *open_;
+  const size_t g = static_cast<size_t>(gid_[owned_[p]]);
+  return o.state[g] == kInflow ? &o.gates[o.gate_of[g]] : nullptr;
+}
+
+Report FluidRanks::open_rhs_ranks(const double *y, double *ydot) {
+  FluidRanks *in = nullptr;
+  const Report begun = open_begin(y, in);
+  if (!begun.ok()) return begun;
+  FluidOpen &o = *open_;
   const int D = dim();
   const size_t na = static_cast<size_t>(link_.n_own), no = static_cast<size_t>(D) * n_own_;
   o.rc.assign((2 * D + 1) * na + 1, 0.0);
-  const Report rep = o.active.empty() ? Report() : in.rhs(0.0, yc, o.rc.data());
+  const Report rep = o.active.empty() ? Report() : in->rhs(0.0, o.yc.data(), o.rc.data());
   std::fill(ydot, ydot + static_cast<size_t>(neq()), 0.0);  // dormant: zero rates
   open_ranks_scatter(o.rc.data(), ydot);
   for (int32_t p = 0; p < n_own_; ++p) {  // buffers: imposed motion
-    const int64_t g = gid_[owned_[p]];
-    if (o.state[static_cast<size_t>(g)] != kInflow) continue;
-    const InflowGate &gate = o.gates[o.gate_of[static_cast<size_t>(g)]];
+    const InflowGate *gate = buffer_gate(p);
+    if (!gate) continue;
     for (int c = 0; c < D; ++c) {
-      ydot[static_cast<size_t>(p) * D + c] = gate.U * gate.nrm[c];
+      ydot[static_cast<size_t>(p) * D + c] = gate->U * gate->nrm[c];
       ydot[no + static_cast<size_t>(p) * D + c] = 0.0;
     }
     ydot[2 * no + p] = 0.0;
   }
   return rep;
+}
+
+Report FluidRanks::open_velocity_ranks(const double *y, double *vhat) {
+  FluidRanks *in = nullptr;
+  const Report begun = open_begin(y, in);
+  if (!begun.ok()) return begun;
+  FluidOpen &o = *open_;
+  const int D = dim();
+  const size_t na = static_cast<size_t>(link_.n_own);
+  o.rc.assign(D * na + 1, 0.0);
+  const Report rep = o.active.empty() ? Report() : in->velocity(o.yc.data(), o.rc.data());
+  std::fill(vhat, vhat + static_cast<size_t>(D) * n_own_, 0.0);  // dormant: zero
+  for (size_t q = 0; q < na; ++q)
+    std::copy_n(&o.rc[q * D], D, vhat + static_cast<size_t>(link_.item[q]) * D);
+  for (int32_t p = 0; p < n_own_; ++p) {  // buffers: imposed
+    const InflowGate *gate = buffer_gate(p);
+    if (gate)
+      for (int c = 0; c < D; ++c) vhat[static_cast<size_t>(p) * D + c] = gate->U * gate->nrm[c];
+  }
+  return rep;
+}
+
+Report FluidRanks::open_wall_force_ranks(const double *y, double *total, int32_t nwall, double *per_wall) {
+  FluidRanks *in = nullptr;
+  const Report begun = open_begin(y, in);
+  return begun.ok() ? in->wall_force(open_->yc.data(), total, nwall, per_wall) : begun;
 }
 
 }  // namespace mfree
