@@ -1983,9 +1983,9 @@ MFREE_API mfree_status_t mfree_system_integrate(mfree_system_t *sys,
  * every rank sets the same active count, gates and planes (the update and the integration
  * agree on them: else MFREE_ERR_ARG), the update is collective, injected particles take
  * the lowest dormant ids as in one process and belong to the rank that owns the id, a halo
- * rebuild callback is required (MFREE_ERR_STATE), and the states, the right-hand side and
- * the integration are bitwise the one-process fluid's. The mass and interpolation
- * matrices and the mass products of such a system return MFREE_ERR_UNSUPPORTED on ranks. */
+ * rebuild callback is required (MFREE_ERR_STATE), and the states, the right-hand side, the
+ * integration and the outputs are bitwise the one-process fluid's (the walls' total force
+ * to rounding). */
 
 /** States of a fluid's particles (mfree_system_get_active). */
 typedef enum {

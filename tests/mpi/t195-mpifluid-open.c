@@ -13,8 +13,11 @@
  * So the injected particles' global ids are the one-process capacity indices on any
  * number of ranks. At the end the right-hand side (mfree_system_rhs) of every owned
  * particle is the reference's bit for bit, and so are the pressures, the interpolated
- * velocities and the walls' force on each wall particle; their total agrees to rounding
- * (4e-12 of the fluid's weight: exact sums on ranks) and is not zero. The run is not trivial: rows went in and out
+ * velocities, the walls' force on each wall particle, the lumped and consistent mass
+ * products (mfree_system_apply_mass), the lumped mass matrix's product and every row of
+ * the interpolation matrix (its entries by column id); the walls' total
+ * force agrees to rounding (4e-12 of the fluid's weight: exact sums on ranks) and is not
+ * zero. The run is not trivial: rows went in and out
  * (180 in, 91 out by 0.3 s on one process) and particles moved between ranks. */
 #include <math.h>
 #include <stdio.h>
@@ -77,6 +80,19 @@ int main(int argc, char **argv) {
   double *rate1 = malloc(5 * (size_t)N * sizeof *rate1), *p1 = malloc((size_t)N * sizeof *p1);
   if (st == MFREE_SUCCESS) st = mfree_system_rhs(one, t, y1, rate1);
   if (st == MFREE_SUCCESS) st = mfree_system_get_pressure(one, y1, p1);
+  /* a vector for the mass products: particle g's unknowns 1 + g / 1000 + c / 10 */
+  double *u1 = malloc(5 * (size_t)N * sizeof *u1), *Mu1 = malloc(10 * (size_t)N * sizeof *Mu1);
+  for (int g = 0; g < N; ++g) {
+    for (int c = 0; c < 2; ++c) {
+      u1[2 * g + c] = 1.0 + g / 1000.0 + c / 10.0;
+      u1[2 * N + 2 * g + c] = 1.0 + g / 1000.0 + (c + 2) / 10.0;
+    }
+    u1[4 * N + g] = 1.0 + g / 1000.0 + 0.4;
+  }
+  if (st == MFREE_SUCCESS) st = mfree_system_apply_mass(one, y1, 0, u1, Mu1);
+  if (st == MFREE_SUCCESS) st = mfree_system_apply_mass(one, y1, 1, u1, Mu1 + 5 * (size_t)N);
+  mfree_matrix_t *S1 = NULL;
+  if (st == MFREE_SUCCESS) st = mfree_system_assemble_interpolation(one, y1, &S1);
   double *v1 = malloc(2 * (size_t)N * sizeof *v1), *pw1 = malloc(2 * ((size_t)b.nwall + 1) * sizeof *pw1), f1[2];
   if (st == MFREE_SUCCESS) st = mfree_system_get_velocity(one, y1, v1);
   if (st == MFREE_SUCCESS) st = mfree_system_get_wall_force(one, y1, f1, b.nwall, pw1);
@@ -165,6 +181,66 @@ int main(int argc, char **argv) {
   const double weight = ref[WINDOWS - 1].min - ref[WINDOWS - 1].mout + 18 * RHO_D2_6 * 9.81;
   CHECK(fabs(f[0] - f1[0]) <= 4e-12 * weight && fabs(f[1] - f1[1]) <= 4e-12 * weight && fabs(f1[1]) > 1e-3 * weight,
         "the walls' force (%.17g, %.17g), one process (%.17g, %.17g)", f[0], f[1], f1[0], f1[1]);
+  /* the lumped and consistent mass products, and the lumped mass matrix's, bitwise */
+  double *u = malloc(5 * ((size_t)no + 1) * sizeof *u), *Mu = malloc(5 * ((size_t)no + 1) * sizeof *Mu);
+  for (int k = 0; k < no; ++k) {
+    for (int c = 0; c < 2; ++c) {
+      u[2 * k + c] = u1[2 * id[k] + c];
+      u[2 * no + 2 * k + c] = u1[2 * N + 2 * id[k] + c];
+    }
+    u[4 * no + k] = u1[4 * N + id[k]];
+  }
+  for (int consistent = 0; consistent < 2 && st == MFREE_SUCCESS; ++consistent) {
+    st = mfree_system_apply_mass(r.sys, y, consistent, u, Mu);
+    CHECK(st == MFREE_SUCCESS && mpimove_differs(&r, Mu, Mu1 + 5 * (size_t)N * consistent, N, &first) == 0,
+          "mass products (consistent %d): status %d, first id %d differs: %s", consistent, (int)st, first,
+          mpifluid_error(ctx));
+  }
+  mfree_matrix_t *M = NULL;
+  if (st == MFREE_SUCCESS) st = mfree_system_assemble_mass(r.sys, y, 0, &M);
+  const int64_t *rp = NULL;
+  const int32_t *col = NULL;
+  const double *val = NULL;
+  if (st == MFREE_SUCCESS) st = mfree_matrix_get_csr(M, &rp, &col, &val);
+  CHECK(st == MFREE_SUCCESS, "lumped mass matrix: status %d: %s", (int)st, mpifluid_error(ctx));
+  for (int q = 0; q < 5 * no && st == MFREE_SUCCESS; ++q) {
+    double sum = 0.0;
+    for (int64_t e = rp[q]; e < rp[q + 1]; ++e) sum += val[e] * u[col[e]];
+    Mu[q] = sum;
+  }
+  CHECK(st != MFREE_SUCCESS || mpimove_differs(&r, Mu, Mu1, N, &first) == 0,
+        "the lumped mass matrix's product: id %d differs", first);
+  mfree_matrix_destroy(&M);
+  free(u), free(Mu), free(u1), free(Mu1);
+  /* the interpolation matrix: every owned row's entries (column id, value) bitwise the
+     one-process row's (its columns the host's items: owned, then ghosts) */
+  const int64_t *rp1 = NULL;
+  const int32_t *col1 = NULL;
+  const double *val1 = NULL;
+  mfree_matrix_t *S = NULL;
+  if (st == MFREE_SUCCESS) st = mfree_matrix_get_csr(S1, &rp1, &col1, &val1);
+  if (st == MFREE_SUCCESS) st = mfree_system_assemble_interpolation(r.sys, y, &S);
+  int32_t ng = 0; /* the host's items after the call (it may rebuild the ghosts) */
+  mfree_halo_get_size(r.halo, &no, &ng);
+  int64_t *items = malloc(((size_t)no + ng + 1) * sizeof *items);
+  mfree_halo_get_global_ids(r.halo, items);
+  if (st == MFREE_SUCCESS) st = mfree_matrix_get_csr(S, &rp, &col, &val);
+  CHECK(st == MFREE_SUCCESS, "interpolation: status %d: %s", (int)st, mpifluid_error(ctx));
+  wrong = 0;
+  for (int k = 0; k < no && st == MFREE_SUCCESS; ++k) {
+    const int64_t g = items[k], len = rp[k + 1] - rp[k];
+    int same = len == rp1[g + 1] - rp1[g];
+    for (int64_t e = 0; e < len && same; ++e) { /* the one-process row's entry of the same column id */
+      int64_t f = rp1[g];
+      while (f < rp1[g + 1] && col1[f] != items[col[rp[k] + e]]) ++f;
+      same = f < rp1[g + 1] && !memcmp(&val[rp[k] + e], &val1[f], sizeof *val);
+    }
+    wrong += !same;
+  }
+  CHECK(wrong == 0, "interpolation: %d owned rows differ from the one-process fluid's", wrong);
+  mfree_matrix_destroy(&S);
+  mfree_matrix_destroy(&S1);
+  free(items);
   free(vel), free(pw), free(v1), free(pw1), free(rate), free(p), free(rate1), free(p1), free(y), free(y1), free(id), free(state), free(owner);
   for (int w = 0; w < WINDOWS; ++w) free(ref[w].y), free(ref[w].state);
   mfree_migration_destroy(&mig);

@@ -12,9 +12,6 @@
  * - no halo rebuild callback: MFREE_ERR_STATE;
  * - a capacity of 60 particles: the integration stops with MFREE_FAIL_CAPACITY on every rank
  *   with the one-process message, at the same time and with the same counts;
- * - the outputs not offered for open systems on ranks (the lumped mass matrix and its
- *   products, the interpolation matrix):
- *   MFREE_ERR_UNSUPPORTED naming the open boundaries;
  * - a fault pending on the last rank (mfree_system_set_pending_error): the right-hand side
  *   returns it on every rank, and the next one runs. */
 #include <math.h>
@@ -115,21 +112,14 @@ int main(int argc, char **argv) {
   CHECK(t == t1 && in == in1 && in > 0, "exhausted at t = %.17g with %lld in; one process %.17g, %lld", t,
         (long long)in, t1, (long long)in1);
 
-  /* the outputs not offered */
-  const char *why = "open boundaries";
-  double *v = calloc(5 * ((size_t)r.n_owned + 1), sizeof *v), *Mv = calloc(5 * ((size_t)r.n_owned + 1), sizeof *Mv);
-  mfree_matrix_t *M = NULL;
-  expect(ctx, mfree_system_assemble_mass(r.sys, r.y, 0, &M), MFREE_ERR_UNSUPPORTED, why, "the lumped mass");
-  expect(ctx, mfree_system_apply_mass(r.sys, r.y, 0, v, Mv), MFREE_ERR_UNSUPPORTED, why, "its products");
-  expect(ctx, mfree_system_assemble_interpolation(r.sys, r.y, &M), MFREE_ERR_UNSUPPORTED, why, "interpolation");
+  double *Mv = calloc(5 * ((size_t)r.n_owned + 1), sizeof *Mv);
   /* a fault pending on one rank (a host's check): the right-hand side returns it on every
      rank, and the next one runs */
   if (rank == last) mfree_system_set_pending_error(r.sys, MFREE_ERR_INPUT, "a host's fault");
   expect_agreed(ctx, mfree_system_rhs(r.sys, t, r.y, Mv), MFREE_ERR_INPUT, last, "a host's fault",
                 "a fault pending in the right-hand side");
   expect(ctx, mfree_system_rhs(r.sys, t, r.y, Mv), MFREE_SUCCESS, NULL, "the right-hand side after the fault");
-  if (M) mfree_matrix_destroy(&M);
-  free(v), free(Mv);
+  free(Mv);
   rankfluid_free(&r);
   mfree_context_destroy(&ctx);
   const int rc = mpitest_finish("t198-mpifluid-open-faults");

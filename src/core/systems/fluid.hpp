@@ -331,6 +331,14 @@ class FluidSystem : public System {
   Report open_integrate(int scheme, double *y, double &t, double t_end, double cfl, double dt_max,
                         mfree_progress_fn progress, void *user, int64_t &nsteps);
   void open_options(FluidSystem &in, const double *r0, const double *m) const;  // this system's, on in
+  // The inner fluid's matrix Mc over the state of its na particles (emptied for none) as M
+  // over the state of n particles, particle a being item[a] (increasing); identity rows
+  // for the others.
+  void open_expand(SparseMatrix &Mc, const int32_t *item, size_t na, int32_t n, SparseMatrix &M) const;
+  // A matrix of compact unknowns written on n rows and ncols columns: row and column q of A
+  // become map[q] (increasing); the other rows are identity rows.
+  static void expand(const SparseMatrix &A, const std::vector<int32_t> &map, int32_t n, int32_t ncols,
+                     SparseMatrix &out);
   // The decisions of an update (the counters, the state of every particle of the capacity)
   // from the crossings out, in increasing particle order; fresh: the particles it
   // activated, with their gates.

@@ -472,11 +472,9 @@ void FluidSystem::open_pressure(const double *y, double *p) const {
   for (size_t a = 0; a < o.active.size(); ++a) p[o.active[a]] = pc[a];
 }
 
-namespace {
-// A matrix of the compact unknowns written on the capacity's: row and column q of the
-// compact matrix become map[q]; the other rows are identity rows.
-void expand(const SparseMatrix &A, const std::vector<int32_t> &map, int32_t n, SparseMatrix &out) {
-  std::vector<int32_t> inv(n, -1);
+void FluidSystem::expand(const SparseMatrix &A, const std::vector<int32_t> &map, int32_t n, int32_t ncols,
+                         SparseMatrix &out) {
+  std::vector<int32_t> inv(ncols, -1);
   for (size_t q = 0; q < map.size(); ++q) inv[map[q]] = static_cast<int32_t>(q);
   std::vector<int64_t> rp(static_cast<size_t>(n) + 1, 0);
   std::vector<int32_t> cols;
@@ -496,10 +494,9 @@ void expand(const SparseMatrix &A, const std::vector<int32_t> &map, int32_t n, S
     }
     rp[r + 1] = static_cast<int64_t>(cols.size());
   }
-  out.set_pattern(n, n, std::move(rp), std::move(cols));
+  out.set_pattern(n, ncols, std::move(rp), std::move(cols));
   std::copy(vals.begin(), vals.end(), out.values_mut().begin());
 }
-}  // namespace
 
 Report FluidSystem::open_interpolation(const double *y, SparseMatrix &S) {
   FluidSystem &in = open_inner();
@@ -508,7 +505,7 @@ Report FluidSystem::open_interpolation(const double *y, SparseMatrix &S) {
   Report rep = open_->active.empty() ? Report() : in.interpolation(yc, Sc);
   if (!rep.ok()) return open_result(rep);
   if (open_->active.empty()) Sc.set_pattern(0, 0, std::vector<int64_t>(1, 0), {});
-  expand(Sc, open_->active, n_, S);
+  expand(Sc, open_->active, n_, n_, S);
   return rep;
 }
 
@@ -519,20 +516,23 @@ Report FluidSystem::open_mass(const double *y, bool consistent, SparseMatrix &M)
   SparseMatrix Mc;
   Report rep = o.active.empty() ? Report() : in.mass(yc, consistent, Mc);
   if (!rep.ok()) return open_result(rep);
-  if (o.active.empty()) Mc.set_pattern(0, 0, std::vector<int64_t>(1, 0), {});
+  open_expand(Mc, o.active.data(), o.active.size(), n_, M);
+  return rep;
+}
+
+void FluidSystem::open_expand(SparseMatrix &Mc, const int32_t *item, size_t na, int32_t n, SparseMatrix &M) const {
+  if (na == 0) Mc.set_pattern(0, 0, std::vector<int64_t>(1, 0), {});
   const int dim = dim_;
-  const size_t na = o.active.size();
-  std::vector<int32_t> map((2 * dim + 1) * na);  // compact unknown -> capacity unknown
+  std::vector<int32_t> map((2 * dim + 1) * na);  // compact unknown -> the state's unknown
   for (size_t a = 0; a < na; ++a) {
-    const int32_t i = o.active[a];
+    const int32_t i = item[a];
     for (int c = 0; c < dim; ++c) {
       map[a * dim + c] = i * dim + c;
-      map[na * dim + a * dim + c] = dim * n_ + i * dim + c;
+      map[na * dim + a * dim + c] = dim * n + i * dim + c;
     }
-    map[2 * na * dim + a] = 2 * dim * n_ + i;
+    map[2 * na * dim + a] = 2 * dim * n + i;
   }
-  expand(Mc, map, neq(), M);
-  return rep;
+  expand(Mc, map, (2 * dim + 1) * n, (2 * dim + 1) * n, M);
 }
 
 Report FluidSystem::open_wall_force(const double *y, double *total, int32_t nwall, double *per_wall) {

@@ -536,9 +536,6 @@ Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t ref
     for (int k = 0; k < nwant; ++k) vals[2 + k] = want[k];
     const Report mine = coll_.local([&] {
       if (refuse != MFREE_SUCCESS) throw Error(refuse, why);
-      if (open_)
-        throw Error(MFREE_ERR_UNSUPPORTED, "no mass or interpolation matrices (or mass products) of a fluid with "
-                                           "open boundaries on ranks yet");
       check_ready();
       return a ? prepare_accel(ys_.data(), false, a, vals[0], vals[1])
                : prepare_rows(ys_.data(), false, vals[0], vals[1]);
@@ -560,6 +557,7 @@ Report FluidRanks::output_prepare(const double *y, double *a, mfree_status_t ref
 // fluid's. The consistent mass couples owned particles to ghosts, which the rank's
 // state does not hold: its products are apply_mass's (fluid_ranks_matrices.cpp).
 Report FluidRanks::mass(const double *y, bool consistent, SparseMatrix &M) {
+  if (open_) return open_mass_ranks(y, consistent, M);
   const Report agreed = output_prepare(
       y, nullptr, consistent ? MFREE_ERR_UNSUPPORTED : MFREE_SUCCESS,
       "no consistent mass matrix for the fluid on ranks (its rows couple owned particles to ghosts): "

@@ -149,7 +149,7 @@ class FluidRanks final : public FluidSystem {
   void open_init();                                  // the bookkeeping per global id (collective)
   void open_items();                                 // link_ from the current items
   FluidRanks &open_ranks_inner(const double *y);     // built when dirty (collective)
-  const double *open_ranks_gather(const double *y);  // the inner's owned state
+  void open_ranks_gather(const double *y, std::vector<double> &yc) const;  // the inner's owned part
   void open_ranks_scatter(const double *yc, double *y) const;
   // An evaluation's start (collective): a pending fault agreed, the bookkeeping set up, the
   // inner system in, its state in open_->yc.
@@ -157,6 +157,9 @@ class FluidRanks final : public FluidSystem {
   const InflowGate *buffer_gate(int32_t p) const;  // owned item p's gate if a buffer particle
   Report open_rhs_ranks(const double *y, double *ydot);
   Report open_velocity_ranks(const double *y, double *vhat);
+  Report open_mass_ranks(const double *y, bool consistent, SparseMatrix &M);
+  Report open_interpolation_ranks(const double *y, SparseMatrix &S);
+  Report open_apply_mass_ranks(const double *y, bool consistent, const double *v, double *Mv);
   Report open_wall_force_ranks(const double *y, double *total, int32_t nwall, double *per_wall);
   FluidSystem &open_stage(const double *y) override;  // (open_windows' steps)
   void open_unstage(const double *yc, double *y) const override { open_ranks_scatter(yc, y); }

@@ -54,6 +54,7 @@ void FluidRanks::consistent_rows(SparseMatrix &M) const {
 // ghosts' from their owners (one exchange of dim values per item).
 Report FluidRanks::apply_mass(const double *y, bool consistent, const double *v, double *Mv) {
   check_usable();
+  if (open_) return open_apply_mass_ranks(y, consistent, v, Mv);
   double same = 0.0;
   const Report mine = coll_.local([&] {
     same = kept_mass_.holds(y, neq(), consistent, options_gen_) ? 1.0 : 0.0;
@@ -95,6 +96,7 @@ Report FluidRanks::apply_mass(const double *y, bool consistent, const double *v,
 // The owned rows in the host's order, the columns the host's items (owned, then ghosts,
 // as the global ids given at creation or by the last rebuild list them).
 Report FluidRanks::interpolation(const double *y, SparseMatrix &S) {
+  if (open_) return open_interpolation_ranks(y, S);
   const Report agreed =
       output_prepare(y, nullptr, !y && n_own_ > 0 ? MFREE_ERR_NULL : MFREE_SUCCESS, "y is NULL");
   if (!agreed.ok()) return agreed;

@@ -195,20 +195,18 @@ FluidRanks &FluidRanks::open_ranks_inner(const double *y) {
   return static_cast<FluidRanks &>(*o.inner);
 }
 
-const double *FluidRanks::open_ranks_gather(const double *y) {
-  FluidOpen &o = *open_;
+void FluidRanks::open_ranks_gather(const double *y, std::vector<double> &yc) const {
   const int D = dim();
   const size_t na = static_cast<size_t>(link_.n_own), no = static_cast<size_t>(D) * n_own_;
-  o.yc.assign((2 * D + 1) * na + 1, 0.0);
+  yc.assign((2 * D + 1) * na + 1, 0.0);
   for (size_t q = 0; q < na; ++q) {
     const size_t p = static_cast<size_t>(link_.item[q]);
     for (int c = 0; c < D; ++c) {
-      o.yc[q * D + c] = y[p * D + c];
-      o.yc[na * D + q * D + c] = y[no + p * D + c];
+      yc[q * D + c] = y[p * D + c];
+      yc[na * D + q * D + c] = y[no + p * D + c];
     }
-    o.yc[2 * na * D + q] = y[2 * no + p];
+    yc[2 * na * D + q] = y[2 * no + p];
   }
-  return o.yc.data();
 }
 
 void FluidRanks::open_ranks_scatter(const double *yc, double *y) const {
@@ -286,7 +284,7 @@ int32_t FluidRanks::open_progress_ranks(void *u, int64_t step, double t, double 
 
 FluidSystem &FluidRanks::open_stage(const double *y) {
   FluidRanks &in = open_ranks_inner(y);
-  open_ranks_gather(y);
+  open_ranks_gather(y, open_->yc);
   return in;
 }
 
@@ -297,7 +295,7 @@ Report FluidRanks::open_begin(const double *y, FluidRanks *&in) {
   open();
   open_init();
   in = &open_ranks_inner(y);
-  open_ranks_gather(y);
+  open_ranks_gather(y, open_->yc);
   return agreed;
 }
 
@@ -347,6 +345,46 @@ Report FluidRanks::open_velocity_ranks(const double *y, double *vhat) {
     if (gate)
       for (int c = 0; c < D; ++c) vhat[static_cast<size_t>(p) * D + c] = gate->U * gate->nrm[c];
   }
+  return rep;
+}
+
+Report FluidRanks::open_mass_ranks(const double *y, bool consistent, SparseMatrix &M) {
+  FluidRanks *in = nullptr;
+  const Report begun = open_begin(y, in);
+  if (!begun.ok()) return begun;
+  SparseMatrix Mc;
+  const Report rep = open_->active.empty() ? Report() : in->mass(open_->yc.data(), consistent, Mc);
+  if (rep.ok()) open_expand(Mc, link_.item.data(), static_cast<size_t>(link_.n_own), n_own_, M);
+  return rep;
+}
+
+// M v as the one-process fluid's expanded matrix applies it: the inner fluid's product at
+// the active particles' unknowns, v itself at the dormant ones (identity rows).
+Report FluidRanks::open_apply_mass_ranks(const double *y, bool consistent, const double *v, double *Mv) {
+  FluidRanks *in = nullptr;
+  const Report begun = open_begin(y, in);
+  if (!begun.ok()) return begun;
+  FluidOpen &o = *open_;
+  std::vector<double> vc;
+  open_ranks_gather(v, vc);
+  o.rc.assign(vc.size(), 0.0);
+  const Report rep = o.active.empty() ? Report() : in->apply_mass(o.yc.data(), consistent, vc.data(), o.rc.data());
+  std::copy_n(v, neq(), Mv);
+  open_ranks_scatter(o.rc.data(), Mv);
+  return rep;
+}
+
+// The owned rows over the host's items: the inner fluid's rows at the active owned items,
+// its columns (its items) at theirs; identity rows at the dormant owned items.
+Report FluidRanks::open_interpolation_ranks(const double *y, SparseMatrix &S) {
+  FluidRanks *in = nullptr;
+  const Report begun = open_begin(y, in);
+  if (!begun.ok()) return begun;
+  SparseMatrix Sc;
+  const Report rep = open_->active.empty() ? Report() : in->interpolation(open_->yc.data(), Sc);
+  if (!rep.ok()) return rep;
+  if (open_->active.empty()) Sc.set_pattern(0, 0, std::vector<int64_t>(1, 0), {});
+  expand(Sc, link_.item, n_own_, size(), S);
   return rep;
 }
 
