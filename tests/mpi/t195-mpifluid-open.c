@@ -294,7 +294,8 @@ int main(int argc, char **argv) {
   mfree_matrix_destroy(&S1);
   free(items);
   if (scheme == MFREE_INTEGRATOR_LEAPFROG) host_windows(ctx, &b, owner); /* (no scheme of ours) */
-  free(vel), free(pw), free(v1), free(pw1), free(rate), free(p), free(rate1), free(p1), free(y), free(y1), free(id), free(state), free(owner);
+  free(vel), free(pw), free(v1), free(pw1), free(rate), free(p), free(rate1), free(p1);
+  free(y), free(y1), free(id), free(state), free(owner);
   for (int w = 0; w < WINDOWS; ++w) free(ref[w].y), free(ref[w].state);
   mfree_migration_destroy(&mig);
   rankfluid_free(&r);

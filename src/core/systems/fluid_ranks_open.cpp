@@ -185,10 +185,11 @@ FluidRanks &FluidRanks::open_ranks_inner(const double *y) {
     const FluidOpen &op = *open_;
     const int Dm = dim();
     const size_t nd = static_cast<size_t>(Dm) * n;
-    for (int32_t k = 0; k < n; ++k)
+    for (int32_t k = 0; k < n; ++k) {
+      const size_t at = static_cast<size_t>(k) * Dm;
       if (op.state[static_cast<size_t>(gid[k])] == kInflow)
-        buffer_state(static_cast<int32_t>(gid[k]), t, ys + static_cast<size_t>(k) * Dm, ys + nd + static_cast<size_t>(k) * Dm,
-                     ys + 2 * nd + k);
+        buffer_state(static_cast<int32_t>(gid[k]), t, ys + at, ys + nd + at, ys + 2 * nd + k);
+    }
   };
   o.inner = std::move(in);
   o.dirty = false;
