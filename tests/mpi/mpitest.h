@@ -5,6 +5,7 @@
 
 #include <mpi.h>
 #include <stdint.h>
+#include <stdio.h> /* CHECK prints */
 
 #include "mfree.h"
 #include "mfree_mpi.h"
