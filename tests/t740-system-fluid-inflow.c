@@ -29,7 +29,8 @@
  * 6. A square gate in 3D (lattice, mass, buffer; parallel edges refused).
  * 7. Bad input: NULL pointers, non-unit or non-orthogonal normals, short edges, bad
  *    speed/density/spacing, non-finite coordinates, gate numbers out of order, an active
- *    count out of range or set after the first update, sizes that do not match. */
+ *    count out of range or set after the first update, sizes that do not match.
+ * 8. The kept mass of mfree_system_apply_mass follows the particles' states (below). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -312,6 +313,46 @@ static void test_host_windows(void **s) {
   free(r);
 }
 
+/* Test 8: mfree_system_apply_mass keeps the mass of one state, and an update that changes the
+ * particles' states (a new row, releases) makes it assemble again even at the same y:
+ * the product at the old state's bits equals a fresh mfree_system_assemble_mass's
+ * (bit for bit) and differs from the product kept before the update. */
+static void test_kept_mass_states(void **s) {
+  (void)s;
+  enum { N = 200 };
+  double *y;
+  mfree_system_t *sys = channel(N, &y);
+  double *y0 = malloc(sizeof(double) * 5 * N), *v = malloc(sizeof(double) * 5 * N);
+  double *m1 = malloc(sizeof(double) * 5 * N), *m2 = malloc(sizeof(double) * 5 * N);
+  double *mr = malloc(sizeof(double) * 5 * N);
+  for (int q = 0; q < 5 * N; ++q) v[q] = 1.0 + 1e-3 * q;
+  assert_ok(ctx, mfree_system_update_open_boundaries(sys, 0.0, y));
+  for (int consistent = 0; consistent < 2; ++consistent) {
+    const double t = (1 + consistent) * D / U; /* one more row each time */
+    memcpy(y0, y, sizeof(double) * 5 * N);
+    int32_t na0 = 0, na1 = 0;
+    assert_ok(ctx, mfree_system_get_active(sys, &na0, 0, NULL));
+    assert_ok(ctx, mfree_system_apply_mass(sys, y0, consistent, v, m1));
+    assert_ok(ctx, mfree_system_update_open_boundaries(sys, t, y));
+    assert_ok(ctx, mfree_system_get_active(sys, &na1, 0, NULL));
+    assert_true(na1 > na0);
+    assert_ok(ctx, mfree_system_apply_mass(sys, y0, consistent, v, m2));
+    mfree_matrix_t *M = NULL;
+    assert_ok(ctx, mfree_system_assemble_mass(sys, y0, consistent, &M));
+    assert_ok(ctx, mfree_matrix_apply(M, v, mr));
+    mfree_matrix_destroy(&M);
+    assert_memory_equal(m2, mr, sizeof(double) * 5 * N);
+    assert_memory_not_equal(m1, m2, sizeof(double) * 5 * N);
+  }
+  mfree_system_destroy(&sys);
+  free(y);
+  free(y0);
+  free(v);
+  free(m1);
+  free(m2);
+  free(mr);
+}
+
 static void test_bad_input(void **s) {
   (void)s;
   double *y;
@@ -419,6 +460,7 @@ int main(void) {
       cmocka_unit_test(test_dormant_excluded),
       cmocka_unit_test(test_host_windows),
       cmocka_unit_test(test_gate_3d),
+      cmocka_unit_test(test_kept_mass_states),
       cmocka_unit_test(test_bad_input),
   };
   return cmocka_run_group_tests(tests, setup, teardown);

@@ -313,12 +313,14 @@ void FluidSystem::KeptMass::keep(const double *at, int32_t neq, bool c, int64_t 
 }
 
 Report FluidSystem::apply_mass(const double *y, bool consistent, const double *v, double *Mv) {
-  // (open boundaries change the active particles without a setter: no mass kept)
-  if (open_ || !kept_mass_.holds(y, neq(), consistent, options_gen_)) {
+  // (open boundaries change the particles' states without a setter: their generation
+  // counts too; the sum of the two counters changes whenever either does)
+  const int64_t gen = options_gen_ + (open_ ? open_->gen : 0);
+  if (!kept_mass_.holds(y, neq(), consistent, gen)) {
     kept_mass_.valid = false;
     Report rep = mass(y, consistent, kept_mass_.M);
     if (!rep.ok()) return rep;
-    if (!open_) kept_mass_.keep(y, neq(), consistent, options_gen_);
+    kept_mass_.keep(y, neq(), consistent, gen);
   }
   kept_mass_.M.apply(v, Mv);
   return Report();

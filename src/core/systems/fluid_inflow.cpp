@@ -28,6 +28,7 @@ void FluidOpen::index_active() {
   slot.assign(state.size(), -1);
   for (size_t a = 0; a < active.size(); ++a) slot[active[a]] = static_cast<int32_t>(a);
   dirty = true;
+  ++gen;
 }
 
 namespace {

@@ -70,7 +70,8 @@ struct FluidOpen {
   // the active set or an option changes.
   std::unique_ptr<FluidSystem> inner;
   bool dirty = true;
-  std::vector<double> yc, rc;      // compact state and rates
+  std::vector<double> yc, rc, vc;  // compact state, rates and (mass products on ranks) vector
+  int64_t gen = 0;                 // bumped by index_active: the states changed
   // On ranks (fluid_ranks_open.cpp) the fields above are per global id over every rank's
   // items, ids 0 .. N - 1, and the same on every rank: set up by the first collective
   // call (`global`); set_active's count waits for it in pending_active (-1: none).

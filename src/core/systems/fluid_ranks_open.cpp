@@ -295,8 +295,7 @@ Report FluidRanks::open_begin(const double *y, FluidRanks *&in) {
   if (!agreed.ok()) return agreed;
   open();
   open_init();
-  in = &open_ranks_inner(y);
-  open_ranks_gather(y, open_->yc);
+  in = &static_cast<FluidRanks &>(open_stage(y));
   return agreed;
 }
 
@@ -366,10 +365,9 @@ Report FluidRanks::open_apply_mass_ranks(const double *y, bool consistent, const
   const Report begun = open_begin(y, in);
   if (!begun.ok()) return begun;
   FluidOpen &o = *open_;
-  std::vector<double> vc;
-  open_ranks_gather(v, vc);
-  o.rc.assign(vc.size(), 0.0);
-  const Report rep = o.active.empty() ? Report() : in->apply_mass(o.yc.data(), consistent, vc.data(), o.rc.data());
+  open_ranks_gather(v, o.vc);
+  o.rc.assign(o.vc.size(), 0.0);
+  const Report rep = o.active.empty() ? Report() : in->apply_mass(o.yc.data(), consistent, o.vc.data(), o.rc.data());
   std::copy_n(v, neq(), Mv);
   open_ranks_scatter(o.rc.data(), Mv);
   return rep;
